@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The whole test suite: formatting, lints, Rust unit and integration tests
+# (release-optimised physics), and — as later layers land — the C examples and
+# the fmpy checks. Installs what it needs; run from anywhere.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --all-targets --release -- -D warnings
+echo "== cargo test (release)"
+cargo test --release --all-targets
+cargo test --release --doc
+if [ -f examples_c/Makefile ]; then
+  echo "== C examples"
+  make -C examples_c test
+fi
+if [ -f tests/fmu/run.sh ]; then
+  echo "== FMU checks (fmpy)"
+  bash tests/fmu/run.sh
+fi
+echo "== all tests passed"

@@ -1,0 +1,134 @@
+//! The typed error of the core. Every variant names what went wrong, with the
+//! offending value and, for input errors, the allowed range.
+
+/// Errors returned by the core library.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A parameter value is outside its allowed range (or NaN/infinite).
+    #[error("parameter `{name}` = {value} is out of range: allowed {range}")]
+    OutOfRange {
+        /// Parameter name.
+        name: String,
+        /// Rejected value.
+        value: f64,
+        /// Allowed range, in interval notation.
+        range: String,
+    },
+    /// A parameter name that the scene does not have.
+    #[error("unknown parameter `{name}` for scene `{scene}`; allowed: {allowed}")]
+    UnknownParameter {
+        /// The unknown name.
+        name: String,
+        /// Scene name.
+        scene: String,
+        /// Comma-separated list of allowed names.
+        allowed: String,
+    },
+    /// A scene name that does not exist.
+    #[error("unknown scene `{name}`; allowed: {allowed}")]
+    UnknownScene {
+        /// The unknown name.
+        name: String,
+        /// Comma-separated list of scene names.
+        allowed: String,
+    },
+    /// A parameter value that could not be parsed as a number.
+    #[error("parameter `{name}`: cannot parse `{text}` as a number")]
+    ParseValue {
+        /// Parameter name.
+        name: String,
+        /// Text given.
+        text: String,
+    },
+    /// Parameters that are each in range but inconsistent together.
+    #[error("inconsistent parameters: {0}")]
+    Inconsistent(String),
+    /// A scene file that could not be read or parsed.
+    #[error("scene file: {0}")]
+    SceneFile(String),
+    /// The MSPH moment matrix of a particle is singular or too ill-conditioned.
+    #[error(
+        "singular MSPH moment matrix at particle {particle} (t = {time:.4e} s, condition number {condition:.3e}): \
+         too few or collinear neighbours; increase smoothing_ratio"
+    )]
+    SingularMomentMatrix {
+        /// Particle index.
+        particle: usize,
+        /// Simulated time.
+        time: f64,
+        /// Estimated 1-norm condition number.
+        condition: f64,
+    },
+    /// A field became NaN or infinite.
+    #[error("non-finite {field} at particle {particle} (t = {time:.4e} s)")]
+    NonFinite {
+        /// Field name.
+        field: &'static str,
+        /// Particle index.
+        particle: usize,
+        /// Simulated time.
+        time: f64,
+    },
+    /// A particle moved through a rigid boundary (the anvil or the axis).
+    #[error(
+        "particle {particle} passed through the {boundary} (t = {time:.4e} s, position {position:.4e} m)"
+    )]
+    ThroughBoundary {
+        /// Particle index.
+        particle: usize,
+        /// "anvil" or "axis".
+        boundary: &'static str,
+        /// Simulated time.
+        time: f64,
+        /// The offending coordinate.
+        position: f64,
+    },
+    /// The time step collapsed: the run left the domain where the explicit
+    /// integrator can make progress.
+    #[error("time step collapsed to {dt:.3e} s (t = {time:.4e} s), below {min:.3e} s")]
+    TimeStepCollapse {
+        /// Current step.
+        dt: f64,
+        /// Simulated time.
+        time: f64,
+        /// Smallest accepted step.
+        min: f64,
+    },
+    /// The energy balance drifted past its bound.
+    #[error("energy error {error:.3e} exceeds the bound {bound} (t = {time:.4e} s)")]
+    EnergyDrift {
+        /// Relative energy error.
+        error: f64,
+        /// Bound.
+        bound: f64,
+        /// Simulated time.
+        time: f64,
+    },
+    /// The caller cancelled the run from a progress callback.
+    #[error("run cancelled by the caller at t = {time:.4e} s")]
+    Cancelled {
+        /// Simulated time when cancelled.
+        time: f64,
+    },
+    /// An input/output failure while writing results.
+    #[error("I/O error on {path}: {message}")]
+    Io {
+        /// File path.
+        path: String,
+        /// System message.
+        message: String,
+    },
+}
+
+impl Error {
+    /// Builds an [`Error::Io`] from a path and an I/O error.
+    pub fn io(path: impl AsRef<std::path::Path>, e: impl std::fmt::Display) -> Self {
+        Error::Io {
+            path: path.as_ref().display().to_string(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// Result alias of the core.
+pub type Result<T> = std::result::Result<T, Error>;

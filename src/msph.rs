@@ -1,0 +1,390 @@
+//! Modified SPH (MSPH) basis functions, eqs. (2.2)-(2.6) of Batra & Zhang (2008).
+//!
+//! For particle `i` the Taylor expansion of a field to second order, multiplied by
+//! the kernel and its first and second derivatives and summed over the
+//! neighbours with weights `V_j = m_j / rho_j`, gives the linear system
+//! `B F = T` (6x6 in the R-Z plane, 3x3 on a line). Row `k` of `B^-1` turns the
+//! neighbour values into the `k`-th entry of `F = (f, f_R, f_Z, f_RR, f_ZZ, f_RZ)`.
+//!
+//! The system is assembled in scaled variables (offsets divided by `h`, the
+//! `k`-th derivative of the kernel multiplied by `h^k`) so that its entries are
+//! of order one whatever the units; the kernel's normalising constant cancels.
+//! A particle (a ring in the axisymmetric case) weighs `V_j = m_j / rho_j`.
+
+use crate::kernel::{EXP_M4, SUPPORT};
+use nalgebra::{Matrix3, Matrix6, SVector};
+
+/// Largest 1-norm condition number of a scaled moment matrix that is accepted.
+/// Beyond it the particle arrangement cannot support a second-order
+/// expansion and the solver stops with a named error.
+pub const MAX_CONDITION: f64 = 1e10;
+
+/// Index of an entry of `F` in the 2-D system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(usize)]
+pub enum Row2 {
+    /// f
+    F = 0,
+    /// df/dR
+    R = 1,
+    /// df/dZ
+    Z = 2,
+    /// d2f/dR2
+    Rr = 3,
+    /// d2f/dZ2
+    Zz = 4,
+    /// d2f/dRdZ
+    Rz = 5,
+}
+
+impl Row2 {
+    /// Order of the derivative this row estimates.
+    fn order(self) -> i32 {
+        match self {
+            Row2::F => 0,
+            Row2::R | Row2::Z => 1,
+            _ => 2,
+        }
+    }
+}
+
+/// A moment matrix that could not be inverted: the neighbourhood of `particle`
+/// is degenerate (too few or collinear neighbours).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Degenerate {
+    /// Index of the particle.
+    pub particle: usize,
+    /// Estimated 1-norm condition number (infinite when singular).
+    pub condition: f64,
+}
+
+/// Scaled test functions `Phi` (kernel and derivatives times powers of h) for a
+/// scaled offset `s = (x_j - x_i)/h`.
+#[inline]
+fn phi2(sr: f64, sz: f64) -> Option<[f64; 6]> {
+    let q2 = sr * sr + sz * sz;
+    if q2 > SUPPORT * SUPPORT {
+        return None;
+    }
+    let e = (-q2).exp();
+    // Derivatives are with respect to the evaluation point x_i, so d = -s.
+    Some([
+        e - EXP_M4,
+        2.0 * e * sr,
+        2.0 * e * sz,
+        e * (4.0 * sr * sr - 2.0),
+        e * (4.0 * sz * sz - 2.0),
+        e * 4.0 * sr * sz,
+    ])
+}
+
+#[inline]
+fn theta2(sr: f64, sz: f64) -> [f64; 6] {
+    [1.0, sr, sz, 0.5 * sr * sr, 0.5 * sz * sz, sr * sz]
+}
+
+/// Selected rows of the inverse of the scaled 2-D moment matrix of particle
+/// `i`, ready to form shape functions with [`Msph2Rows::weight`].
+#[derive(Debug, Clone, Copy)]
+pub struct Msph2Rows<const K: usize> {
+    rows: [SVector<f64, 6>; K],
+    scale: [f64; K],
+    xi: [f64; 2],
+    inv_h: f64,
+}
+
+impl<const K: usize> Msph2Rows<K> {
+    /// Solves the 2-D MSPH system of particle `i` for the requested rows.
+    /// `pos` are the (R, Z) positions, `vol` the weights `m_j / rho_j`.
+    pub fn new(
+        i: usize,
+        neighbors: &[usize],
+        pos: &[[f64; 2]],
+        vol: &[f64],
+        h: f64,
+        which: [Row2; K],
+    ) -> Result<Self, Degenerate> {
+        let xi = pos[i];
+        let inv_h = 1.0 / h;
+        let mut b = Matrix6::<f64>::zeros();
+        for &j in neighbors {
+            let sr = (pos[j][0] - xi[0]) * inv_h;
+            let sz = (pos[j][1] - xi[1]) * inv_h;
+            let Some(phi) = phi2(sr, sz) else { continue };
+            let th = theta2(sr, sz);
+            let v = vol[j];
+            for a in 0..6 {
+                let pv = phi[a] * v;
+                for c in 0..6 {
+                    b[(a, c)] += pv * th[c];
+                }
+            }
+        }
+        let inv = invert_checked(i, b)?;
+        let rows = which.map(|r| inv.row(r as usize).transpose());
+        let scale = which.map(|r| inv_h.powi(r.order()));
+        Ok(Self {
+            rows,
+            scale,
+            xi,
+            inv_h,
+        })
+    }
+
+    /// Shape-function weights of neighbour `xj` with weight `vj` for each
+    /// requested row: `d^k f(x_i) = sum_j weight_k(j) f_j`.
+    #[inline]
+    pub fn weight(&self, xj: [f64; 2], vj: f64) -> [f64; K] {
+        let sr = (xj[0] - self.xi[0]) * self.inv_h;
+        let sz = (xj[1] - self.xi[1]) * self.inv_h;
+        let Some(phi) = phi2(sr, sz) else {
+            return [0.0; K];
+        };
+        let mut out = [0.0; K];
+        for k in 0..K {
+            let r = &self.rows[k];
+            let mut s = 0.0;
+            for a in 0..6 {
+                s += r[a] * phi[a];
+            }
+            out[k] = s * vj * self.scale[k];
+        }
+        out
+    }
+}
+
+fn invert_checked<const N: usize>(
+    i: usize,
+    b: nalgebra::SMatrix<f64, N, N>,
+) -> Result<nalgebra::SMatrix<f64, N, N>, Degenerate>
+where
+    nalgebra::Const<N>: nalgebra::DimMin<nalgebra::Const<N>, Output = nalgebra::Const<N>>,
+{
+    let inv = b.try_inverse().ok_or(Degenerate {
+        particle: i,
+        condition: f64::INFINITY,
+    })?;
+    let norm1 = |m: &nalgebra::SMatrix<f64, N, N>| {
+        (0..N)
+            .map(|c| m.column(c).iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    };
+    let cond = norm1(&b) * norm1(&inv);
+    if !cond.is_finite() || cond > MAX_CONDITION {
+        return Err(Degenerate {
+            particle: i,
+            condition: cond,
+        });
+    }
+    Ok(inv)
+}
+
+/// Index of an entry of `F = (f, f_R, f_RR)` in the 1-D system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(usize)]
+pub enum Row1 {
+    /// f
+    F = 0,
+    /// df/dR
+    R = 1,
+    /// d2f/dR2
+    Rr = 2,
+}
+
+#[inline]
+fn phi1(s: f64) -> Option<[f64; 3]> {
+    let q2 = s * s;
+    if q2 > SUPPORT * SUPPORT {
+        return None;
+    }
+    let e = (-q2).exp();
+    Some([e - EXP_M4, 2.0 * e * s, e * (4.0 * s * s - 2.0)])
+}
+
+/// Selected rows of the inverse of the scaled 1-D (radial) moment matrix.
+#[derive(Debug, Clone, Copy)]
+pub struct Msph1Rows<const K: usize> {
+    rows: [nalgebra::Vector3<f64>; K],
+    scale: [f64; K],
+    xi: f64,
+    inv_h: f64,
+}
+
+impl<const K: usize> Msph1Rows<K> {
+    /// Solves the 3x3 MSPH system (f, f_R, f_RR) of particle `i` on a line.
+    pub fn new(
+        i: usize,
+        neighbors: &[usize],
+        pos: &[f64],
+        vol: &[f64],
+        h: f64,
+        which: [Row1; K],
+    ) -> Result<Self, Degenerate> {
+        let xi = pos[i];
+        let inv_h = 1.0 / h;
+        let mut b = Matrix3::<f64>::zeros();
+        for &j in neighbors {
+            let s = (pos[j] - xi) * inv_h;
+            let Some(phi) = phi1(s) else { continue };
+            let th = [1.0, s, 0.5 * s * s];
+            for a in 0..3 {
+                for c in 0..3 {
+                    b[(a, c)] += phi[a] * vol[j] * th[c];
+                }
+            }
+        }
+        let inv = invert_checked(i, b)?;
+        let rows = which.map(|r| inv.row(r as usize).transpose());
+        let scale = which.map(|r| inv_h.powi(r as i32));
+        Ok(Self {
+            rows,
+            scale,
+            xi,
+            inv_h,
+        })
+    }
+
+    /// Shape-function weights of the neighbour at `xj` with weight `vj`.
+    #[inline]
+    pub fn weight(&self, xj: f64, vj: f64) -> [f64; K] {
+        let Some(phi) = phi1((xj - self.xi) * self.inv_h) else {
+            return [0.0; K];
+        };
+        let mut out = [0.0; K];
+        for k in 0..K {
+            let r = &self.rows[k];
+            out[k] = (r[0] * phi[0] + r[1] * phi[1] + r[2] * phi[2]) * vj * self.scale[k];
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::neighbors::cell_list;
+
+    /// A jittered lattice of ring particles in a rectangle touching the axis,
+    /// with ring volumes as weights.
+    fn cloud() -> (Vec<[f64; 2]>, Vec<f64>, f64) {
+        let d = 0.1;
+        let mut p = Vec::new();
+        let mut v = Vec::new();
+        let mut s = 12345u64;
+        for k in 0..15 {
+            for i in 0..10 {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let jr = ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.3 * d;
+                let jz = ((s >> 17 & 0xffff) as f64 / 65536.0 - 0.5) * 0.3 * d;
+                let r = if i == 0 { 0.0 } else { i as f64 * d + jr };
+                p.push([r, k as f64 * d + jz]);
+                v.push(2.0 * std::f64::consts::PI * r.max(d / 4.0) * d * d);
+            }
+        }
+        (p, v, 1.5 * d)
+    }
+
+    #[test]
+    fn reproduces_quadratic_fields_and_their_derivatives_exactly() {
+        let (p, v, h) = cloud();
+        let nl = cell_list(&p, 2.0 * h);
+        let f = |x: &[f64; 2]| {
+            1.5 - 2.0 * x[0] + 0.7 * x[1] + 3.0 * x[0] * x[0] - 1.1 * x[1] * x[1]
+                + 0.4 * x[0] * x[1]
+        };
+        let exact = |x: &[f64; 2]| {
+            [
+                f(x),
+                -2.0 + 6.0 * x[0] + 0.4 * x[1],
+                0.7 - 2.2 * x[1] + 0.4 * x[0],
+                6.0,
+                -2.2,
+                0.4,
+            ]
+        };
+        let all = [Row2::F, Row2::R, Row2::Z, Row2::Rr, Row2::Zz, Row2::Rz];
+        // Every particle, including those on the axis, the corners and the edges.
+        for i in 0..p.len() {
+            let m = Msph2Rows::new(i, nl.of(i), &p, &v, h, all).unwrap();
+            let mut est = [0.0; 6];
+            for &j in nl.of(i) {
+                let w = m.weight(p[j], v[j]);
+                for k in 0..6 {
+                    est[k] += w[k] * f(&p[j]);
+                }
+            }
+            let ex = exact(&p[i]);
+            for k in 0..6 {
+                assert!(
+                    (est[k] - ex[k]).abs() < 1e-7 * (1.0 + ex[k].abs()),
+                    "particle {i} row {k}: {} vs {}",
+                    est[k],
+                    ex[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn partition_of_unity_and_linear_reproduction() {
+        let (p, v, h) = cloud();
+        let nl = cell_list(&p, 2.0 * h);
+        for i in 0..p.len() {
+            let m = Msph2Rows::new(i, nl.of(i), &p, &v, h, [Row2::F, Row2::R, Row2::Z]).unwrap();
+            let (mut s0, mut sr, mut sz) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+            for &j in nl.of(i) {
+                let w = m.weight(p[j], v[j]);
+                for k in 0..3 {
+                    s0[k] += w[k];
+                    sr[k] += w[k] * p[j][0];
+                    sz[k] += w[k] * p[j][1];
+                }
+            }
+            // f = 1: value 1, derivatives 0.
+            assert!((s0[0] - 1.0).abs() < 1e-10 && s0[1].abs() < 1e-6 && s0[2].abs() < 1e-6);
+            // f = R and f = Z.
+            assert!((sr[0] - p[i][0]).abs() < 1e-10 && (sr[1] - 1.0).abs() < 1e-8);
+            assert!((sz[0] - p[i][1]).abs() < 1e-10 && (sz[2] - 1.0).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn one_dimensional_system_reproduces_quadratics() {
+        let d = 0.01;
+        let p: Vec<f64> = (0..60).map(|k| k as f64 * d).collect();
+        let v: Vec<f64> = p
+            .iter()
+            .map(|r| 2.0 * std::f64::consts::PI * r.max(d / 4.0) * d)
+            .collect();
+        let h = 1.5 * d;
+        let pts: Vec<[f64; 2]> = p.iter().map(|&r| [r, 0.0]).collect();
+        let nl = cell_list(&pts, 2.0 * h);
+        for i in 0..p.len() {
+            let m = Msph1Rows::new(i, nl.of(i), &p, &v, h, [Row1::F, Row1::R, Row1::Rr]).unwrap();
+            let mut e = [0.0; 3];
+            for &j in nl.of(i) {
+                let w = m.weight(p[j], v[j]);
+                let f = 2.0 - 3.0 * p[j] + 5.0 * p[j] * p[j];
+                for k in 0..3 {
+                    e[k] += w[k] * f;
+                }
+            }
+            let x = p[i];
+            assert!((e[0] - (2.0 - 3.0 * x + 5.0 * x * x)).abs() < 1e-9);
+            assert!((e[1] - (-3.0 + 10.0 * x)).abs() < 1e-6);
+            assert!((e[2] - 10.0).abs() < 1e-4, "{}", e[2]);
+        }
+    }
+
+    #[test]
+    fn collinear_neighbourhood_is_reported_degenerate() {
+        // Points on a line cannot support derivatives across it.
+        let p: Vec<[f64; 2]> = (0..10).map(|k| [k as f64 * 0.1, 0.0]).collect();
+        let v = vec![1.0; 10];
+        let nl = cell_list(&p, 0.3);
+        let e = Msph2Rows::new(5, nl.of(5), &p, &v, 0.15, [Row2::R]).unwrap_err();
+        assert_eq!(e.particle, 5);
+    }
+}

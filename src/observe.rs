@@ -1,0 +1,245 @@
+//! Observables (names, units, meanings), their time histories, particle
+//! snapshots, and the writers for CSV, JSON and VTK (`.vtu`).
+
+use crate::error::{Error, Result};
+use std::io::Write;
+use std::path::Path;
+
+/// One observable: a time history and a final value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObservableSpec {
+    /// Name used by every interface.
+    pub name: &'static str,
+    /// SI unit ("1" for dimensionless, "bool" for flags stored as 0/1).
+    pub unit: &'static str,
+    /// Meaning.
+    pub description: &'static str,
+}
+
+impl ObservableSpec {
+    /// Whether the value is a flag (0 or 1).
+    pub fn is_bool(&self) -> bool {
+        self.unit == "bool"
+    }
+}
+
+macro_rules! observables {
+    ($table:ident, $doc:literal, $( $name:ident : $unit:literal, $desc:literal; )*) => {
+        #[doc = $doc]
+        pub const $table: &[ObservableSpec] = &[
+            $( ObservableSpec { name: stringify!($name), unit: $unit, description: $desc }, )*
+        ];
+    };
+}
+
+observables! {
+    TAYLOR_OBSERVABLES, "Observables of the Taylor scene, in output order.",
+    rod_length: "m", "current length of the rod (highest minus lowest material point)";
+    mushroom_radius: "m", "largest R among particles that started on the impact face";
+    undeformed_length: "m", "length of the contiguous part from the free end where R/R0 - 1 < 0.2%";
+    tail_velocity: "m/s", "axial velocity of the centre of the free end, positive toward the anvil";
+    face_lift: "m", "axial gap between the centre of the impact face and the anvil";
+    max_plastic_strain: "1", "largest effective plastic strain";
+    max_temperature: "K", "highest temperature";
+    kinetic_energy: "J", "kinetic energy of the rod";
+    internal_energy: "J", "stress work stored and dissipated in the material (elastic plus plastic)";
+    smoothing_dissipation: "J", "kinetic energy removed by the conservative smoothing of velocity";
+    contact_dissipation: "J", "kinetic energy removed by the rigid anvil when it stops particles";
+    energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
+    at_rest: "bool", "the rod has stopped: the end condition of a run";
+}
+
+observables! {
+    NOH_OBSERVABLES, "Observables of the Noh scene, in output order.",
+    shock_radius: "1", "outermost radius where the density reaches the mean of the exact pre- and post-shock values";
+    post_shock_density: "1", "mean density over 0.1 <= r <= 0.18";
+    pre_shock_density_l1: "1", "mean relative error of the density against 1 + t/r over 0.25 <= r <= 0.9";
+    density_l1: "1", "mean relative density error against the exact solution over all particles with r >= 0.05";
+    kinetic_energy: "1", "kinetic energy per unit length of the gas column";
+    internal_energy: "1", "internal energy per unit length (smoothing heat included)";
+    energy_error: "1", "|kinetic + internal - initial| / initial";
+}
+
+/// Time histories of a scene's observables: one row per recorded time.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct History {
+    /// Observable names (columns after time).
+    pub names: Vec<&'static str>,
+    /// Recorded times.
+    pub times: Vec<f64>,
+    /// Row-major values, `times.len() * names.len()`.
+    pub values: Vec<f64>,
+}
+
+impl History {
+    /// An empty history for these observables.
+    pub fn new(specs: &[ObservableSpec]) -> Self {
+        History {
+            names: specs.iter().map(|s| s.name).collect(),
+            times: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    /// Appends a row.
+    pub fn push(&mut self, time: f64, row: &[f64]) {
+        debug_assert_eq!(row.len(), self.names.len());
+        self.times.push(time);
+        self.values.extend_from_slice(row);
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.times.len()
+    }
+
+    /// True when nothing was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.times.is_empty()
+    }
+
+    /// The `k`-th row.
+    pub fn row(&self, k: usize) -> &[f64] {
+        let n = self.names.len();
+        &self.values[k * n..(k + 1) * n]
+    }
+
+    /// The column of the observable `name`, if it exists.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let c = self.names.iter().position(|n| *n == name)?;
+        Some((0..self.len()).map(|k| self.row(k)[c]).collect())
+    }
+
+    /// Writes the history as CSV with a header `time,<names...>`.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        let mut w = csv::Writer::from_path(path).map_err(|e| Error::io(path, e))?;
+        let mut header = vec!["time"];
+        header.extend(self.names.iter().copied());
+        w.write_record(&header).map_err(|e| Error::io(path, e))?;
+        for k in 0..self.len() {
+            let mut rec = vec![format!("{:e}", self.times[k])];
+            rec.extend(self.row(k).iter().map(|v| format!("{v:e}")));
+            w.write_record(&rec).map_err(|e| Error::io(path, e))?;
+        }
+        w.flush().map_err(|e| Error::io(path, e))
+    }
+}
+
+/// One named particle field of a snapshot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Field {
+    /// Field name (for example `stress`).
+    pub name: &'static str,
+    /// Names of the components, in storage order.
+    pub components: &'static [&'static str],
+    /// Unit.
+    pub unit: &'static str,
+    /// Interleaved values, `particles * components.len()`.
+    pub data: Vec<f64>,
+}
+
+/// Particle positions and fields at one time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    /// Simulated time.
+    pub time: f64,
+    /// (R, Z) positions.
+    pub positions: Vec<[f64; 2]>,
+    /// Fields; which ones depends on the scene.
+    pub fields: Vec<Field>,
+}
+
+impl Snapshot {
+    /// The field called `name`.
+    pub fn field(&self, name: &str) -> Option<&Field> {
+        self.fields.iter().find(|f| f.name == name)
+    }
+
+    /// Writes the snapshot as a VTK XML unstructured grid (`.vtu`) of vertex
+    /// cells in the R-Z plane (x = R, y = Z), readable by ParaView. Two-component
+    /// vectors are padded to three.
+    pub fn write_vtu(&self, path: &Path) -> Result<()> {
+        use vtkio::model::*;
+        let n = self.positions.len();
+        let points: Vec<f64> = self
+            .positions
+            .iter()
+            .flat_map(|p| [p[0], p[1], 0.0])
+            .collect();
+        let mut point_data = Vec::new();
+        for f in &self.fields {
+            let nc = f.components.len();
+            let (num_comp, data): (u32, Vec<f64>) = if nc == 2 {
+                (
+                    3,
+                    f.data.chunks(2).flat_map(|c| [c[0], c[1], 0.0]).collect(),
+                )
+            } else {
+                (nc as u32, f.data.clone())
+            };
+            point_data.push(Attribute::DataArray(DataArray {
+                name: f.name.to_string(),
+                elem: ElementType::Scalars {
+                    num_comp,
+                    lookup_table: None,
+                },
+                data: data.into(),
+            }));
+        }
+        let vtk = Vtk {
+            version: Version::new((1, 0)),
+            title: format!("meshless-impact t = {:e} s", self.time),
+            byte_order: ByteOrder::LittleEndian,
+            file_path: None,
+            data: DataSet::inline(UnstructuredGridPiece {
+                points: points.into(),
+                cells: Cells {
+                    cell_verts: VertexNumbers::XML {
+                        connectivity: (0..n as u64).collect(),
+                        offsets: (1..=n as u64).collect(),
+                    },
+                    types: vec![CellType::Vertex; n],
+                },
+                data: Attributes {
+                    point: point_data,
+                    cell: vec![],
+                },
+            }),
+        };
+        vtk.export(path)
+            .map_err(|e| crate::error::Error::io(path, format!("{e:?}")))
+    }
+}
+
+/// Final values of a run as a JSON object: every observable by name, plus
+/// `particles`, `steps`, `end_time` and `wall_time_s`.
+pub fn final_json(
+    specs: &[ObservableSpec],
+    values: &[f64],
+    particles: usize,
+    steps: u64,
+    end_time: f64,
+    wall_time_s: f64,
+) -> serde_json::Value {
+    let mut m = serde_json::Map::new();
+    for (s, v) in specs.iter().zip(values) {
+        let val = if s.is_bool() {
+            serde_json::Value::Bool(*v != 0.0)
+        } else {
+            serde_json::json!(v)
+        };
+        m.insert(s.name.to_string(), val);
+    }
+    m.insert("particles".into(), particles.into());
+    m.insert("steps".into(), steps.into());
+    m.insert("end_time".into(), serde_json::json!(end_time));
+    m.insert("wall_time_s".into(), serde_json::json!(wall_time_s));
+    serde_json::Value::Object(m)
+}
+
+/// Writes a JSON value to a file, pretty-printed.
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    let mut f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    serde_json::to_writer_pretty(&mut f, value).map_err(|e| Error::io(path, e))?;
+    writeln!(f).map_err(|e| Error::io(path, e))
+}

@@ -1,0 +1,35 @@
+//! The `noh` scene: the cylindrical Noh problem, eqs. (4.1)-(4.4): an ideal gas
+//! streaming toward the axis at unit speed. One-dimensional in R; no strength,
+//! no heating beyond compression and smoothing, no anvil.
+
+use super::params::{Range, param_table};
+
+param_table! {
+    /// Parameters of the cylindrical Noh scene (dimensionless units of the
+    /// problem: initial density 1, inflow speed 1).
+    NohParams, NOH_PARAMS {
+        particles_radial: "1" = 800.0, Range::integer(10.0, 100_000.0),
+            "particles along the radius, the one on the axis included";
+        outer_radius: "1" = 1.5, Range::open_closed(0.0, 100.0),
+            "initial radius of the gas column; 1.5 keeps gas out to r = 0.9 at t = 0.6";
+        gamma: "1" = 5.0 / 3.0, Range::open_closed(1.0, 10.0),
+            "ratio of specific heats of the ideal gas";
+        smoothing_ratio: "1" = 1.5, Range::closed(0.5, 4.0),
+            "smoothing length h divided by the particle spacing";
+        smoothing_coefficient: "1" = 0.3, Range::closed(0.0, 0.5),
+            "alpha_cs of the conservative smoothing (3.23)";
+        viscosity_quadratic: "1" = 1.0, Range::closed(0.0, 10.0),
+            "c_q of the radial von Neumann-Richtmyer artificial viscosity";
+        viscosity_linear: "1" = 0.5, Range::closed(0.0, 10.0),
+            "c_l of the radial artificial viscosity";
+        end_time: "1" = 0.6, Range::open_closed(0.0, 100.0),
+            "simulated time at which the run ends";
+    }
+}
+
+impl NohParams {
+    /// Cross-parameter checks (none beyond the ranges today).
+    pub fn check_consistency(&self) -> crate::Result<()> {
+        Ok(())
+    }
+}

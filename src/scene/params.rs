@@ -1,0 +1,169 @@
+//! The parameter tables: one per scene, the single source of parameter names,
+//! units, defaults and allowed ranges for the CLI, scene files, the C ABI and
+//! the FMU.
+
+use crate::error::{Error, Result};
+
+/// Allowed interval of a parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// Lower bound.
+    pub min: f64,
+    /// Whether `min` itself is allowed.
+    pub min_inclusive: bool,
+    /// Upper bound.
+    pub max: f64,
+    /// Whether `max` itself is allowed.
+    pub max_inclusive: bool,
+    /// Whether the value must be a whole number.
+    pub integer: bool,
+}
+
+impl Range {
+    /// `(min, max]`
+    pub const fn open_closed(min: f64, max: f64) -> Self {
+        Range {
+            min,
+            min_inclusive: false,
+            max,
+            max_inclusive: true,
+            integer: false,
+        }
+    }
+    /// `[min, max]`
+    pub const fn closed(min: f64, max: f64) -> Self {
+        Range {
+            min,
+            min_inclusive: true,
+            max,
+            max_inclusive: true,
+            integer: false,
+        }
+    }
+    /// Whole numbers in `[min, max]`.
+    pub const fn integer(min: f64, max: f64) -> Self {
+        Range {
+            min,
+            min_inclusive: true,
+            max,
+            max_inclusive: true,
+            integer: true,
+        }
+    }
+
+    /// Whether `v` is finite and inside the interval.
+    pub fn contains(&self, v: f64) -> bool {
+        v.is_finite()
+            && (if self.min_inclusive {
+                v >= self.min
+            } else {
+                v > self.min
+            })
+            && (if self.max_inclusive {
+                v <= self.max
+            } else {
+                v < self.max
+            })
+            && (!self.integer || v.fract() == 0.0)
+    }
+}
+
+impl std::fmt::Display for Range {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.integer {
+            write!(f, "integers ")?;
+        }
+        write!(
+            f,
+            "{}{}, {}{}",
+            if self.min_inclusive { '[' } else { '(' },
+            self.min,
+            self.max,
+            if self.max_inclusive { ']' } else { ')' }
+        )
+    }
+}
+
+/// One row of a parameter table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamSpec {
+    /// Name used by the CLI, scene files, the C ABI and the FMU.
+    pub name: &'static str,
+    /// SI unit ("1" for dimensionless).
+    pub unit: &'static str,
+    /// Default value.
+    pub default: f64,
+    /// Allowed values.
+    pub range: Range,
+    /// One-line meaning.
+    pub description: &'static str,
+}
+
+impl ParamSpec {
+    /// Checks `value` against the range, with an error naming the parameter.
+    pub fn check(&self, value: f64) -> Result<()> {
+        if self.range.contains(value) {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange {
+                name: self.name.to_string(),
+                value,
+                range: self.range.to_string(),
+            })
+        }
+    }
+}
+
+/// Declares a parameter struct together with its table, `Default`, and
+/// name-based access, so that the three can never disagree.
+macro_rules! param_table {
+    (
+        $(#[$meta:meta])*
+        $name:ident, $specs:ident {
+            $( $field:ident : $unit:literal = $default:expr, $range:expr, $desc:literal; )*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[serde(deny_unknown_fields, default)]
+        pub struct $name {
+            $( #[doc = $desc] pub $field: f64, )*
+        }
+
+        /// The parameter table of this scene, in declaration order.
+        pub const $specs: &[$crate::scene::params::ParamSpec] = &[
+            $( $crate::scene::params::ParamSpec {
+                name: stringify!($field),
+                unit: $unit,
+                default: $default,
+                range: $range,
+                description: $desc,
+            }, )*
+        ];
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self { $( $field: $default, )* }
+            }
+        }
+
+        impl $name {
+            /// Value of the parameter called `name`, if it exists.
+            pub fn get(&self, name: &str) -> Option<f64> {
+                match name {
+                    $( stringify!($field) => Some(self.$field), )*
+                    _ => None,
+                }
+            }
+
+            /// Mutable slot of the parameter called `name`, if it exists.
+            pub(crate) fn slot(&mut self, name: &str) -> Option<&mut f64> {
+                match name {
+                    $( stringify!($field) => Some(&mut self.$field), )*
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+pub(crate) use param_table;

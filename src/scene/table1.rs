@@ -1,0 +1,120 @@
+//! Table 1 of Batra & Zhang (2008): the twelve House et al. (1995) Taylor tests
+//! on 4340 steel, with the experimental and the paper's MSPH results.
+
+use super::{Scene, SceneKind, SceneParams};
+use std::collections::BTreeMap;
+
+/// The table as shipped in `data/house1995_4340_table1.csv`.
+pub const TABLE1_CSV: &str = include_str!("../../data/house1995_4340_table1.csv");
+
+/// One configuration of Table 1. Lengths in metres, speed in m/s.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+pub struct Table1Row {
+    /// Test number (1..12).
+    pub test: u32,
+    /// Initial diameter.
+    pub d0: f64,
+    /// Initial length.
+    pub l0: f64,
+    /// Impact speed.
+    pub v: f64,
+    /// Final length, experiment.
+    pub lf_test: f64,
+    /// Final length, paper's MSPH.
+    pub lf_msph: f64,
+    /// Undeformed length, experiment.
+    pub lu_test: f64,
+    /// Undeformed length, paper's MSPH.
+    pub lu_msph: f64,
+    /// Impact-face diameter, experiment.
+    pub df_test: f64,
+    /// Impact-face diameter, paper's MSPH.
+    pub df_msph: f64,
+}
+
+impl Table1Row {
+    /// All twelve rows, converted from millimetres to metres.
+    pub fn all() -> Vec<Table1Row> {
+        let mut rdr = csv::ReaderBuilder::new()
+            .comment(Some(b'#'))
+            .from_reader(TABLE1_CSV.as_bytes());
+        rdr.records()
+            .map(|rec| {
+                let rec = rec.expect("shipped table parses");
+                let f = |k: usize| rec[k].parse::<f64>().expect("shipped table is numeric");
+                Table1Row {
+                    test: rec[0].parse().expect("test number"),
+                    d0: f(1) * 1e-3,
+                    l0: f(2) * 1e-3,
+                    v: f(3),
+                    lf_test: f(4) * 1e-3,
+                    lf_msph: f(5) * 1e-3,
+                    lu_test: f(6) * 1e-3,
+                    lu_msph: f(7) * 1e-3,
+                    df_test: f(8) * 1e-3,
+                    df_msph: f(9) * 1e-3,
+                }
+            })
+            .collect()
+    }
+
+    /// Reference values keyed like the observables they compare with.
+    pub fn reference(&self) -> BTreeMap<String, f64> {
+        BTreeMap::from([
+            ("rod_length".to_string(), self.lf_test),
+            ("undeformed_length".to_string(), self.lu_test),
+            ("mushroom_radius".to_string(), 0.5 * self.df_test),
+            ("rod_length_msph".to_string(), self.lf_msph),
+            ("undeformed_length_msph".to_string(), self.lu_msph),
+            ("mushroom_radius_msph".to_string(), 0.5 * self.df_msph),
+        ])
+    }
+
+    /// The Taylor scene of this configuration (other parameters default).
+    pub fn scene(&self) -> Scene {
+        let mut s = Scene::default_of(SceneKind::Taylor);
+        if let SceneParams::Taylor(p) = &mut s.params {
+            p.impact_speed = self.v;
+            p.initial_length = self.l0;
+            p.initial_diameter = self.d0;
+        }
+        s.title = format!(
+            "House et al. (1995) test {}: L0 = {} mm, D0 = {} mm, V = {} m/s",
+            self.test,
+            self.l0 * 1e3,
+            self.d0 * 1e3,
+            self.v
+        );
+        s.reference = self.reference();
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn twelve_rows_with_test7_as_published() {
+        let rows = Table1Row::all();
+        assert_eq!(rows.len(), 12);
+        let t7 = rows[6];
+        assert_eq!(t7.test, 7);
+        assert!(
+            (t7.l0 - 0.03797).abs() < 1e-12 && t7.v == 181.0 && (t7.lf_test - 0.0346).abs() < 1e-12
+        );
+    }
+
+    #[test]
+    fn shipped_scene_files_match_the_table() {
+        for row in Table1Row::all() {
+            let path = format!(
+                "{}/scenes/house_test{:02}.toml",
+                env!("CARGO_MANIFEST_DIR"),
+                row.test
+            );
+            let s = Scene::from_file(&path).unwrap();
+            assert_eq!(s, row.scene(), "{path}");
+        }
+    }
+}

@@ -1,0 +1,226 @@
+//! [`Simulation`]: one run of one scene. The CLI, the C ABI and the FMU are
+//! thin layers over this type. It holds no global state: separate instances
+//! run in parallel, and the result of a run does not depend on the number of
+//! threads.
+
+use crate::error::{Error, Result};
+use crate::observe::{History, ObservableSpec, Snapshot};
+use crate::scene::{Scene, SceneKind, SceneParams};
+use crate::solver::axisymmetric::TaylorSolver;
+use crate::solver::radial::NohSolver;
+
+/// The solver a scene composes.
+#[derive(Debug, Clone)]
+enum Solver {
+    Taylor(Box<TaylorSolver>),
+    Noh(Box<NohSolver>),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match &$self.solver {
+            Solver::Taylor($s) => $e,
+            Solver::Noh($s) => $e,
+        }
+    };
+    (mut $self:expr, $s:ident => $e:expr) => {
+        match &mut $self.solver {
+            Solver::Taylor($s) => $e,
+            Solver::Noh($s) => $e,
+        }
+    };
+}
+
+/// Progress of a run, passed to the callback of [`Simulation::run_with`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Simulated time.
+    pub time: f64,
+    /// Latest time the run may reach (the scene's `end_time`).
+    pub end_time: f64,
+    /// Steps taken.
+    pub steps: u64,
+}
+
+/// One run of one scene.
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    scene: Scene,
+    solver: Solver,
+    history: History,
+    record_interval: f64,
+    next_record: f64,
+    error: Option<Error>,
+}
+
+impl Simulation {
+    /// Validates the scene and sets up the initial state.
+    pub fn new(scene: Scene) -> Result<Self> {
+        scene.validate()?;
+        let (solver, record_interval) = match scene.params {
+            SceneParams::Taylor(p) => {
+                let s = TaylorSolver::new(p)?;
+                // 64 records per elastic transit of the rod.
+                let dt = p.initial_length / s.wave_speed() / 64.0;
+                (Solver::Taylor(Box::new(s)), dt)
+            }
+            SceneParams::Noh(p) => (
+                Solver::Noh(Box::new(NohSolver::new(p)?)),
+                p.end_time / 600.0,
+            ),
+        };
+        let mut sim = Simulation {
+            history: History::new(scene.kind().observable_specs()),
+            scene,
+            solver,
+            record_interval,
+            next_record: 0.0,
+            error: None,
+        };
+        sim.record();
+        Ok(sim)
+    }
+
+    /// A built-in scene by name with default parameters.
+    pub fn builtin(name: &str) -> Result<Self> {
+        Simulation::new(Scene::builtin(name)?)
+    }
+
+    /// The scene this run was built from.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The kind of scene.
+    pub fn kind(&self) -> SceneKind {
+        self.scene.kind()
+    }
+
+    /// Simulated time.
+    pub fn time(&self) -> f64 {
+        dispatch!(self, s => s.time())
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        dispatch!(self, s => s.steps())
+    }
+
+    /// Number of particles.
+    pub fn particles(&self) -> usize {
+        dispatch!(self, s => s.particles())
+    }
+
+    /// Latest time the run may reach.
+    pub fn end_time(&self) -> f64 {
+        self.scene
+            .get("end_time")
+            .expect("every scene has end_time")
+    }
+
+    /// Whether the end condition holds (or the run stopped on an error).
+    pub fn finished(&self) -> bool {
+        self.error.is_some() || dispatch!(self, s => s.finished())
+    }
+
+    /// The error that stopped the run, if any.
+    pub fn error(&self) -> Option<&Error> {
+        self.error.as_ref()
+    }
+
+    /// Names, units and meanings of this scene's observables.
+    pub fn observable_specs(&self) -> &'static [ObservableSpec] {
+        self.kind().observable_specs()
+    }
+
+    /// Current values of the observables, in [`Simulation::observable_specs`] order.
+    pub fn observables(&self) -> Vec<f64> {
+        dispatch!(self, s => s.observables())
+    }
+
+    /// Current value of one observable.
+    pub fn observable(&self, name: &str) -> Option<f64> {
+        let k = self
+            .observable_specs()
+            .iter()
+            .position(|s| s.name == name)?;
+        Some(self.observables()[k])
+    }
+
+    /// Recorded time histories of the observables.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Particle positions and fields now.
+    pub fn snapshot(&self) -> Snapshot {
+        dispatch!(self, s => s.snapshot())
+    }
+
+    fn record(&mut self) {
+        let t = self.time();
+        let values = self.observables();
+        self.history.push(t, &values);
+        while self.next_record <= t {
+            self.next_record += self.record_interval;
+        }
+    }
+
+    /// Takes one step. After an error the run is stopped and every further
+    /// call returns that error.
+    pub fn step(&mut self) -> Result<()> {
+        if let Some(e) = &self.error {
+            return Err(e.clone());
+        }
+        if let Err(e) = dispatch!(mut self, s => s.step()) {
+            self.record();
+            self.error = Some(e.clone());
+            return Err(e);
+        }
+        if self.time() >= self.next_record || self.finished() {
+            self.record();
+        }
+        Ok(())
+    }
+
+    /// Steps until the simulated time reaches `t` or the end condition holds.
+    /// The last step is not shortened, so the time may pass `t` by less than
+    /// one step; results therefore do not depend on how a run is divided.
+    pub fn advance_to(&mut self, t: f64) -> Result<()> {
+        while self.time() < t && !self.finished() {
+            self.step()?;
+        }
+        match &self.error {
+            Some(e) => Err(e.clone()),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs to the end condition.
+    pub fn run(&mut self) -> Result<()> {
+        self.run_with(|_| true)
+    }
+
+    /// Runs to the end condition, calling `progress` after every step; the
+    /// run is cancelled (with [`Error::Cancelled`]) when it returns `false`.
+    pub fn run_with(&mut self, mut progress: impl FnMut(&Progress) -> bool) -> Result<()> {
+        let end_time = self.end_time();
+        while !self.finished() {
+            self.step()?;
+            let p = Progress {
+                time: self.time(),
+                end_time,
+                steps: self.steps(),
+            };
+            if !progress(&p) {
+                let e = Error::Cancelled { time: p.time };
+                self.error = Some(e.clone());
+                return Err(e);
+            }
+        }
+        match &self.error {
+            Some(e) => Err(e.clone()),
+            None => Ok(()),
+        }
+    }
+}
