@@ -24,13 +24,13 @@
 //!    the free surfaces, next time step.
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
-use super::{COURANT, MIN_DT_FRACTION, first_non_finite, rows_mut, smooth};
+use super::{COURANT, MIN_DT_FRACTION, first_non_finite, rows_mut, smooth, with_images};
 use crate::error::{Error, Result};
 use crate::kernel::kernel2;
 use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
 use crate::msph::{Msph2Rows, Row2};
-use crate::neighbors::{NeighborList, cell_list};
+use crate::neighbors::{NeighborList, cell_list_first};
 use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
 use crate::scene::taylor::TaylorParams;
 use rayon::prelude::*;
@@ -250,11 +250,15 @@ impl TaylorSolver {
     }
 
     /// MSPH derivative weights and Shepard weights for every neighbour pair.
-    fn pair_weights(&self, nl: &NeighborList, vol: &[f64]) -> Result<Vec<PairWeights>> {
+    fn pair_weights(
+        &self,
+        nl: &NeighborList,
+        pos: &[[f64; 2]],
+        vol: &[f64],
+    ) -> Result<Vec<PairWeights>> {
         let mut w = vec![[0.0; 3]; nl.indices.len()];
         let rows = rows_mut(&mut w, &nl.offsets);
         let h = self.h;
-        let pos = &self.pos;
         let status: Vec<std::result::Result<(), crate::msph::Degenerate>> = rows
             .into_par_iter()
             .enumerate()
@@ -295,13 +299,22 @@ impl TaylorSolver {
             .zip(&self.rho)
             .map(|(m, r)| m / r)
             .collect();
-        let nl = cell_list(&self.pos, 2.0 * self.h);
-        let w = self.pair_weights(&nl, &vol)?;
         let nr = self.nr;
         let axis = |i: usize| i.is_multiple_of(nr);
+        // Mirror images across the axis of the particles within one support
+        // radius of it, so that particles near the axis see a symmetric
+        // neighbourhood: U_R and sigma_RZ change sign, the rest is even.
+        let ghosts: Vec<usize> = (0..n)
+            .filter(|&i| !axis(i) && self.pos[i][0] < 2.0 * self.h)
+            .collect();
+        let pos_ext = with_images(&self.pos, &ghosts, |x| [-x[0], x[1]]);
+        let vol_ext = with_images(&vol, &ghosts, |v| v);
+        let nl = cell_list_first(&pos_ext, n, 2.0 * self.h);
+        let w = self.pair_weights(&nl, &pos_ext, &vol_ext)?;
 
         // 2. Momentum: v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
-        let (pos, sbc, rho) = (&self.pos, &self.stress_bc, &self.rho);
+        let sbc = with_images(&self.stress_bc, &ghosts, |s| [s[0], s[1], s[2], -s[3]]);
+        let (pos, sbc, rho) = (&self.pos, &sbc, &self.rho);
         let mut vel: Vec<[f64; 2]> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -338,7 +351,12 @@ impl TaylorSolver {
                 .sum()
         };
         let ke_before = ke(&vel);
-        let mut vel = smooth(&nl, &shepard, &vel, alpha);
+        let mut vel = smooth(
+            &nl,
+            &shepard,
+            &with_images(&vel, &ghosts, |v| [-v[0], v[1]]),
+            alpha,
+        );
         for i in (0..n).step_by(nr) {
             vel[i][0] = 0.0;
         }
@@ -350,6 +368,7 @@ impl TaylorSolver {
         self.smoothing_dissipation += ke_before - ke(&vel);
 
         // 4. Velocity gradients and continuity.
+        let vel_ext = with_images(&vel, &ghosts, |v| [-v[0], v[1]]);
         let grads: Vec<[f64; 4]> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -357,7 +376,7 @@ impl TaylorSolver {
                 let vi = vel[i];
                 let mut gr = [0.0; 4]; // dvr/dR, dvr/dZ, dvz/dR, dvz/dZ
                 for (&j, g) in nl.indices[a..b].iter().zip(&w[a..b]) {
-                    let dv = [vel[j][0] - vi[0], vel[j][1] - vi[1]];
+                    let dv = [vel_ext[j][0] - vi[0], vel_ext[j][1] - vi[1]];
                     gr[0] += g[0] * dv[0];
                     gr[1] += g[1] * dv[0];
                     gr[2] += g[0] * dv[1];
@@ -379,7 +398,7 @@ impl TaylorSolver {
                 [self.rho[i] * (1.0 - dt * div)]
             })
             .collect();
-        let rho_new = smooth(&nl, &shepard, &rho_new, alpha);
+        let rho_new = smooth(&nl, &shepard, &with_images(&rho_new, &ghosts, |r| r), alpha);
 
         // 5. Constitutive update.
         let (jc, eos, mu, cap) = (
@@ -448,7 +467,7 @@ impl TaylorSolver {
         self.update_contact()?;
         self.check_finite()?;
         self.apply_stress_bc();
-        self.track_spacing(&nl);
+        self.track_spacing(&nl, &pos_ext);
 
         let e = self.energy_error();
         if e > ENERGY_ERROR_BOUND {
@@ -593,10 +612,9 @@ impl TaylorSolver {
         let _ = ON_TOP;
     }
 
-    fn track_spacing(&mut self, nl: &NeighborList) {
+    fn track_spacing(&mut self, nl: &NeighborList, pos: &[[f64; 2]]) {
         let d0 = self.r0 / (self.nr - 1) as f64;
-        let pos = &self.pos;
-        let min2 = (0..pos.len())
+        let min2 = (0..nl.len())
             .into_par_iter()
             .map(|i| {
                 nl.of(i)

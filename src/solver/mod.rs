@@ -32,14 +32,16 @@ pub(crate) fn rows_mut<'a, T>(mut buf: &'a mut [T], offsets: &[usize]) -> Vec<&'
 
 /// Conservative smoothing, eq. (3.23): `f_i + alpha (sum_j s_ij f_j - f_i)`,
 /// where `s_ij` are the Shepard weights `W_ij V_j / sum_j W_ij V_j` stored in
-/// CSR order. Runs in parallel; the result does not depend on thread count.
+/// CSR order, for the particles that have rows in `nl` (`f` may extend past
+/// them with mirror images). Runs in parallel; the result does not depend on
+/// thread count.
 pub(crate) fn smooth<const K: usize>(
     nl: &NeighborList,
     shepard: &[f64],
     f: &[[f64; K]],
     alpha: f64,
 ) -> Vec<[f64; K]> {
-    (0..f.len())
+    (0..nl.len())
         .into_par_iter()
         .map(|i| {
             if alpha == 0.0 {
@@ -59,6 +61,16 @@ pub(crate) fn smooth<const K: usize>(
             out
         })
         .collect()
+}
+
+/// Values of the real particles followed by those of their mirror images
+/// across the axis: `ghosts[k]` is the real particle the `k`-th image copies,
+/// and `mirror` maps a value to its image.
+pub(crate) fn with_images<T: Copy>(f: &[T], ghosts: &[usize], mirror: impl Fn(T) -> T) -> Vec<T> {
+    let mut out = Vec::with_capacity(f.len() + ghosts.len());
+    out.extend_from_slice(f);
+    out.extend(ghosts.iter().map(|&i| mirror(f[i])));
+    out
 }
 
 /// Index and field of the first non-finite value, if any.

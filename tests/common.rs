@@ -1,0 +1,32 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use meshless_impact::{Scene, Simulation};
+
+/// Runs a scene to its end condition and returns the simulation.
+pub fn run(mut scene: Scene, sets: &[(&str, f64)]) -> Simulation {
+    for (k, v) in sets {
+        scene.set(k, *v).unwrap();
+    }
+    let mut sim = Simulation::new(scene).unwrap();
+    sim.run().unwrap();
+    sim
+}
+
+/// First recorded time at which the tail velocity falls below 99% of the
+/// impact speed: when the tail starts to slow down.
+pub fn tail_slowdown_time(sim: &Simulation) -> f64 {
+    let v0 = sim.scene().get("impact_speed").unwrap();
+    let h = sim.history();
+    let tail = h.column("tail_velocity").unwrap();
+    let k = tail
+        .iter()
+        .position(|&v| v < 0.99 * v0)
+        .expect("tail slows down");
+    h.times[k]
+}
+
+/// Relative error in percent.
+pub fn pct(value: f64, reference: f64) -> f64 {
+    100.0 * (value - reference) / reference
+}
