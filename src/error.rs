@@ -110,6 +110,9 @@ pub enum Error {
         /// Simulated time when cancelled.
         time: f64,
     },
+    /// Bytes that are not a serialized simulation state.
+    #[error("invalid serialized state: {0}")]
+    InvalidState(String),
     /// An input/output failure while writing results.
     #[error("I/O error on {path}: {message}")]
     Io {

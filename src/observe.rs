@@ -61,10 +61,10 @@ observables! {
 }
 
 /// Time histories of a scene's observables: one row per recorded time.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct History {
     /// Observable names (columns after time).
-    pub names: Vec<&'static str>,
+    pub names: Vec<String>,
     /// Recorded times.
     pub times: Vec<f64>,
     /// Row-major values, `times.len() * names.len()`.
@@ -75,7 +75,7 @@ impl History {
     /// An empty history for these observables.
     pub fn new(specs: &[ObservableSpec]) -> Self {
         History {
-            names: specs.iter().map(|s| s.name).collect(),
+            names: specs.iter().map(|s| s.name.to_string()).collect(),
             times: Vec::new(),
             values: Vec::new(),
         }
@@ -114,7 +114,7 @@ impl History {
     pub fn write_csv(&self, path: &Path) -> Result<()> {
         let mut w = csv::Writer::from_path(path).map_err(|e| Error::io(path, e))?;
         let mut header = vec!["time"];
-        header.extend(self.names.iter().copied());
+        header.extend(self.names.iter().map(String::as_str));
         w.write_record(&header).map_err(|e| Error::io(path, e))?;
         for k in 0..self.len() {
             let mut rec = vec![format!("{:e}", self.times[k])];

@@ -10,7 +10,7 @@ use crate::solver::axisymmetric::TaylorSolver;
 use crate::solver::radial::NohSolver;
 
 /// The solver a scene composes.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 enum Solver {
     Taylor(Box<TaylorSolver>),
     Noh(Box<NohSolver>),
@@ -43,13 +43,14 @@ pub struct Progress {
 }
 
 /// One run of one scene.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
     scene: Scene,
     solver: Solver,
     history: History,
     record_interval: f64,
     next_record: f64,
+    #[serde(skip)]
     error: Option<Error>,
 }
 
@@ -194,6 +195,18 @@ impl Simulation {
             Some(e) => Err(e.clone()),
             None => Ok(()),
         }
+    }
+
+    /// The complete state of the run (solver, history, scene) as bytes, for
+    /// hosts that roll back (FMI `fmi3SerializeFMUState`). A stopped run's
+    /// error is not part of the state.
+    pub fn serialize_state(&self) -> Vec<u8> {
+        serde_json::to_vec(self).expect("the state holds only finite numbers")
+    }
+
+    /// Restores a run from [`Simulation::serialize_state`] bytes.
+    pub fn deserialize_state(bytes: &[u8]) -> Result<Self> {
+        serde_json::from_slice(bytes).map_err(|e| Error::InvalidState(e.to_string()))
     }
 
     /// Runs to the end condition.

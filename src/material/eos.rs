@@ -1,7 +1,7 @@
 //! Linear equation of state, eq. (3.17): `P = K (rho / rho0 - 1)`.
 
 /// Linear (bulk-modulus) equation of state.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinearEos {
     /// Bulk modulus K (Pa).
     pub bulk_modulus: f64,

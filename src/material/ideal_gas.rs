@@ -1,7 +1,7 @@
 //! Ideal gas, eq. (4.4): `P = (gamma - 1) rho e`.
 
 /// Ideal-gas equation of state.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IdealGas {
     /// Ratio of specific heats.
     pub gamma: f64,

@@ -9,7 +9,7 @@
 //! temperature.
 
 /// Johnson-Cook flow-stress model.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct JohnsonCook {
     /// a (Pa)
     pub a: f64,

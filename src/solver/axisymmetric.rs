@@ -46,7 +46,7 @@ const ON_TOP: u8 = 2;
 const ON_FACE: u8 = 4;
 
 /// State of a Taylor impact run.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct TaylorSolver {
     p: TaylorParams,
     jc: JohnsonCook,

@@ -8,7 +8,7 @@ pub type Stress = [f64; 4];
 
 /// A surface of the rod: particles ordered along it, and the sign that turns
 /// the tangent `x_next - x_prev` into the outward normal.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Surface {
     /// Particle indices in order along the surface.
     pub particles: Vec<usize>,

@@ -71,7 +71,7 @@ pub const MAX_VOLUME_STRAIN: f64 = 0.02;
 pub const POST_SHOCK_DENSITY: f64 = 16.0;
 
 /// State of a Noh run.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct NohSolver {
     p: NohParams,
     gas: IdealGas,
