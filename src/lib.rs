@@ -19,7 +19,12 @@
 // Index loops over fixed-size arrays read more clearly in numerical kernels.
 #![allow(clippy::needless_range_loop)]
 
+// The C ABI and the FMI glue are the only places with unsafe code.
+#[allow(unsafe_code)]
+pub mod capi;
 pub mod error;
+#[allow(unsafe_code)]
+pub mod fmi;
 pub mod kernel;
 pub mod material;
 pub mod msph;
