@@ -277,10 +277,14 @@ fn observables(scene: &str) -> Result<(), Error> {
     Ok(())
 }
 
+/// Simulated values of one configuration: final length, undeformed length,
+/// impact-face diameter, energy error, particles, steps, wall time.
+type SweepValues = (f64, f64, f64, f64, usize, u64, f64);
+
 /// One row of the Table 1 sweep.
 struct SweepRow {
     row: Table1Row,
-    result: Result<(f64, f64, f64, usize, u64, f64), Error>,
+    result: Result<SweepValues, Error>,
 }
 
 fn sweep(a: SweepArgs) -> Result<(), Error> {
@@ -314,6 +318,7 @@ fn sweep(a: SweepArgs) -> Result<(), Error> {
                     o("rod_length"),
                     o("undeformed_length"),
                     2.0 * o("mushroom_radius"),
+                    o("energy_error"),
                     sim.particles(),
                     sim.steps(),
                     t0.elapsed().as_secs_f64(),
@@ -343,6 +348,7 @@ fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Error>
         "Df_test_mm",
         "Df_msph_mm",
         "Df_err_pct",
+        "energy_error",
         "particles",
         "steps",
         "wall_s",
@@ -350,30 +356,15 @@ fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Error>
     ];
     w.write_record(header).map_err(|e| Error::io(out, e))?;
     println!(
-        "{:>4} {:>5} {:>6} | {:>6} {:>6} {:>6} {:>7} | {:>6} {:>6} {:>6} {:>7} | {:>6} {:>6} {:>6} {:>7} | {:>7}",
-        "test",
-        "V",
-        "L0",
-        "Lf",
-        "test",
-        "MSPH",
-        "err%",
-        "Lu",
-        "test",
-        "MSPH",
-        "err%",
-        "Df",
-        "test",
-        "MSPH",
-        "err%",
-        "wall s"
+        "test     V     L0 |     Lf   test   MSPH    err% |     Lu   test   MSPH    err% \
+         |     Df   test   MSPH    err% |  E err  wall s"
     );
     let pct = |sim: f64, exp: f64| 100.0 * (sim - exp) / exp;
     let (mut lf_err, mut df_err) = (Vec::new(), Vec::new());
     for r in results {
         let t = &r.row;
         match &r.result {
-            Ok((lf, lu, df, n, steps, secs)) => {
+            Ok((lf, lu, df, energy, n, steps, secs)) => {
                 let (el, eu, ed) = (
                     pct(*lf, t.lf_test),
                     pct(*lu, t.lu_test),
@@ -381,51 +372,34 @@ fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Error>
                 );
                 lf_err.push(el.abs());
                 df_err.push(ed.abs());
-                println!(
-                    "{:>4} {:>5} {:>6.2} | {:>6.2} {:>6.2} {:>6.2} {:>+7.2} | {:>6.2} {:>6.2} {:>6.2} {:>+7.2} | {:>6.2} {:>6.2} {:>6.2} {:>+7.2} | {:>7.1}",
-                    t.test,
-                    t.v,
-                    t.l0 * 1e3,
-                    lf * 1e3,
-                    t.lf_test * 1e3,
-                    t.lf_msph * 1e3,
-                    el,
-                    lu * 1e3,
-                    t.lu_test * 1e3,
-                    t.lu_msph * 1e3,
-                    eu,
-                    df * 1e3,
-                    t.df_test * 1e3,
-                    t.df_msph * 1e3,
-                    ed,
-                    secs
-                );
-                let rec: Vec<String> = [
-                    t.v,
-                    t.l0 * 1e3,
-                    lf * 1e3,
-                    t.lf_test * 1e3,
-                    t.lf_msph * 1e3,
-                    el,
-                    lu * 1e3,
-                    t.lu_test * 1e3,
-                    t.lu_msph * 1e3,
-                    eu,
-                    df * 1e3,
-                    t.df_test * 1e3,
-                    t.df_msph * 1e3,
-                    ed,
-                    *n as f64,
-                    *steps as f64,
-                    *secs,
-                ]
-                .iter()
-                .map(|x| format!("{x}"))
-                .collect();
-                let mut full = vec![t.test.to_string()];
-                full.extend(rec);
-                full.push(String::new());
-                w.write_record(&full).map_err(|e| Error::io(out, e))?;
+                // Groups of (simulated, test, paper MSPH) in mm with the error in %.
+                let groups = [
+                    [lf * 1e3, t.lf_test * 1e3, t.lf_msph * 1e3, el],
+                    [lu * 1e3, t.lu_test * 1e3, t.lu_msph * 1e3, eu],
+                    [df * 1e3, t.df_test * 1e3, t.df_msph * 1e3, ed],
+                ];
+                let mut line = format!("{:>4} {:>5} {:>6.2}", t.test, t.v, t.l0 * 1e3);
+                for g in &groups {
+                    line += &format!(
+                        " | {:>6.2} {:>6.2} {:>6.2} {:>+7.2}",
+                        g[0], g[1], g[2], g[3]
+                    );
+                }
+                println!("{line} | {energy:>6.4} {secs:>7.1}");
+                let mut rec = vec![
+                    t.test.to_string(),
+                    t.v.to_string(),
+                    (t.l0 * 1e3).to_string(),
+                ];
+                rec.extend(groups.iter().flatten().map(|x| x.to_string()));
+                rec.extend([
+                    energy.to_string(),
+                    n.to_string(),
+                    steps.to_string(),
+                    secs.to_string(),
+                    String::new(),
+                ]);
+                w.write_record(&rec).map_err(|e| Error::io(out, e))?;
             }
             Err(e) => {
                 println!("{:>4} {:>5} {:>6.2} | failed: {e}", t.test, t.v, t.l0 * 1e3);
