@@ -24,7 +24,7 @@
 //!    the free surfaces, next time step.
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
-use super::{COURANT, MIN_DT_FRACTION, first_non_finite, rows_mut, smooth, with_images};
+use super::{COURANT, MIN_DT_FRACTION, rows_mut, smooth, with_images};
 use crate::error::{Error, Result};
 use crate::kernel::kernel2;
 use crate::material::eos::LinearEos;
@@ -40,10 +40,6 @@ pub const UNDEFORMED_STRAIN: f64 = 0.002;
 
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
 pub const ENERGY_ERROR_BOUND: f64 = 0.5;
-
-const ON_MANTLE: u8 = 1;
-const ON_TOP: u8 = 2;
-const ON_FACE: u8 = 4;
 
 /// State of a Taylor impact run.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -67,7 +63,6 @@ pub struct TaylorSolver {
     /// Stress with boundary conditions, used by the momentum equation.
     stress_bc: Vec<Stress>,
     contact: Vec<bool>,
-    flags: Vec<u8>,
     mantle: Surface,
     top: Surface,
     face: Surface,
@@ -101,7 +96,6 @@ impl TaylorSolver {
         let n = nr * nz;
         let mut pos = Vec::with_capacity(n);
         let mut mass = Vec::with_capacity(n);
-        let mut flags = Vec::with_capacity(n);
         for k in 0..nz {
             for i in 0..nr {
                 let r = i as f64 * d;
@@ -111,17 +105,6 @@ impl TaylorSolver {
                 let vol = std::f64::consts::PI * (r_out * r_out - r_in * r_in) * z_len;
                 pos.push([r, k as f64 * dz]);
                 mass.push(p.density * vol);
-                let mut f = 0;
-                if i == nr - 1 {
-                    f |= ON_MANTLE;
-                }
-                if k == nz - 1 {
-                    f |= ON_TOP;
-                }
-                if k == 0 {
-                    f |= ON_FACE;
-                }
-                flags.push(f);
             }
         }
         let mantle = Surface {
@@ -168,7 +151,6 @@ impl TaylorSolver {
             temp: vec![p.initial_temperature; n],
             stress_bc: vec![[0.0; 4]; n],
             contact,
-            flags,
             mantle,
             top,
             face,
@@ -537,30 +519,31 @@ impl TaylorSolver {
     }
 
     fn check_finite(&self) -> Result<()> {
-        let flat = |v: &[[f64; 2]]| -> Vec<f64> { v.iter().flat_map(|x| *x).collect() };
-        let dev: Vec<f64> = self.dev.iter().flat_map(|x| *x).collect();
-        let (pos, vel) = (flat(&self.pos), flat(&self.vel));
-        if let Some((field, k)) = first_non_finite(&[
-            ("position", &pos),
-            ("velocity", &vel),
-            ("density", &self.rho),
-            ("deviatoric stress", &dev),
-            ("temperature", &self.temp),
-        ]) {
-            let per = if field == "deviatoric stress" {
-                4
-            } else if field == "position" || field == "velocity" {
-                2
+        let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+        let bad = (0..self.particles()).find_map(|i| {
+            if !finite(&self.pos[i]) {
+                Some("position")
+            } else if !finite(&self.vel[i]) {
+                Some("velocity")
+            } else if !self.rho[i].is_finite() {
+                Some("density")
+            } else if !finite(&self.dev[i]) {
+                Some("deviatoric stress")
+            } else if !self.temp[i].is_finite() {
+                Some("temperature")
             } else {
-                1
-            };
-            return Err(Error::NonFinite {
+                None
+            }
+            .map(|field| (field, i))
+        });
+        match bad {
+            Some((field, particle)) => Err(Error::NonFinite {
                 field,
-                particle: k / per,
+                particle,
                 time: self.time,
-            });
+            }),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Stress used by the momentum equation: the constitutive stress with the
@@ -605,11 +588,10 @@ impl TaylorSolver {
         // Particles that started elsewhere but touch the anvil (a folded
         // mantle) carry no shear there either.
         for i in 0..n {
-            if self.contact[i] && self.flags[i] & ON_FACE == 0 {
+            if self.contact[i] && i >= self.nr {
                 self.stress_bc[i][3] = 0.0;
             }
         }
-        let _ = ON_TOP;
     }
 
     fn track_spacing(&mut self, nl: &NeighborList, pos: &[[f64; 2]]) {
