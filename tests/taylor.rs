@@ -50,6 +50,12 @@ fn check_table1(particles: f64) {
         .par_iter()
         .map(|r| {
             let sim = run(r.scene(), &[("particles_radial", particles)]);
+            assert_eq!(
+                sim.observable("at_rest"),
+                Some(1.0),
+                "test {} ends at rest",
+                r.test
+            );
             let lf = sim.observable("rod_length").unwrap();
             let df = 2.0 * sim.observable("mushroom_radius").unwrap();
             (r.test, pct(lf, r.lf_test), pct(df, r.df_test))
