@@ -24,7 +24,7 @@
 //!    the free surfaces, next time step.
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
-use super::{COURANT, MIN_DT_FRACTION, rows_mut, smooth, with_images};
+use super::{COURANT, check_time_step, first_degenerate, rows_mut, smooth, with_images};
 use crate::error::{Error, Result};
 use crate::kernel::kernel2;
 use crate::material::eos::LinearEos;
@@ -260,13 +260,7 @@ impl TaylorSolver {
                 Ok(())
             })
             .collect();
-        if let Some(e) = status.into_iter().find_map(|s| s.err()) {
-            return Err(Error::SingularMomentMatrix {
-                particle: e.particle,
-                time: self.time,
-                condition: e.condition,
-            });
-        }
+        first_degenerate(status, self.time)?;
         Ok(w)
     }
 
@@ -460,13 +454,7 @@ impl TaylorSolver {
             });
         }
         self.dt = self.stable_dt();
-        if self.dt < MIN_DT_FRACTION * self.dt0 {
-            return Err(Error::TimeStepCollapse {
-                dt: self.dt,
-                time: self.time,
-                min: MIN_DT_FRACTION * self.dt0,
-            });
-        }
+        check_time_step(self.dt, self.dt0, self.time)?;
         self.update_at_rest();
         Ok(())
     }

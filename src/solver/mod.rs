@@ -73,6 +73,34 @@ pub(crate) fn with_images<T: Copy>(f: &[T], ghosts: &[usize], mirror: impl Fn(T)
     out
 }
 
+/// The first degenerate moment matrix, in particle order, as the named error.
+pub(crate) fn first_degenerate(
+    status: Vec<std::result::Result<(), crate::msph::Degenerate>>,
+    time: f64,
+) -> crate::Result<()> {
+    match status.into_iter().find_map(|s| s.err()) {
+        Some(e) => Err(crate::Error::SingularMomentMatrix {
+            particle: e.particle,
+            time,
+            condition: e.condition,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Stops a run whose stable step fell below [`MIN_DT_FRACTION`] of the first.
+pub(crate) fn check_time_step(dt: f64, dt0: f64, time: f64) -> crate::Result<()> {
+    if dt < MIN_DT_FRACTION * dt0 {
+        Err(crate::Error::TimeStepCollapse {
+            dt,
+            time,
+            min: MIN_DT_FRACTION * dt0,
+        })
+    } else {
+        Ok(())
+    }
+}
+
 /// Index and field of the first non-finite value, if any.
 pub(crate) fn first_non_finite(fields: &[(&'static str, &[f64])]) -> Option<(&'static str, usize)> {
     fields

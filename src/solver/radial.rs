@@ -36,7 +36,7 @@
 //! of 0.2 at t = 0.6. The density is not smoothed: it is the shell's mass over
 //! its volume.
 
-use super::{COURANT, MIN_DT_FRACTION, first_non_finite, rows_mut};
+use super::{COURANT, check_time_step, first_degenerate, first_non_finite, rows_mut};
 use crate::error::{Error, Result};
 use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
@@ -199,13 +199,7 @@ impl NohSolver {
                 Ok(())
             })
             .collect();
-        if let Some(e) = status.into_iter().find_map(|s| s.err()) {
-            return Err(Error::SingularMomentMatrix {
-                particle: e.particle,
-                time: self.time,
-                condition: e.condition,
-            });
-        }
+        first_degenerate(status, self.time)?;
         Ok(w)
     }
 
@@ -342,13 +336,7 @@ impl NohSolver {
             });
         }
         self.dt = self.stable_dt();
-        if self.dt < MIN_DT_FRACTION * self.dt0 {
-            return Err(Error::TimeStepCollapse {
-                dt: self.dt,
-                time: self.time,
-                min: MIN_DT_FRACTION * self.dt0,
-            });
-        }
+        check_time_step(self.dt, self.dt0, self.time)?;
         Ok(())
     }
 
