@@ -1,2 +1,921 @@
 //! FMI 3.0 and FMI 2.0 Co-Simulation glue over the same core (model
 //! identifier `TaylorImpact`).
+//!
+//! The FMUs expose the Taylor scene: every parameter of
+//! [`TAYLOR_PARAMS`](crate::scene::taylor::TAYLOR_PARAMS) as a fixed
+//! parameter, every observable of [`TAYLOR_OBSERVABLES`] as an output.
+//! [`variables`] derives the variable list (and so the value references) from
+//! those tables; [`model_description`] writes the `modelDescription.xml` from
+//! the same list, so the glue and the packaged FMU can never disagree.
+//!
+//! Layout, after the Reference-FMUs:
+//!
+//! - this module: the variable table, the instance type shared by both
+//!   standards, the mask of allowed states per function, logging, and the
+//!   operations (set/get, step, state) written once;
+//! - [`fmi3`] and [`fmi2`]: the exported C functions of each standard, thin
+//!   wrappers that check pointers, catch panics and translate types.
+//!
+//! There is no global state: every instance owns its scene, its simulation
+//! and its logger, so instances run in parallel.
+
+pub mod fmi2;
+pub mod fmi3;
+pub mod model_description;
+
+use crate::observe::{ObservableSpec, TAYLOR_OBSERVABLES};
+use crate::scene::params::ParamSpec;
+use crate::scene::taylor::TAYLOR_PARAMS;
+use crate::{Scene, Simulation};
+use std::ffi::{CString, c_char, c_int, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// The model identifier: the name of the shared library inside the FMUs.
+pub const MODEL_IDENTIFIER: &str = "TaylorImpact";
+
+/// The model name shown by hosts.
+pub const MODEL_NAME: &str = "TaylorImpact";
+
+/// Log categories declared in the model description, with their meaning.
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    (
+        "logStatusError",
+        "errors: bad parameter values, calls in a state that does not allow them, solver stops",
+    ),
+    ("logStatusWarning", "warnings"),
+    (
+        "logEvents",
+        "events: initialization, the rod coming to rest, end_time reached, reset, state restored",
+    ),
+    (
+        "logProgress",
+        "progress after every doStep: simulated time, steps taken, rod length",
+    ),
+];
+
+const CAT_ERROR: usize = 0;
+const CAT_WARNING: usize = 1;
+const CAT_EVENTS: usize = 2;
+const CAT_PROGRESS: usize = 3;
+
+/// The FMI type of a variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarType {
+    /// `Float64` (FMI 3) / `Real` (FMI 2).
+    Float64,
+    /// `Int32` (FMI 3) / `Integer` (FMI 2).
+    Int32,
+    /// `Boolean`.
+    Boolean,
+}
+
+/// Where a variable's value lives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VarKind {
+    /// The independent variable `time` (FMI 3 only).
+    Time,
+    /// A scene parameter: causality parameter, variability fixed.
+    Parameter(&'static ParamSpec),
+    /// An observable, by its index in [`TAYLOR_OBSERVABLES`]: causality output.
+    Output(usize, &'static ObservableSpec),
+}
+
+/// One variable of the FMU.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Variable {
+    /// Value reference.
+    pub vr: u32,
+    /// Name (the same as the CLI's).
+    pub name: &'static str,
+    /// FMI type.
+    pub ty: VarType,
+    /// What the variable is.
+    pub kind: VarKind,
+}
+
+impl Variable {
+    /// SI unit as written in the tables ("1" dimensionless, "bool" flag).
+    pub fn unit(&self) -> &'static str {
+        match self.kind {
+            VarKind::Time => "s",
+            VarKind::Parameter(p) => p.unit,
+            VarKind::Output(_, o) => o.unit,
+        }
+    }
+
+    /// One-line meaning.
+    pub fn description(&self) -> &'static str {
+        match self.kind {
+            VarKind::Time => "simulated time",
+            VarKind::Parameter(p) => p.description,
+            VarKind::Output(_, o) => o.description,
+        }
+    }
+}
+
+/// Value reference of `time` (FMI 3).
+pub const VR_TIME: u32 = 0;
+
+/// Every variable of the FMU: `time` (value reference 0, listed only in the
+/// FMI 3 model description), then the Taylor parameters in table order
+/// (value references 1, 2, ...), then the observables in table order.
+/// This is the single source of the value references.
+pub fn variables() -> Vec<Variable> {
+    let mut out = vec![Variable {
+        vr: VR_TIME,
+        name: "time",
+        ty: VarType::Float64,
+        kind: VarKind::Time,
+    }];
+    let mut vr = 1;
+    for p in TAYLOR_PARAMS {
+        out.push(Variable {
+            vr,
+            name: p.name,
+            ty: if p.range.integer {
+                VarType::Int32
+            } else {
+                VarType::Float64
+            },
+            kind: VarKind::Parameter(p),
+        });
+        vr += 1;
+    }
+    for (k, o) in TAYLOR_OBSERVABLES.iter().enumerate() {
+        out.push(Variable {
+            vr,
+            name: o.name,
+            ty: if o.is_bool() {
+                VarType::Boolean
+            } else {
+                VarType::Float64
+            },
+            kind: VarKind::Output(k, o),
+        });
+        vr += 1;
+    }
+    out
+}
+
+/// The variable with value reference `vr`.
+fn variable(vr: u32) -> Option<Variable> {
+    // The table is small (34 rows); a linear lookup keeps one source of truth.
+    variables().into_iter().find(|v| v.vr == vr)
+}
+
+/// The instantiation token (FMI 3) / GUID (FMI 2): a deterministic hash of
+/// the crate version and the generated variable list, formatted as a GUID.
+pub fn instantiation_token() -> String {
+    // 128-bit FNV-1a over a canonical text of everything a host relies on.
+    let mut text = format!("{MODEL_IDENTIFIER} {}\n", crate::VERSION);
+    for v in variables() {
+        text.push_str(&format!("{} {} {:?} {}", v.vr, v.name, v.ty, v.unit()));
+        if let VarKind::Parameter(p) = v.kind {
+            text.push_str(&format!(" {:e} {}", p.default, p.range));
+        }
+        text.push('\n');
+    }
+    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
+    for b in text.bytes() {
+        h ^= b as u128;
+        h = h.wrapping_mul(0x0000000001000000000000000000013B);
+    }
+    let s = format!("{h:032x}");
+    format!(
+        "{{{}-{}-{}-{}-{}}}",
+        &s[0..8],
+        &s[8..12],
+        &s[12..16],
+        &s[16..20],
+        &s[20..32]
+    )
+}
+
+/// Status codes; the numbers are those of `fmi3Status` and `fmi2Status`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[repr(i32)]
+pub(crate) enum Status {
+    Ok = 0,
+    Warning = 1,
+    Discard = 2,
+    Error = 3,
+    Fatal = 4,
+}
+
+// Instance states, one bit each, as in the Reference-FMUs.
+pub(crate) const INSTANTIATED: u32 = 1 << 0;
+pub(crate) const INITIALIZATION_MODE: u32 = 1 << 1;
+/// FMI 3 step mode / FMI 2 stepComplete.
+pub(crate) const STEP_MODE: u32 = 1 << 2;
+/// FMI 2 stepFailed after a doStep that returned Discard (early stop).
+pub(crate) const STEP_DISCARDED: u32 = 1 << 3;
+pub(crate) const TERMINATED: u32 = 1 << 4;
+pub(crate) const ANY_STATE: u32 =
+    INSTANTIATED | INITIALIZATION_MODE | STEP_MODE | STEP_DISCARDED | TERMINATED;
+
+/// Allowed states per function (both standards).
+pub(crate) mod mask {
+    use super::*;
+    pub const SET_DEBUG_LOGGING: u32 = ANY_STATE;
+    pub const SETUP_EXPERIMENT: u32 = INSTANTIATED;
+    pub const ENTER_INITIALIZATION_MODE: u32 = INSTANTIATED;
+    pub const EXIT_INITIALIZATION_MODE: u32 = INITIALIZATION_MODE;
+    pub const TERMINATE: u32 = STEP_MODE | STEP_DISCARDED;
+    pub const RESET: u32 = ANY_STATE;
+    pub const GET: u32 = INITIALIZATION_MODE | STEP_MODE | STEP_DISCARDED | TERMINATED;
+    pub const SET: u32 = INSTANTIATED | INITIALIZATION_MODE | STEP_MODE;
+    pub const DO_STEP: u32 = STEP_MODE;
+    pub const STATUS: u32 = STEP_MODE | STEP_DISCARDED | TERMINATED;
+    pub const FMU_STATE: u32 = ANY_STATE;
+}
+
+fn state_name(state: u32) -> &'static str {
+    match state {
+        INSTANTIATED => "Instantiated",
+        INITIALIZATION_MODE => "InitializationMode",
+        STEP_MODE => "StepMode",
+        STEP_DISCARDED => "StepDiscarded",
+        TERMINATED => "Terminated",
+        _ => "unknown",
+    }
+}
+
+/// `fmi3LogMessageCallback`.
+pub(crate) type Fmi3Logger = unsafe extern "C" fn(
+    instance_environment: *mut c_void,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+);
+
+/// `fmi2CallbackLogger` (the message is a printf format).
+pub(crate) type Fmi2Logger = unsafe extern "C" fn(
+    component_environment: *mut c_void,
+    instance_name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+    ...
+);
+
+/// The host's logger.
+pub(crate) enum LogSink {
+    None,
+    Fmi3 {
+        callback: Fmi3Logger,
+        environment: *mut c_void,
+    },
+    Fmi2 {
+        callback: Fmi2Logger,
+        environment: *mut c_void,
+    },
+}
+
+/// Which standard an instance was created through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Standard {
+    Fmi3,
+    Fmi2,
+}
+
+/// What the last doStep reported.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct StepOutcome {
+    pub terminate: bool,
+    pub early_return: bool,
+    pub last_successful_time: f64,
+}
+
+/// The part of an instance that a host saves and restores (FMU state).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub(crate) struct Saved {
+    state: u32,
+    scene: Scene,
+    sim: Option<Simulation>,
+    start_time: f64,
+    time: f64,
+    at_end: bool,
+    last_successful_time: f64,
+}
+
+const STATE_MAGIC: &[u8] = b"TaylorImpact FMU state v1\n";
+
+/// One FMU instance (FMI 3 or FMI 2).
+pub(crate) struct Instance {
+    pub standard: Standard,
+    pub name: CString,
+    log: LogSink,
+    categories: [bool; 4],
+    pub state: u32,
+    /// Parameter values (set by the host before initialization).
+    scene: Scene,
+    /// The run; built lazily in initialization mode, always at its exit.
+    sim: Option<Simulation>,
+    /// Start time given by the host; simulated time 0 corresponds to it.
+    pub start_time: f64,
+    /// Stop time given by the host, if any.
+    pub stop_time: Option<f64>,
+    /// Current communication point (host time).
+    time: f64,
+    /// The run has ended (rod at rest or end_time reached).
+    at_end: bool,
+    pub last_successful_time: f64,
+    pub early_return_allowed: bool,
+    /// Kept alive for `fmi2GetStringStatus`.
+    pub status_string: CString,
+}
+
+fn default_scene() -> Scene {
+    Scene::builtin("taylor").expect("the taylor scene is built in")
+}
+
+impl Instance {
+    pub(crate) fn new(standard: Standard, name: &str, log: LogSink, logging_on: bool) -> Self {
+        Instance {
+            standard,
+            name: CString::new(name.replace('\0', "")).unwrap_or_default(),
+            log,
+            categories: [logging_on; 4],
+            state: INSTANTIATED,
+            scene: default_scene(),
+            sim: None,
+            start_time: 0.0,
+            stop_time: None,
+            time: 0.0,
+            at_end: false,
+            last_successful_time: 0.0,
+            early_return_allowed: false,
+            status_string: CString::default(),
+        }
+    }
+
+    /// Sends a message to the host's logger. Errors always go out; other
+    /// categories only when logging is on for them.
+    pub(crate) fn log(&self, status: Status, category: usize, message: &str) {
+        if category != CAT_ERROR && !self.categories[category] {
+            return;
+        }
+        let cat = CString::new(LOG_CATEGORIES[category].0).expect("no NUL in category names");
+        match self.log {
+            LogSink::None => {}
+            LogSink::Fmi3 {
+                callback,
+                environment,
+            } => {
+                let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
+                // SAFETY: the host gave this callback and environment at
+                // instantiation and guarantees them valid for the instance's
+                // lifetime; the strings are NUL-terminated and outlive the call.
+                unsafe { callback(environment, status as c_int, cat.as_ptr(), msg.as_ptr()) }
+            }
+            LogSink::Fmi2 {
+                callback,
+                environment,
+            } => {
+                // The FMI 2 message is a printf format: escape '%'.
+                let msg =
+                    CString::new(message.replace('\0', " ").replace('%', "%%")).unwrap_or_default();
+                // SAFETY: as above; the format has no conversions left, so no
+                // variadic arguments are read.
+                unsafe {
+                    callback(
+                        environment,
+                        self.name.as_ptr(),
+                        status as c_int,
+                        cat.as_ptr(),
+                        msg.as_ptr(),
+                    )
+                }
+            }
+        }
+    }
+
+    /// Logs an error, moves to Terminated (Error leads to Terminated) and
+    /// returns `Status::Error`.
+    pub(crate) fn fail(&mut self, message: &str) -> Status {
+        self.log(Status::Error, CAT_ERROR, message);
+        self.state = TERMINATED;
+        Status::Error
+    }
+
+    /// Checks that `function` may be called in the current state.
+    pub(crate) fn check_state(&mut self, function: &str, mask: u32) -> Result<(), Status> {
+        if self.state & mask == 0 {
+            let msg = format!(
+                "{function}: not allowed in state {}",
+                state_name(self.state)
+            );
+            return Err(self.fail(&msg));
+        }
+        Ok(())
+    }
+
+    /// `fmi3SetDebugLogging` / `fmi2SetDebugLogging`.
+    pub(crate) fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Status {
+        if categories.is_empty() {
+            self.categories = [on; 4];
+            return Status::Ok;
+        }
+        for c in categories {
+            match LOG_CATEGORIES.iter().position(|(n, _)| n == c) {
+                Some(k) => self.categories[k] = on,
+                None => {
+                    let allowed: Vec<_> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
+                    return self.fail(&format!(
+                        "unknown log category `{c}`; allowed: {}",
+                        allowed.join(", ")
+                    ));
+                }
+            }
+        }
+        Status::Ok
+    }
+
+    pub(crate) fn enter_initialization_mode(&mut self, start_time: f64) -> Status {
+        if !start_time.is_finite() {
+            return self.fail(&format!("startTime = {start_time} must be finite"));
+        }
+        self.start_time = start_time;
+        self.time = start_time;
+        self.last_successful_time = start_time;
+        self.state = INITIALIZATION_MODE;
+        Status::Ok
+    }
+
+    /// Builds the simulation from the current parameters if needed.
+    fn ensure_sim(&mut self) -> Result<(), Status> {
+        if self.sim.is_none() {
+            match Simulation::new(self.scene.clone()) {
+                Ok(s) => self.sim = Some(s),
+                Err(e) => return Err(self.fail(&e.to_string())),
+            }
+        }
+        Ok(())
+    }
+
+    pub(crate) fn exit_initialization_mode(&mut self) -> Status {
+        if let Err(s) = self.ensure_sim() {
+            return s;
+        }
+        let sim = self.sim.as_ref().expect("built above");
+        let msg = format!(
+            "initialized: {} particles, impact_speed = {} m/s, end_time = {} s",
+            sim.particles(),
+            self.scene.get("impact_speed").unwrap_or(f64::NAN),
+            sim.end_time()
+        );
+        self.log(Status::Ok, CAT_EVENTS, &msg);
+        if let Some(stop) = self.stop_time
+            && stop - self.start_time > sim.end_time()
+        {
+            let msg = format!(
+                "stopTime = {stop} s lies beyond end_time = {} s after the start: the run ends at end_time at the latest",
+                sim.end_time()
+            );
+            self.log(Status::Warning, CAT_WARNING, &msg);
+        }
+        self.at_end = sim.finished();
+        self.state = STEP_MODE;
+        Status::Ok
+    }
+
+    pub(crate) fn terminate(&mut self) -> Status {
+        self.state = TERMINATED;
+        Status::Ok
+    }
+
+    pub(crate) fn reset(&mut self) -> Status {
+        self.state = INSTANTIATED;
+        self.scene = default_scene();
+        self.sim = None;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        self.time = 0.0;
+        self.at_end = false;
+        self.last_successful_time = 0.0;
+        self.log(Status::Ok, CAT_EVENTS, "reset to the default parameters");
+        Status::Ok
+    }
+
+    /// Looks up `vr` and checks its type.
+    fn lookup(&mut self, vr: u32, ty: VarType, function: &str) -> Result<Variable, Status> {
+        match variable(vr) {
+            Some(v)
+                if v.ty == ty && !(self.standard == Standard::Fmi2 && v.kind == VarKind::Time) =>
+            {
+                Ok(v)
+            }
+            Some(v) if v.ty != ty => Err(self.fail(&format!(
+                "{function}: variable `{}` (value reference {vr}) is of type {:?}, not {:?}",
+                v.name, v.ty, ty
+            ))),
+            _ => Err(self.fail(&format!("{function}: unknown value reference {vr}"))),
+        }
+    }
+
+    /// Value of a variable as f64 (booleans as 0/1).
+    fn value(&mut self, v: &Variable) -> Result<f64, Status> {
+        match v.kind {
+            VarKind::Time => Ok(self.time),
+            VarKind::Parameter(p) => Ok(self
+                .scene
+                .get(p.name)
+                .expect("the table and the scene agree")),
+            VarKind::Output(k, _) => {
+                self.ensure_sim()?;
+                Ok(self.sim.as_ref().expect("built above").observables()[k])
+            }
+        }
+    }
+
+    /// Reads `vrs` of type `ty` as f64.
+    pub(crate) fn get(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        ty: VarType,
+    ) -> Result<Vec<f64>, Status> {
+        self.check_state(function, mask::GET)?;
+        let mut out = Vec::with_capacity(vrs.len());
+        for &vr in vrs {
+            let v = self.lookup(vr, ty, function)?;
+            out.push(self.value(&v)?);
+        }
+        Ok(out)
+    }
+
+    /// Sets `vrs` of type `ty` from f64 values.
+    pub(crate) fn set(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        values: &[f64],
+        ty: VarType,
+    ) -> Status {
+        if let Err(s) = self.check_state(function, mask::SET) {
+            return s;
+        }
+        for (&vr, &value) in vrs.iter().zip(values) {
+            let v = match self.lookup(vr, ty, function) {
+                Ok(v) => v,
+                Err(s) => return s,
+            };
+            match v.kind {
+                VarKind::Time => {
+                    return self.fail(&format!(
+                        "{function}: `time` is the independent variable and cannot be set"
+                    ));
+                }
+                VarKind::Output(..) => {
+                    return self.fail(&format!(
+                        "{function}: `{}` is an output and cannot be set",
+                        v.name
+                    ));
+                }
+                VarKind::Parameter(p) => {
+                    if self.state == STEP_MODE {
+                        return self.fail(&format!(
+                            "{function}: `{}` is a fixed parameter and cannot be changed after initialization",
+                            p.name
+                        ));
+                    }
+                    if let Err(e) = self.scene.set(p.name, value) {
+                        return self.fail(&e.to_string());
+                    }
+                    // Rebuilt from the new parameters when next needed.
+                    self.sim = None;
+                }
+            }
+        }
+        Status::Ok
+    }
+
+    /// Advances to `current + h`. Errors have been logged and moved the
+    /// instance to Terminated.
+    pub(crate) fn do_step(
+        &mut self,
+        function: &str,
+        current: f64,
+        h: f64,
+    ) -> Result<StepOutcome, Status> {
+        self.check_state(function, mask::DO_STEP)?;
+        if h.is_nan() || h <= 0.0 || h.is_infinite() {
+            return Err(self.fail(&format!(
+                "{function}: communicationStepSize = {h} must be positive and finite"
+            )));
+        }
+        // Hosts' step sizes vary in the last ulp: compare with a tolerance.
+        let tol = 1e-9 * (self.time.abs() + h.abs());
+        if !current.is_finite() || (current - self.time).abs() > tol {
+            return Err(self.fail(&format!(
+                "{function}: currentCommunicationPoint = {current} s does not match the FMU's time {} s",
+                self.time
+            )));
+        }
+        let target = current + h;
+        if self.at_end {
+            // The rod is at rest (or end_time passed): outputs hold.
+            self.time = target;
+            return Ok(StepOutcome {
+                terminate: true,
+                early_return: false,
+                last_successful_time: target,
+            });
+        }
+        let sim = self.sim.as_mut().expect("built at initialization");
+        let result = sim.advance_to(target - self.start_time);
+        if let Err(e) = result {
+            let msg = format!("{function}: the solver stopped: {e}");
+            return Err(self.fail(&msg));
+        }
+        let sim_time = self.start_time + sim.time();
+        let (steps, length) = (
+            sim.steps(),
+            sim.observable("rod_length").unwrap_or(f64::NAN),
+        );
+        let finished = sim.finished();
+        let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
+        self.log(
+            Status::Ok,
+            CAT_PROGRESS,
+            &format!("t = {sim_time:.6e} s, {steps} steps, rod_length = {length:.6e} m"),
+        );
+        if !finished {
+            self.time = target;
+            self.last_successful_time = target;
+            return Ok(StepOutcome {
+                terminate: false,
+                early_return: false,
+                last_successful_time: target,
+            });
+        }
+        self.at_end = true;
+        let why = if at_rest {
+            "the rod is at rest"
+        } else {
+            "end_time reached"
+        };
+        self.log(
+            Status::Ok,
+            CAT_EVENTS,
+            &format!(
+                "{why} at t = {sim_time:.6e} s after {steps} steps; outputs hold their final values"
+            ),
+        );
+        let early = sim_time < target - tol;
+        let last = if early { sim_time } else { target };
+        self.last_successful_time = last;
+        Ok(StepOutcome {
+            terminate: true,
+            early_return: early,
+            last_successful_time: last,
+        })
+    }
+
+    /// Moves the communication time after a step (FMI 3: to the last
+    /// successful time when returning early).
+    pub(crate) fn set_time(&mut self, t: f64) {
+        self.time = t;
+    }
+
+    /// Whether the run has ended (rod at rest or end_time).
+    pub(crate) fn at_end(&self) -> bool {
+        self.at_end
+    }
+
+    pub(crate) fn save(&self) -> Saved {
+        Saved {
+            state: self.state,
+            scene: self.scene.clone(),
+            sim: self.sim.clone(),
+            start_time: self.start_time,
+            time: self.time,
+            at_end: self.at_end,
+            last_successful_time: self.last_successful_time,
+        }
+    }
+
+    pub(crate) fn restore(&mut self, s: &Saved) {
+        self.state = s.state;
+        self.scene = s.scene.clone();
+        self.sim = s.sim.clone();
+        self.start_time = s.start_time;
+        self.time = s.time;
+        self.at_end = s.at_end;
+        self.last_successful_time = s.last_successful_time;
+        self.log(
+            Status::Ok,
+            CAT_EVENTS,
+            &format!("FMU state restored at t = {} s", self.time),
+        );
+    }
+}
+
+impl Saved {
+    /// Bytes of this state: a magic line, the instantiation token, JSON.
+    pub(crate) fn serialize(&self) -> Vec<u8> {
+        let mut out = STATE_MAGIC.to_vec();
+        out.extend_from_slice(instantiation_token().as_bytes());
+        out.push(b'\n');
+        out.extend(serde_json::to_vec(self).expect("the state holds only finite numbers"));
+        out
+    }
+
+    /// Parses [`Saved::serialize`] bytes.
+    pub(crate) fn deserialize(bytes: &[u8]) -> Result<Saved, String> {
+        let rest = bytes
+            .strip_prefix(STATE_MAGIC)
+            .ok_or("the bytes are not a serialized TaylorImpact FMU state")?;
+        let token = instantiation_token();
+        let rest = rest
+            .strip_prefix(token.as_bytes())
+            .and_then(|r| r.strip_prefix(b"\n"))
+            .ok_or("the serialized state comes from a different version of the FMU")?;
+        let saved: Saved =
+            serde_json::from_slice(rest).map_err(|e| format!("invalid serialized state: {e}"))?;
+        if saved.state & ANY_STATE == 0 || saved.state.count_ones() != 1 {
+            return Err("invalid serialized state: unknown instance state".into());
+        }
+        Ok(saved)
+    }
+}
+
+/// Runs `f`, turning a panic into `fallback`: nothing unwinds into the host.
+pub(crate) fn guard<R>(fallback: R, f: impl FnOnce() -> R) -> R {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
+}
+
+/// Runs `f` on the instance behind `ptr` with a panic boundary. A null
+/// instance gives `Status::Error`; a panic is logged as Fatal, drops the
+/// (possibly inconsistent) simulation and leaves the instance Terminated.
+///
+/// # Safety
+/// `ptr` must be null or an instance created by this library and not freed.
+pub(crate) unsafe fn with_instance(
+    ptr: *mut c_void,
+    f: impl FnOnce(&mut Instance) -> Status,
+) -> Status {
+    if ptr.is_null() {
+        return Status::Error;
+    }
+    // SAFETY: by the contract above, a non-null `ptr` is a live
+    // `Box<Instance>` from `into_raw`; FMI forbids concurrent calls on one
+    // instance, so this is the only reference.
+    let inst = unsafe { &mut *(ptr as *mut Instance) };
+    match catch_unwind(AssertUnwindSafe(|| f(&mut *inst))) {
+        Ok(s) => s,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                inst.sim = None;
+                inst.state = TERMINATED;
+                inst.log(
+                    Status::Fatal,
+                    CAT_ERROR,
+                    &format!("internal error (panic): {what}"),
+                );
+            }));
+            Status::Fatal
+        }
+    }
+}
+
+/// Reads a C array; an empty slice when `n == 0`.
+///
+/// # Safety
+/// `p` must point to `n` readable elements when `n > 0`.
+pub(crate) unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
+    if n == 0 {
+        return Some(&[]);
+    }
+    if p.is_null() {
+        return None;
+    }
+    // SAFETY: non-null and, by the contract, valid for `n` elements.
+    Some(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+/// Writes into a C array.
+///
+/// # Safety
+/// `p` must point to `n` writable elements when `n > 0`.
+pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
+    if n == 0 {
+        return Some(&mut []);
+    }
+    if p.is_null() {
+        return None;
+    }
+    // SAFETY: non-null and, by the contract, valid for `n` elements with no
+    // other live reference.
+    Some(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+/// Reads a C string (lossy UTF-8); `None` for null.
+///
+/// # Safety
+/// `p` must be null or a NUL-terminated string.
+pub(crate) unsafe fn c_str(p: *const c_char) -> Option<String> {
+    if p.is_null() {
+        return None;
+    }
+    // SAFETY: non-null and NUL-terminated by the contract.
+    Some(
+        unsafe { std::ffi::CStr::from_ptr(p) }
+            .to_string_lossy()
+            .into_owned(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn variables_follow_the_tables() {
+        let vars = variables();
+        assert_eq!(
+            vars.len(),
+            1 + TAYLOR_PARAMS.len() + TAYLOR_OBSERVABLES.len()
+        );
+        assert_eq!(vars[0].name, "time");
+        for (k, v) in vars.iter().enumerate() {
+            assert_eq!(v.vr as usize, k, "value references are dense");
+        }
+        let pr = vars.iter().find(|v| v.name == "particles_radial").unwrap();
+        assert_eq!(pr.ty, VarType::Int32);
+        let rest = vars.iter().find(|v| v.name == "at_rest").unwrap();
+        assert_eq!(rest.ty, VarType::Boolean);
+        assert!(
+            vars.iter()
+                .all(|v| !matches!(v.name, "shock_radius" | "post_shock_density"))
+        );
+    }
+
+    #[test]
+    fn token_is_deterministic_and_guid_shaped() {
+        let t = instantiation_token();
+        assert_eq!(t, instantiation_token());
+        assert_eq!(t.len(), 38);
+        assert!(t.starts_with('{') && t.ends_with('}'));
+    }
+
+    #[test]
+    fn fixed_parameter_refused_after_initialization_and_bad_values_named() {
+        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
+        let density = variables().iter().find(|v| v.name == "density").unwrap().vr;
+        assert_eq!(
+            inst.set("fmi3SetFloat64", &[density], &[-5.0], VarType::Float64),
+            Status::Error
+        );
+        assert_eq!(inst.state, TERMINATED);
+        inst.reset();
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        assert_eq!(
+            inst.set("fmi3SetInt32", &[pr], &[5.0], VarType::Int32),
+            Status::Ok
+        );
+        assert_eq!(inst.enter_initialization_mode(0.0), Status::Ok);
+        assert_eq!(inst.exit_initialization_mode(), Status::Ok);
+        assert_eq!(
+            inst.set("fmi3SetFloat64", &[density], &[7000.0], VarType::Float64),
+            Status::Error
+        );
+        assert_eq!(inst.state, TERMINATED);
+    }
+
+    #[test]
+    fn state_round_trips_through_bytes() {
+        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        inst.set("fmi3SetInt32", &[pr], &[4.0], VarType::Int32);
+        inst.enter_initialization_mode(0.0);
+        inst.exit_initialization_mode();
+        inst.do_step("doStep", 0.0, 1e-6).unwrap();
+        let bytes = inst.save().serialize();
+        let saved = Saved::deserialize(&bytes).unwrap();
+        let out = inst.do_step("doStep", 1e-6, 1e-6).unwrap();
+        let a = inst.sim.as_ref().unwrap().observables();
+        inst.restore(&saved);
+        let out2 = inst.do_step("doStep", 1e-6, 1e-6).unwrap();
+        assert_eq!(out.last_successful_time, out2.last_successful_time);
+        let b = inst.sim.as_ref().unwrap().observables();
+        assert_eq!(
+            a.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            b.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+        assert!(Saved::deserialize(b"nonsense").is_err());
+    }
+}

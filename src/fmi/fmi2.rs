@@ -1,0 +1,769 @@
+//! The FMI 2.0 Co-Simulation functions (all 34 `fmi2*` symbols that a
+//! Co-Simulation importer resolves).
+//!
+//! Early stop: when the rod comes to rest (or `end_time` passes) during a
+//! communication step, `fmi2DoStep` returns `fmi2Discard`;
+//! `fmi2GetBooleanStatus(fmi2Terminated)` is then true and
+//! `fmi2GetRealStatus(fmi2LastSuccessfulTime)` is the time the run ended
+//! (at most the end of the step).
+
+use super::fmi3::{
+    deserialize, free_fmu_state, get_fmu_state, serialize, serialized_size, set_fmu_state,
+};
+use super::*;
+use std::ffi::{c_char, c_void};
+
+type Fmi2Status = c_int;
+type Component = *mut c_void;
+type Vr = u32;
+
+const VERSION: &[u8] = b"2.0\0";
+const TYPES_PLATFORM: &[u8] = b"default\0";
+
+const FMI2_COSIMULATION: c_int = 1;
+const FMI2_DO_STEP_STATUS: c_int = 0;
+const FMI2_PENDING_STATUS: c_int = 1;
+const FMI2_LAST_SUCCESSFUL_TIME: c_int = 2;
+const FMI2_TERMINATED: c_int = 3;
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+pub struct CallbackFunctions {
+    /// Logger (printf-style message).
+    pub logger: Option<Fmi2Logger>,
+    /// Not used: `canNotUseMemoryManagementFunctions="true"`.
+    pub allocate_memory: *mut c_void,
+    /// Not used.
+    pub free_memory: *mut c_void,
+    /// Not used (doStep is synchronous).
+    pub step_finished: *mut c_void,
+    /// Passed back to the logger.
+    pub component_environment: *mut c_void,
+}
+
+/// # Safety
+/// `c` null or a live instance of this library.
+unsafe fn call(
+    c: Component,
+    function: &str,
+    mask: u32,
+    f: impl FnOnce(&mut Instance) -> Status,
+) -> Fmi2Status {
+    // SAFETY: forwarded contract.
+    (unsafe {
+        with_instance(c, |inst| match inst.check_state(function, mask) {
+            Ok(()) => f(inst),
+            Err(s) => s,
+        })
+    }) as c_int
+}
+
+/// `fmi2GetTypesPlatform`: "default".
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+    TYPES_PLATFORM.as_ptr() as *const c_char
+}
+
+/// `fmi2GetVersion`: "2.0".
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi2GetVersion() -> *const c_char {
+    VERSION.as_ptr() as *const c_char
+}
+
+/// `fmi2SetDebugLogging`.
+///
+/// # Safety
+/// FMI 2.0 contract: a live instance; `categories` holds `n` strings.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: Component,
+    logging_on: c_int,
+    n_categories: usize,
+    categories: *const *const c_char,
+) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe {
+        call(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
+            let Some(cats) = slice(categories, n_categories) else {
+                return inst.fail("fmi2SetDebugLogging: categories is NULL");
+            };
+            let names: Vec<String> = cats.iter().map(|&p| c_str(p).unwrap_or_default()).collect();
+            inst.set_debug_logging(logging_on != 0, &names)
+        })
+    }
+}
+
+/// `fmi2Instantiate`: a Co-Simulation instance with the default
+/// parameters, or NULL on a wrong GUID or type.
+///
+/// # Safety
+/// FMI 2.0 contract: strings NUL-terminated or NULL; `functions` valid
+/// until `fmi2FreeInstance`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Instantiate(
+    instance_name: *const c_char,
+    fmu_type: c_int,
+    fmu_guid: *const c_char,
+    _fmu_resource_location: *const c_char,
+    functions: *const CallbackFunctions,
+    _visible: c_int,
+    logging_on: c_int,
+) -> Component {
+    guard(std::ptr::null_mut(), || {
+        // SAFETY: NUL-terminated or NULL by the FMI contract.
+        let name = unsafe { c_str(instance_name) }.unwrap_or_else(|| MODEL_IDENTIFIER.into());
+        // SAFETY: `functions` is NULL or a valid struct by the contract.
+        let log = match unsafe { functions.as_ref() } {
+            Some(CallbackFunctions {
+                logger: Some(callback),
+                component_environment,
+                ..
+            }) => LogSink::Fmi2 {
+                callback: *callback,
+                environment: *component_environment,
+            },
+            _ => LogSink::None,
+        };
+        let mut inst = Instance::new(Standard::Fmi2, &name, log, logging_on != 0);
+        if fmu_type != FMI2_COSIMULATION {
+            inst.fail("fmi2Instantiate: TaylorImpact supports only Co-Simulation (fmuType = fmi2CoSimulation)");
+            return std::ptr::null_mut();
+        }
+        // SAFETY: as above.
+        if let Some(guid) = unsafe { c_str(fmu_guid) } {
+            let expected = instantiation_token();
+            if guid != expected {
+                inst.fail(&format!(
+                    "fmi2Instantiate: GUID `{guid}` does not match this FMU's `{expected}`"
+                ));
+                return std::ptr::null_mut();
+            }
+        }
+        Box::into_raw(Box::new(inst)) as Component
+    })
+}
+
+/// `fmi2FreeInstance`: always works; NULL is ignored.
+///
+/// # Safety
+/// `c` NULL or a live instance, not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
+    if c.is_null() {
+        return;
+    }
+    guard((), || {
+        // SAFETY: from `Box::into_raw` in fmi2Instantiate, freed once.
+        drop(unsafe { Box::from_raw(c as *mut Instance) });
+    })
+}
+
+/// `fmi2SetupExperiment`: records the start time.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetupExperiment(
+    c: Component,
+    _tolerance_defined: c_int,
+    _tolerance: f64,
+    start_time: f64,
+    stop_time_defined: c_int,
+    stop_time: f64,
+) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe {
+        call(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
+            if !start_time.is_finite() {
+                return inst.fail(&format!(
+                    "fmi2SetupExperiment: startTime = {start_time} must be finite"
+                ));
+            }
+            inst.start_time = start_time;
+            inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
+            Status::Ok
+        })
+    }
+}
+
+/// `fmi2EnterInitializationMode`.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2EnterInitializationMode(c: Component) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe {
+        call(
+            c,
+            "fmi2EnterInitializationMode",
+            mask::ENTER_INITIALIZATION_MODE,
+            |inst| {
+                let t = inst.start_time;
+                inst.enter_initialization_mode(t)
+            },
+        )
+    }
+}
+
+/// `fmi2ExitInitializationMode`: builds the simulation from the parameters.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2ExitInitializationMode(c: Component) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe {
+        call(
+            c,
+            "fmi2ExitInitializationMode",
+            mask::EXIT_INITIALIZATION_MODE,
+            |inst| inst.exit_initialization_mode(),
+        )
+    }
+}
+
+/// `fmi2Terminate`.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Terminate(c: Component) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe { call(c, "fmi2Terminate", mask::TERMINATE, |inst| inst.terminate()) }
+}
+
+/// `fmi2Reset`: back to Instantiated with the default parameters.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Reset(c: Component) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe { call(c, "fmi2Reset", mask::RESET, |inst| inst.reset()) }
+}
+
+/// # Safety
+/// `vrs` holds `nvr` references; `values` has room for `nvr` values.
+unsafe fn get_values<T>(
+    c: Component,
+    function: &str,
+    ty: VarType,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *mut T,
+    convert: impl Fn(f64) -> T,
+) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    (unsafe {
+        with_instance(c, |inst| {
+            let Some(vrs) = slice(vrs, nvr) else {
+                return inst.fail(&format!("{function}: vr is NULL"));
+            };
+            let Some(out) = slice_mut(values, nvr) else {
+                return inst.fail(&format!("{function}: value is NULL"));
+            };
+            match inst.get(function, vrs, ty) {
+                Ok(v) => {
+                    for (o, x) in out.iter_mut().zip(v) {
+                        *o = convert(x);
+                    }
+                    Status::Ok
+                }
+                Err(s) => s,
+            }
+        })
+    }) as c_int
+}
+
+/// # Safety
+/// `vrs` and `values` hold `nvr` elements.
+unsafe fn set_values<T: Copy>(
+    c: Component,
+    function: &str,
+    ty: VarType,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *const T,
+    convert: impl Fn(T) -> f64,
+) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    (unsafe {
+        with_instance(c, |inst| {
+            let Some(vrs) = slice(vrs, nvr) else {
+                return inst.fail(&format!("{function}: vr is NULL"));
+            };
+            let Some(vals) = slice(values, nvr) else {
+                return inst.fail(&format!("{function}: value is NULL"));
+            };
+            let vals: Vec<f64> = vals.iter().map(|&x| convert(x)).collect();
+            inst.set(function, vrs, &vals, ty)
+        })
+    }) as c_int
+}
+
+/// `fmi2GetReal`: Real parameters and outputs.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetReal(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    value: *mut f64,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { get_values(c, "fmi2GetReal", VarType::Float64, vr, nvr, value, |x| x) }
+}
+
+/// `fmi2GetInteger`: `particles_radial`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetInteger(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    value: *mut c_int,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        get_values(c, "fmi2GetInteger", VarType::Int32, vr, nvr, value, |x| {
+            x as c_int
+        })
+    }
+}
+
+/// `fmi2GetBoolean`: `at_rest`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetBoolean(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    value: *mut c_int,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        get_values(c, "fmi2GetBoolean", VarType::Boolean, vr, nvr, value, |x| {
+            (x != 0.0) as c_int
+        })
+    }
+}
+
+/// `fmi2GetString`: there are no String variables.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetString(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    _value: *mut *const c_char,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { no_strings(c, "fmi2GetString", vr, nvr) }
+}
+
+/// `fmi2SetReal`: Real parameters, before the end of initialization.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetReal(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    value: *const f64,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { set_values(c, "fmi2SetReal", VarType::Float64, vr, nvr, value, |x| x) }
+}
+
+/// `fmi2SetInteger`: `particles_radial`, before the end of initialization.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetInteger(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    value: *const c_int,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        set_values(c, "fmi2SetInteger", VarType::Int32, vr, nvr, value, |x| {
+            x as f64
+        })
+    }
+}
+
+/// `fmi2SetBoolean`: no Boolean parameters (the only Boolean is an output).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetBoolean(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    value: *const c_int,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        set_values(c, "fmi2SetBoolean", VarType::Boolean, vr, nvr, value, |x| {
+            (x != 0) as u8 as f64
+        })
+    }
+}
+
+/// `fmi2SetString`: there are no String variables.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetString(
+    c: Component,
+    vr: *const Vr,
+    nvr: usize,
+    _value: *const *const c_char,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { no_strings(c, "fmi2SetString", vr, nvr) }
+}
+
+/// # Safety
+/// FMI 2.0 contract.
+unsafe fn no_strings(c: Component, function: &str, vr: *const Vr, nvr: usize) -> Fmi2Status {
+    // SAFETY: forwarded.
+    (unsafe {
+        with_instance(c, |inst| {
+            if nvr == 0 {
+                return Status::Ok;
+            }
+            match slice(vr, nvr).and_then(|v| v.first().copied()) {
+                Some(r) => inst.fail(&format!(
+                    "{function}: value reference {r} is not a String variable (this FMU has none)"
+                )),
+                None => inst.fail(&format!("{function}: vr is NULL")),
+            }
+        })
+    }) as c_int
+}
+
+/// `fmi2GetFMUstate`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { get_fmu_state(c, "fmi2GetFMUstate", state) as c_int }
+}
+
+/// `fmi2SetFMUstate`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { set_fmu_state(c, "fmi2SetFMUstate", state) as c_int }
+}
+
+/// `fmi2FreeFMUstate`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { free_fmu_state(c, state) as c_int }
+}
+
+/// `fmi2SerializedFMUstateSize`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: Component,
+    state: *mut c_void,
+    size: *mut usize,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", state, size) as c_int }
+}
+
+/// `fmi2SerializeFMUstate`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: Component,
+    state: *mut c_void,
+    bytes: *mut u8,
+    size: usize,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { serialize(c, "fmi2SerializeFMUstate", state, bytes, size) as c_int }
+}
+
+/// `fmi2DeSerializeFMUstate`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: Component,
+    bytes: *const u8,
+    size: usize,
+    state: *mut *mut c_void,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, state) as c_int }
+}
+
+/// # Safety
+/// `c` NULL or live.
+unsafe fn unsupported(c: Component, function: &str) -> Fmi2Status {
+    // SAFETY: forwarded.
+    (unsafe {
+        with_instance(c, |inst| {
+            inst.fail(&format!(
+                "{function} is not supported: TaylorImpact provides no derivatives and has no inputs"
+            ))
+        })
+    }) as c_int
+}
+
+/// `fmi2GetDirectionalDerivative`: not supported (Error).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
+    c: Component,
+    _unknown: *const Vr,
+    _n_unknown: usize,
+    _known: *const Vr,
+    _n_known: usize,
+    _dv_known: *const f64,
+    _dv_unknown: *mut f64,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { unsupported(c, "fmi2GetDirectionalDerivative") }
+}
+
+/// `fmi2SetRealInputDerivatives`: not supported (Error).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: Component,
+    _vr: *const Vr,
+    _nvr: usize,
+    _order: *const c_int,
+    _value: *const f64,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { unsupported(c, "fmi2SetRealInputDerivatives") }
+}
+
+/// `fmi2GetRealOutputDerivatives`: not supported (Error).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: Component,
+    _vr: *const Vr,
+    _nvr: usize,
+    _order: *const c_int,
+    _value: *mut f64,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { unsupported(c, "fmi2GetRealOutputDerivatives") }
+}
+
+/// `fmi2DoStep`: advances to `currentCommunicationPoint +
+/// communicationStepSize`; `fmi2Discard` when the run ends (rod at rest or
+/// end_time) during the step or has already ended.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DoStep(
+    c: Component,
+    current_communication_point: f64,
+    communication_step_size: f64,
+    _no_set_fmu_state_prior: c_int,
+) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    (unsafe {
+        with_instance(c, |inst| {
+            let ended_before = inst.at_end();
+            match inst.do_step(
+                "fmi2DoStep",
+                current_communication_point,
+                communication_step_size,
+            ) {
+                Ok(out) if !out.terminate => {
+                    inst.set_time(current_communication_point + communication_step_size);
+                    Status::Ok
+                }
+                Ok(out) => {
+                    let last = if ended_before {
+                        current_communication_point
+                    } else {
+                        out.last_successful_time
+                    };
+                    inst.last_successful_time = last;
+                    inst.set_time(last);
+                    inst.state = STEP_DISCARDED;
+                    Status::Discard
+                }
+                Err(s) => s,
+            }
+        })
+    }) as c_int
+}
+
+/// `fmi2CancelStep`: doStep never returns Pending, so there is nothing to
+/// cancel (Error).
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2CancelStep(c: Component) -> Fmi2Status {
+    // SAFETY: FMI 2.0 contract.
+    unsafe {
+        call(c, "fmi2CancelStep", mask::DO_STEP, |inst| {
+            inst.fail("fmi2CancelStep: fmi2DoStep never returns fmi2Pending, so there is no step to cancel")
+        })
+    }
+}
+
+/// # Safety
+/// `out` NULL or writable.
+unsafe fn status_query<T>(
+    c: Component,
+    function: &str,
+    kind: c_int,
+    out: *mut T,
+    answer: impl FnOnce(&mut Instance, c_int) -> Option<T>,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        call(c, function, mask::STATUS, |inst| {
+            if out.is_null() {
+                return inst.fail(&format!("{function}: value is NULL"));
+            }
+            match answer(inst, kind) {
+                Some(v) => {
+                    // SAFETY: non-null and writable by the contract.
+                    *out = v;
+                    Status::Ok
+                }
+                None => inst.fail(&format!("{function}: status kind {kind} is not available")),
+            }
+        })
+    }
+}
+
+/// `fmi2GetStatus`: `fmi2DoStepStatus` (Discard after an early stop).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetStatus(c: Component, kind: c_int, value: *mut c_int) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        status_query(c, "fmi2GetStatus", kind, value, |inst, k| {
+            let status = if inst.state == STEP_DISCARDED {
+                Status::Discard
+            } else {
+                Status::Ok
+            };
+            (k == FMI2_DO_STEP_STATUS).then_some(status as c_int)
+        })
+    }
+}
+
+/// `fmi2GetRealStatus`: `fmi2LastSuccessfulTime`.
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetRealStatus(
+    c: Component,
+    kind: c_int,
+    value: *mut f64,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        status_query(c, "fmi2GetRealStatus", kind, value, |inst, k| {
+            (k == FMI2_LAST_SUCCESSFUL_TIME).then_some(inst.last_successful_time)
+        })
+    }
+}
+
+/// `fmi2GetIntegerStatus`: no integer status kinds exist (Error).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetIntegerStatus(
+    c: Component,
+    kind: c_int,
+    value: *mut c_int,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe { status_query(c, "fmi2GetIntegerStatus", kind, value, |_, _| None) }
+}
+
+/// `fmi2GetBooleanStatus`: `fmi2Terminated` (the rod is at rest or
+/// end_time passed).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetBooleanStatus(
+    c: Component,
+    kind: c_int,
+    value: *mut c_int,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        status_query(c, "fmi2GetBooleanStatus", kind, value, |inst, k| {
+            (k == FMI2_TERMINATED).then_some(inst.at_end() as c_int)
+        })
+    }
+}
+
+/// `fmi2GetStringStatus`: `fmi2PendingStatus` ("" since doStep is
+/// synchronous).
+///
+/// # Safety
+/// FMI 2.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetStringStatus(
+    c: Component,
+    kind: c_int,
+    value: *mut *const c_char,
+) -> Fmi2Status {
+    // SAFETY: forwarded.
+    unsafe {
+        status_query(c, "fmi2GetStringStatus", kind, value, |inst, k| {
+            (k == FMI2_PENDING_STATUS).then(|| inst.status_string.as_ptr())
+        })
+    }
+}

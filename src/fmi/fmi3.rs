@@ -1,0 +1,987 @@
+//! The FMI 3.0 Co-Simulation functions (all 75 `fmi3*` symbols of the
+//! standard; the Model Exchange and Scheduled Execution ones report that this
+//! FMU does not support them).
+//!
+//! Early stop: when the rod comes to rest (or `end_time` passes) `fmi3DoStep`
+//! returns OK with `terminateSimulation = true`; when that happens before the
+//! end of the communication step and the host allowed early return,
+//! `earlyReturn = true` and `lastSuccessfulTime` is the time the run ended.
+
+use super::*;
+use std::ffi::{c_char, c_void};
+
+type Fmi3Status = c_int;
+type Instance3 = *mut c_void;
+type Vr = u32;
+
+const VERSION: &[u8] = b"3.0\0";
+
+/// Runs `f` on an instance with the state check of `function`.
+///
+/// # Safety
+/// `instance` must be null or a live instance of this library.
+unsafe fn call(
+    instance: Instance3,
+    function: &str,
+    mask: u32,
+    f: impl FnOnce(&mut Instance) -> Status,
+) -> Fmi3Status {
+    // SAFETY: forwarded contract.
+    (unsafe {
+        with_instance(instance, |inst| match inst.check_state(function, mask) {
+            Ok(()) => f(inst),
+            Err(s) => s,
+        })
+    }) as c_int
+}
+
+/// `fmi3GetVersion`: "3.0".
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi3GetVersion() -> *const c_char {
+    VERSION.as_ptr() as *const c_char
+}
+
+/// `fmi3SetDebugLogging`.
+///
+/// # Safety
+/// FMI 3.0 contract: a live instance; `categories` holds `n` strings.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetDebugLogging(
+    instance: Instance3,
+    logging_on: u8,
+    n_categories: usize,
+    categories: *const *const c_char,
+) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract (see above).
+    unsafe {
+        call(
+            instance,
+            "fmi3SetDebugLogging",
+            mask::SET_DEBUG_LOGGING,
+            |inst| {
+                let Some(cats) = slice(categories, n_categories) else {
+                    return inst.fail("fmi3SetDebugLogging: categories is NULL");
+                };
+                let names: Vec<String> =
+                    cats.iter().map(|&c| c_str(c).unwrap_or_default()).collect();
+                inst.set_debug_logging(logging_on != 0, &names)
+            },
+        )
+    }
+}
+
+/// `fmi3InstantiateModelExchange`: not supported (NULL).
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi3InstantiateModelExchange(
+    _instance_name: *const c_char,
+    _token: *const c_char,
+    _resource_path: *const c_char,
+    _visible: u8,
+    _logging_on: u8,
+    _environment: *mut c_void,
+    _log_message: Option<Fmi3Logger>,
+) -> Instance3 {
+    std::ptr::null_mut()
+}
+
+/// `fmi3InstantiateScheduledExecution`: not supported (NULL).
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi3InstantiateScheduledExecution(
+    _instance_name: *const c_char,
+    _token: *const c_char,
+    _resource_path: *const c_char,
+    _visible: u8,
+    _logging_on: u8,
+    _environment: *mut c_void,
+    _log_message: Option<Fmi3Logger>,
+    _clock_update: *mut c_void,
+    _lock_preemption: *mut c_void,
+    _unlock_preemption: *mut c_void,
+) -> Instance3 {
+    std::ptr::null_mut()
+}
+
+/// `fmi3InstantiateCoSimulation`: a new instance with the default
+/// parameters, or NULL (with a logged error) on a wrong token.
+///
+/// # Safety
+/// FMI 3.0 contract: strings NUL-terminated or NULL; the logger (may be
+/// NULL) and environment valid until `fmi3FreeInstance`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
+    instance_name: *const c_char,
+    instantiation_token: *const c_char,
+    _resource_path: *const c_char,
+    _visible: u8,
+    logging_on: u8,
+    _event_mode_used: u8,
+    early_return_allowed: u8,
+    _required_intermediate_variables: *const Vr,
+    _n_required_intermediate_variables: usize,
+    instance_environment: *mut c_void,
+    log_message: Option<Fmi3Logger>,
+    _intermediate_update: *mut c_void,
+) -> Instance3 {
+    guard(std::ptr::null_mut(), || {
+        // SAFETY: NUL-terminated or NULL by the FMI contract.
+        let name = unsafe { c_str(instance_name) }.unwrap_or_else(|| MODEL_IDENTIFIER.into());
+        let log = match log_message {
+            Some(callback) => LogSink::Fmi3 {
+                callback,
+                environment: instance_environment,
+            },
+            None => LogSink::None,
+        };
+        let mut inst = Instance::new(Standard::Fmi3, &name, log, logging_on != 0);
+        inst.early_return_allowed = early_return_allowed != 0;
+        // SAFETY: as above.
+        if let Some(token) = unsafe { c_str(instantiation_token) } {
+            let expected = super::instantiation_token();
+            if token != expected {
+                inst.fail(&format!(
+                    "fmi3InstantiateCoSimulation: instantiationToken `{token}` does not match this FMU's `{expected}`"
+                ));
+                return std::ptr::null_mut();
+            }
+        }
+        Box::into_raw(Box::new(inst)) as Instance3
+    })
+}
+
+/// `fmi3FreeInstance`: always works; NULL is ignored.
+///
+/// # Safety
+/// `instance` is NULL or a live instance, not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3FreeInstance(instance: Instance3) {
+    if instance.is_null() {
+        return;
+    }
+    guard((), || {
+        // SAFETY: created by `Box::into_raw` in fmi3InstantiateCoSimulation and
+        // not yet freed, by the FMI contract.
+        drop(unsafe { Box::from_raw(instance as *mut Instance) });
+    })
+}
+
+/// `fmi3EnterInitializationMode`.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3EnterInitializationMode(
+    instance: Instance3,
+    _tolerance_defined: u8,
+    _tolerance: f64,
+    start_time: f64,
+    stop_time_defined: u8,
+    stop_time: f64,
+) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe {
+        call(
+            instance,
+            "fmi3EnterInitializationMode",
+            mask::ENTER_INITIALIZATION_MODE,
+            |inst| {
+                inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
+                inst.enter_initialization_mode(start_time)
+            },
+        )
+    }
+}
+
+/// `fmi3ExitInitializationMode`: builds the simulation from the parameters.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: Instance3) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe {
+        call(
+            instance,
+            "fmi3ExitInitializationMode",
+            mask::EXIT_INITIALIZATION_MODE,
+            |inst| inst.exit_initialization_mode(),
+        )
+    }
+}
+
+/// `fmi3Terminate`.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3Terminate(instance: Instance3) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe {
+        call(instance, "fmi3Terminate", mask::TERMINATE, |inst| {
+            inst.terminate()
+        })
+    }
+}
+
+/// `fmi3Reset`: back to Instantiated with the default parameters.
+///
+/// # Safety
+/// A live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3Reset(instance: Instance3) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe { call(instance, "fmi3Reset", mask::RESET, |inst| inst.reset()) }
+}
+
+/// Shared body of the getters.
+#[allow(clippy::too_many_arguments)]
+///
+/// # Safety
+/// `vrs` holds `nvr` references, `values` has room for `n_values`.
+unsafe fn get_values<T: Copy>(
+    instance: Instance3,
+    function: &str,
+    ty: VarType,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *mut T,
+    n_values: usize,
+    convert: impl Fn(f64) -> T,
+) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if nvr != n_values {
+                return inst.fail(&format!(
+                    "{function}: nValues = {n_values} but nValueReferences = {nvr}"
+                ));
+            }
+            let Some(vrs) = slice(vrs, nvr) else {
+                return inst.fail(&format!("{function}: valueReferences is NULL"));
+            };
+            let Some(out) = slice_mut(values, n_values) else {
+                return inst.fail(&format!("{function}: values is NULL"));
+            };
+            match inst.get(function, vrs, ty) {
+                Ok(v) => {
+                    for (o, x) in out.iter_mut().zip(v) {
+                        *o = convert(x);
+                    }
+                    Status::Ok
+                }
+                Err(s) => s,
+            }
+        }) as c_int
+    }
+}
+
+/// Shared body of the setters.
+#[allow(clippy::too_many_arguments)]
+///
+/// # Safety
+/// `vrs` holds `nvr` references, `values` holds `n_values` values.
+unsafe fn set_values<T: Copy>(
+    instance: Instance3,
+    function: &str,
+    ty: VarType,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *const T,
+    n_values: usize,
+    convert: impl Fn(T) -> f64,
+) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if nvr != n_values {
+                return inst.fail(&format!(
+                    "{function}: nValues = {n_values} but nValueReferences = {nvr}"
+                ));
+            }
+            let Some(vrs) = slice(vrs, nvr) else {
+                return inst.fail(&format!("{function}: valueReferences is NULL"));
+            };
+            let Some(vals) = slice(values, n_values) else {
+                return inst.fail(&format!("{function}: values is NULL"));
+            };
+            let vals: Vec<f64> = vals.iter().map(|&x| convert(x)).collect();
+            inst.set(function, vrs, &vals, ty)
+        }) as c_int
+    }
+}
+
+/// `fmi3GetFloat64`: `time`, the Float64 parameters and outputs.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetFloat64(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *mut f64,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        get_values(
+            instance,
+            "fmi3GetFloat64",
+            VarType::Float64,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| x,
+        )
+    }
+}
+
+/// `fmi3GetInt32`: `particles_radial`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetInt32(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *mut i32,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        get_values(
+            instance,
+            "fmi3GetInt32",
+            VarType::Int32,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| x as i32,
+        )
+    }
+}
+
+/// `fmi3GetBoolean`: `at_rest`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetBoolean(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *mut u8,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        get_values(
+            instance,
+            "fmi3GetBoolean",
+            VarType::Boolean,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| (x != 0.0) as u8,
+        )
+    }
+}
+
+/// `fmi3SetFloat64`: Float64 parameters, before the end of initialization.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetFloat64(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *const f64,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        set_values(
+            instance,
+            "fmi3SetFloat64",
+            VarType::Float64,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| x,
+        )
+    }
+}
+
+/// `fmi3SetInt32`: `particles_radial`, before the end of initialization.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetInt32(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *const i32,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        set_values(
+            instance,
+            "fmi3SetInt32",
+            VarType::Int32,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| x as f64,
+        )
+    }
+}
+
+/// `fmi3SetBoolean`: there are no Boolean inputs or parameters.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetBoolean(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *const u8,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        set_values(
+            instance,
+            "fmi3SetBoolean",
+            VarType::Boolean,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| (x != 0) as u8 as f64,
+        )
+    }
+}
+
+/// Getters and setters of types this FMU has no variables of: OK for an
+/// empty list, otherwise an error naming the value reference.
+macro_rules! no_variables_of_type {
+    ($( $fname:ident, $t:ty, $ptr:ident; )*) => {$(
+        #[doc = concat!("`", stringify!($fname), "`: this FMU has no variables of this type.")]
+        ///
+        /// # Safety
+        /// FMI 3.0 contract.
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $fname(
+            instance: Instance3,
+            vrs: *const Vr,
+            nvr: usize,
+            _values: *$ptr $t,
+            _n_values: usize,
+        ) -> Fmi3Status {
+            // SAFETY: FMI 3.0 contract.
+            unsafe { no_such_type(instance, stringify!($fname), vrs, nvr) }
+        }
+    )*};
+}
+
+/// # Safety
+/// FMI 3.0 contract.
+unsafe fn no_such_type(
+    instance: Instance3,
+    function: &str,
+    vrs: *const Vr,
+    nvr: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        with_instance(instance, |inst| {
+            if nvr == 0 {
+                return Status::Ok;
+            }
+            let first = slice(vrs, nvr).and_then(|v| v.first().copied());
+            match first {
+                Some(vr) => inst.fail(&format!(
+                    "{function}: value reference {vr} is not a variable of this type (this FMU has Float64, Int32 and Boolean variables)"
+                )),
+                None => inst.fail(&format!("{function}: valueReferences is NULL")),
+            }
+        }) as c_int
+    }
+}
+
+no_variables_of_type! {
+    fmi3GetFloat32, f32, mut;
+    fmi3GetInt8, i8, mut;
+    fmi3GetUInt8, u8, mut;
+    fmi3GetInt16, i16, mut;
+    fmi3GetUInt16, u16, mut;
+    fmi3GetUInt32, u32, mut;
+    fmi3GetInt64, i64, mut;
+    fmi3GetUInt64, u64, mut;
+    fmi3GetString, *const c_char, mut;
+    fmi3SetFloat32, f32, const;
+    fmi3SetInt8, i8, const;
+    fmi3SetUInt8, u8, const;
+    fmi3SetInt16, i16, const;
+    fmi3SetUInt16, u16, const;
+    fmi3SetUInt32, u32, const;
+    fmi3SetInt64, i64, const;
+    fmi3SetUInt64, u64, const;
+    fmi3SetString, *const c_char, const;
+}
+
+/// `fmi3GetBinary`: no Binary variables.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetBinary(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    _value_sizes: *mut usize,
+    _values: *mut *const u8,
+    _n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { no_such_type(instance, "fmi3GetBinary", vrs, nvr) }
+}
+
+/// `fmi3SetBinary`: no Binary variables.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetBinary(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    _value_sizes: *const usize,
+    _values: *const *const u8,
+    _n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { no_such_type(instance, "fmi3SetBinary", vrs, nvr) }
+}
+
+/// `fmi3GetClock`: no clocks.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetClock(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    _values: *mut u8,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { no_such_type(instance, "fmi3GetClock", vrs, nvr) }
+}
+
+/// `fmi3SetClock`: no clocks.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetClock(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    _values: *const u8,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { no_such_type(instance, "fmi3SetClock", vrs, nvr) }
+}
+
+/// Functions this Co-Simulation FMU does not provide: an error naming them.
+///
+/// # Safety
+/// `instance` null or live.
+unsafe fn unsupported(instance: Instance3, function: &str) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        with_instance(instance, |inst| {
+            inst.fail(&format!(
+                "{function} is not supported: TaylorImpact is a Co-Simulation FMU without event mode, clocks or derivatives"
+            ))
+        }) as c_int
+    }
+}
+
+macro_rules! unsupported_fns {
+    ($( $fname:ident ( $($arg:ident : $t:ty),* ); )*) => {$(
+        #[doc = concat!("`", stringify!($fname), "`: not supported by this Co-Simulation FMU (returns Error).")]
+        ///
+        /// # Safety
+        /// FMI 3.0 contract.
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $fname(instance: Instance3 $(, $arg: $t)*) -> Fmi3Status {
+            $( let _ = $arg; )*
+            // SAFETY: FMI 3.0 contract.
+            unsafe { unsupported(instance, stringify!($fname)) }
+        }
+    )*};
+}
+
+unsupported_fns! {
+    fmi3EnterEventMode();
+    fmi3GetNumberOfVariableDependencies(vr: Vr, n: *mut usize);
+    fmi3GetVariableDependencies(dependent: Vr, a: *mut usize, b: *mut Vr, c: *mut usize, d: *mut c_int, n: usize);
+    fmi3GetDirectionalDerivative(u: *const Vr, nu: usize, k: *const Vr, nk: usize, s: *const f64, ns: usize, o: *mut f64, no: usize);
+    fmi3GetAdjointDerivative(u: *const Vr, nu: usize, k: *const Vr, nk: usize, s: *const f64, ns: usize, o: *mut f64, no: usize);
+    fmi3EnterConfigurationMode();
+    fmi3ExitConfigurationMode();
+    fmi3GetIntervalDecimal(v: *const Vr, n: usize, i: *mut f64, q: *mut c_int);
+    fmi3GetIntervalFraction(v: *const Vr, n: usize, c: *mut u64, r: *mut u64, q: *mut c_int);
+    fmi3GetShiftDecimal(v: *const Vr, n: usize, s: *mut f64);
+    fmi3GetShiftFraction(v: *const Vr, n: usize, c: *mut u64, r: *mut u64);
+    fmi3SetIntervalDecimal(v: *const Vr, n: usize, i: *const f64);
+    fmi3SetIntervalFraction(v: *const Vr, n: usize, c: *const u64, r: *const u64);
+    fmi3SetShiftDecimal(v: *const Vr, n: usize, s: *const f64);
+    fmi3SetShiftFraction(v: *const Vr, n: usize, c: *const u64, r: *const u64);
+    fmi3EvaluateDiscreteStates();
+    fmi3UpdateDiscreteStates(a: *mut u8, b: *mut u8, c: *mut u8, d: *mut u8, e: *mut u8, t: *mut f64);
+    fmi3EnterContinuousTimeMode();
+    fmi3CompletedIntegratorStep(no_set: u8, enter: *mut u8, term: *mut u8);
+    fmi3SetTime(time: f64);
+    fmi3SetContinuousStates(x: *const f64, n: usize);
+    fmi3GetContinuousStateDerivatives(x: *mut f64, n: usize);
+    fmi3GetEventIndicators(x: *mut f64, n: usize);
+    fmi3GetContinuousStates(x: *mut f64, n: usize);
+    fmi3GetNominalsOfContinuousStates(x: *mut f64, n: usize);
+    fmi3GetNumberOfEventIndicators(n: *mut usize);
+    fmi3GetNumberOfContinuousStates(n: *mut usize);
+    fmi3EnterStepMode();
+    fmi3GetOutputDerivatives(v: *const Vr, n: usize, o: *const i32, x: *mut f64, nx: usize);
+    fmi3ActivateModelPartition(clock: Vr, t: f64);
+}
+
+/// `fmi3DoStep`: advances to `currentCommunicationPoint +
+/// communicationStepSize`, taking as many solver steps as needed.
+///
+/// # Safety
+/// FMI 3.0 contract: a live instance; the output pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3DoStep(
+    instance: Instance3,
+    current_communication_point: f64,
+    communication_step_size: f64,
+    _no_set_fmu_state_prior_to_current_point: u8,
+    event_handling_needed: *mut u8,
+    terminate_simulation: *mut u8,
+    early_return: *mut u8,
+    last_successful_time: *mut f64,
+) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if event_handling_needed.is_null()
+                || terminate_simulation.is_null()
+                || early_return.is_null()
+                || last_successful_time.is_null()
+            {
+                return inst.fail("fmi3DoStep: an output argument is NULL");
+            }
+            match inst.do_step(
+                "fmi3DoStep",
+                current_communication_point,
+                communication_step_size,
+            ) {
+                Ok(out) => {
+                    let early = out.early_return && inst.early_return_allowed;
+                    let last = if early {
+                        out.last_successful_time
+                    } else {
+                        current_communication_point + communication_step_size
+                    };
+                    inst.set_time(last);
+                    // SAFETY (covered by the enclosing block): checked non-null
+                    // above; writable by the contract.
+                    *event_handling_needed = 0;
+                    *terminate_simulation = out.terminate as u8;
+                    *early_return = early as u8;
+                    *last_successful_time = last;
+                    Status::Ok
+                }
+                Err(s) => s,
+            }
+        }) as c_int
+    }
+}
+
+/// `fmi3GetFMUState`: a copy of the instance's state (a new one, or
+/// overwriting `*state` when it is not NULL).
+///
+/// # Safety
+/// FMI 3.0 contract: `state` writable; `*state` NULL or a state of this FMU.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetFMUState(
+    instance: Instance3,
+    state: *mut *mut c_void,
+) -> Fmi3Status {
+    // SAFETY: FMI 3.0 contract.
+    unsafe { get_fmu_state(instance, "fmi3GetFMUState", state) as c_int }
+}
+
+/// Shared by FMI 3 and FMI 2.
+///
+/// # Safety
+/// `state` writable; `*state` NULL or a state of this FMU.
+pub(crate) unsafe fn get_fmu_state(
+    instance: *mut c_void,
+    function: &str,
+    state: *mut *mut c_void,
+) -> Status {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if let Err(s) = inst.check_state(function, mask::FMU_STATE) {
+                return s;
+            }
+            if state.is_null() {
+                return inst.fail(&format!("{function}: FMUState is NULL"));
+            }
+            let saved = inst.save();
+            // SAFETY: `state` is writable; a non-null `*state` is a
+            // `Box<Saved>` this FMU handed out and has not freed.
+            if (*state).is_null() {
+                *state = Box::into_raw(Box::new(saved)) as *mut c_void;
+            } else {
+                *(*state as *mut Saved) = saved;
+            }
+            Status::Ok
+        })
+    }
+}
+
+/// Shared by FMI 3 and FMI 2.
+///
+/// # Safety
+/// `state` NULL or a live state of this FMU.
+pub(crate) unsafe fn set_fmu_state(
+    instance: *mut c_void,
+    function: &str,
+    state: *mut c_void,
+) -> Status {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if let Err(s) = inst.check_state(function, mask::FMU_STATE) {
+                return s;
+            }
+            if state.is_null() {
+                return inst.fail(&format!("{function}: FMUState is NULL"));
+            }
+            // SAFETY: a live `Box<Saved>` of this FMU by the contract.
+            let saved = &*(state as *const Saved);
+            inst.restore(saved);
+            Status::Ok
+        })
+    }
+}
+
+/// Shared by FMI 3 and FMI 2: frees `*state` and sets it to NULL.
+///
+/// # Safety
+/// `state` NULL or writable; `*state` NULL or a live state of this FMU.
+pub(crate) unsafe fn free_fmu_state(instance: *mut c_void, state: *mut *mut c_void) -> Status {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with_instance(instance, |_inst| {
+            if !state.is_null() && !(*state).is_null() {
+                // SAFETY: a `Box<Saved>` from `get_fmu_state`, freed once.
+                drop(Box::from_raw(*state as *mut Saved));
+                *state = std::ptr::null_mut();
+            }
+            Status::Ok
+        })
+    }
+}
+
+/// Shared by FMI 3 and FMI 2.
+///
+/// # Safety
+/// `state` a live state of this FMU; `size` writable.
+pub(crate) unsafe fn serialized_size(
+    instance: *mut c_void,
+    function: &str,
+    state: *mut c_void,
+    size: *mut usize,
+) -> Status {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if state.is_null() || size.is_null() {
+                return inst.fail(&format!("{function}: FMUState or size is NULL"));
+            }
+            // SAFETY: a live `Box<Saved>`; `size` writable.
+            *size = (*(state as *const Saved)).serialize().len();
+            Status::Ok
+        })
+    }
+}
+
+/// Shared by FMI 3 and FMI 2.
+///
+/// # Safety
+/// `state` a live state; `bytes` has room for `size` bytes.
+pub(crate) unsafe fn serialize(
+    instance: *mut c_void,
+    function: &str,
+    state: *mut c_void,
+    bytes: *mut u8,
+    size: usize,
+) -> Status {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            if state.is_null() {
+                return inst.fail(&format!("{function}: FMUState is NULL"));
+            }
+            // SAFETY: a live `Box<Saved>`.
+            let data = (*(state as *const Saved)).serialize();
+            if data.len() != size {
+                return inst.fail(&format!(
+                    "{function}: size = {size} but the serialized state has {} bytes",
+                    data.len()
+                ));
+            }
+            let Some(out) = slice_mut(bytes, size) else {
+                return inst.fail(&format!("{function}: serializedState is NULL"));
+            };
+            out.copy_from_slice(&data);
+            Status::Ok
+        })
+    }
+}
+
+/// Shared by FMI 3 and FMI 2.
+///
+/// # Safety
+/// `bytes` holds `size` bytes; `state` writable.
+pub(crate) unsafe fn deserialize(
+    instance: *mut c_void,
+    function: &str,
+    bytes: *const u8,
+    size: usize,
+    state: *mut *mut c_void,
+) -> Status {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with_instance(instance, |inst| {
+            let Some(data) = slice(bytes, size) else {
+                return inst.fail(&format!("{function}: serializedState is NULL"));
+            };
+            if state.is_null() {
+                return inst.fail(&format!("{function}: FMUState is NULL"));
+            }
+            match Saved::deserialize(data) {
+                Ok(saved) => {
+                    // SAFETY: writable; a non-null `*state` is a live `Box<Saved>`.
+                    if (*state).is_null() {
+                        *state = Box::into_raw(Box::new(saved)) as *mut c_void;
+                    } else {
+                        *(*state as *mut Saved) = saved;
+                    }
+                    Status::Ok
+                }
+                Err(e) => inst.fail(&format!("{function}: {e}")),
+            }
+        })
+    }
+}
+
+/// `fmi3SetFMUState`: restores a state from `fmi3GetFMUState` or
+/// `fmi3DeserializeFMUState`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetFMUState(instance: Instance3, state: *mut c_void) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { set_fmu_state(instance, "fmi3SetFMUState", state) as c_int }
+}
+
+/// `fmi3FreeFMUState`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3FreeFMUState(
+    instance: Instance3,
+    state: *mut *mut c_void,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { free_fmu_state(instance, state) as c_int }
+}
+
+/// `fmi3SerializedFMUStateSize`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
+    instance: Instance3,
+    state: *mut c_void,
+    size: *mut usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { serialized_size(instance, "fmi3SerializedFMUStateSize", state, size) as c_int }
+}
+
+/// `fmi3SerializeFMUState`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SerializeFMUState(
+    instance: Instance3,
+    state: *mut c_void,
+    bytes: *mut u8,
+    size: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { serialize(instance, "fmi3SerializeFMUState", state, bytes, size) as c_int }
+}
+
+/// `fmi3DeserializeFMUState`.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3DeserializeFMUState(
+    instance: Instance3,
+    bytes: *const u8,
+    size: usize,
+    state: *mut *mut c_void,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe { deserialize(instance, "fmi3DeserializeFMUState", bytes, size, state) as c_int }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn version_and_null_instance() {
+        // SAFETY: a static NUL-terminated string.
+        let v = unsafe { std::ffi::CStr::from_ptr(fmi3GetVersion()) };
+        assert_eq!(v.to_str().unwrap(), "3.0");
+        // SAFETY: NULL is allowed and refused.
+        unsafe {
+            assert_eq!(fmi3Terminate(std::ptr::null_mut()), Status::Error as c_int);
+            fmi3FreeInstance(std::ptr::null_mut());
+        }
+    }
+}

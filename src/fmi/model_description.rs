@@ -1,0 +1,315 @@
+//! `modelDescription.xml` for FMI 3.0 and FMI 2.0, generated from
+//! [`variables`](super::variables) (and so from the parameter and observable
+//! tables). `cargo xtask fmu` writes its output into the FMUs; there is no
+//! hand-edited model description.
+
+use super::{
+    LOG_CATEGORIES, MODEL_IDENTIFIER, MODEL_NAME, VarKind, VarType, Variable, instantiation_token,
+    variables,
+};
+use crate::scene::taylor::TAYLOR_PARAMS;
+use std::fmt::Write;
+
+/// Which standard to describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FmiVersion {
+    /// FMI 3.0 Co-Simulation.
+    Fmi3,
+    /// FMI 2.0 Co-Simulation.
+    Fmi2,
+}
+
+/// SI base-unit exponents (kg, m, s, K) of every unit string used in the
+/// tables; `None` for a unit this generator does not know.
+pub fn base_units(unit: &str) -> Option<&'static [(&'static str, i32)]> {
+    Some(match unit {
+        "1" => &[],
+        "m" => &[("m", 1)],
+        "s" => &[("s", 1)],
+        "K" => &[("K", 1)],
+        "m/s" => &[("m", 1), ("s", -1)],
+        "1/s" => &[("s", -1)],
+        "kg/m3" => &[("kg", 1), ("m", -3)],
+        "Pa" => &[("kg", 1), ("m", -1), ("s", -2)],
+        "J" => &[("kg", 1), ("m", 2), ("s", -2)],
+        "J/(kg.K)" => &[("m", 2), ("s", -2), ("K", -1)],
+        _ => return None,
+    })
+}
+
+/// The declared unit of a variable (none for flags).
+fn declared_unit(v: &Variable) -> Option<&'static str> {
+    match v.unit() {
+        "bool" => None,
+        u => Some(u),
+    }
+}
+
+/// XML-escapes attribute text.
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A number as an xs:double (shortest round-trip form).
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+/// The description of a variable as written in the model description: the
+/// table's meaning plus, for parameters, the exact allowed interval (FMI
+/// `min`/`max` are inclusive; the interval says which ends are open).
+pub fn full_description(v: &Variable) -> String {
+    match v.kind {
+        VarKind::Parameter(p) => format!("{}; allowed {}", p.description, p.range),
+        _ => v.description().to_string(),
+    }
+}
+
+/// Default stop time of the experiment: the scene's `end_time` default.
+fn default_stop_time() -> f64 {
+    TAYLOR_PARAMS
+        .iter()
+        .find(|p| p.name == "end_time")
+        .map(|p| p.default)
+        .unwrap_or(4.0e-4)
+}
+
+/// Default communication step of the experiment (1 µs).
+pub const DEFAULT_STEP: f64 = 1.0e-6;
+
+/// The model description of the given standard.
+pub fn model_description(version: FmiVersion) -> Result<String, String> {
+    let vars: Vec<Variable> = variables()
+        .into_iter()
+        .filter(|v| version == FmiVersion::Fmi3 || v.kind != VarKind::Time)
+        .collect();
+    let mut units: Vec<&str> = Vec::new();
+    for v in &vars {
+        if let Some(u) = declared_unit(v) {
+            if base_units(u).is_none() {
+                return Err(format!(
+                    "variable `{}`: unit `{u}` has no base-unit definition",
+                    v.name
+                ));
+            }
+            if !units.contains(&u) {
+                units.push(u);
+            }
+        }
+    }
+    let token = instantiation_token();
+    let version_str = crate::VERSION;
+    let desc = "Taylor rod impact on a rigid anvil: axisymmetric Modified SPH (MSPH, Batra & Zhang 2008) \
+                with Johnson-Cook thermo-viscoplasticity; defaults are House et al. (1995) test 7 on 4340 steel";
+    let mut x = String::new();
+    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    match version {
+        FmiVersion::Fmi3 => {
+            writeln!(
+                x,
+                "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{MODEL_NAME}\" description=\"{}\" \
+                 instantiationToken=\"{token}\" version=\"{version_str}\" generationTool=\"meshless-impact {version_str}\" \
+                 license=\"MIT OR Apache-2.0\" variableNamingConvention=\"flat\">",
+                escape(desc)
+            )
+            .unwrap();
+            writeln!(
+                x,
+                "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
+                 canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" mightReturnEarlyFromDoStep=\"true\"/>"
+            )
+            .unwrap();
+        }
+        FmiVersion::Fmi2 => {
+            writeln!(
+                x,
+                "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{MODEL_NAME}\" description=\"{}\" \
+                 guid=\"{token}\" version=\"{version_str}\" generationTool=\"meshless-impact {version_str}\" \
+                 license=\"MIT OR Apache-2.0\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
+                escape(desc)
+            )
+            .unwrap();
+            writeln!(
+                x,
+                "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
+                 canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\"/>"
+            )
+            .unwrap();
+        }
+    }
+    x.push_str("  <UnitDefinitions>\n");
+    for u in &units {
+        let exps = base_units(u).expect("checked above");
+        let attrs: String = exps.iter().map(|(b, e)| format!(" {b}=\"{e}\"")).collect();
+        writeln!(
+            x,
+            "    <Unit name=\"{}\">\n      <BaseUnit{attrs}/>\n    </Unit>",
+            escape(u)
+        )
+        .unwrap();
+    }
+    x.push_str("  </UnitDefinitions>\n");
+    x.push_str("  <LogCategories>\n");
+    for (name, d) in LOG_CATEGORIES {
+        writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            escape(d)
+        )
+        .unwrap();
+    }
+    x.push_str("  </LogCategories>\n");
+    writeln!(
+        x,
+        "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
+        num(default_stop_time()),
+        num(DEFAULT_STEP)
+    )
+    .unwrap();
+    x.push_str("  <ModelVariables>\n");
+    for v in &vars {
+        let unit_attr = declared_unit(v)
+            .map(|u| format!(" unit=\"{}\"", escape(u)))
+            .unwrap_or_default();
+        let (causality, variability, initial) = match (v.kind, v.ty) {
+            (VarKind::Time, _) => ("independent", "continuous", ""),
+            (VarKind::Parameter(_), _) => ("parameter", "fixed", " initial=\"exact\""),
+            (VarKind::Output(..), VarType::Float64) => {
+                ("output", "continuous", " initial=\"calculated\"")
+            }
+            (VarKind::Output(..), _) => ("output", "discrete", " initial=\"calculated\""),
+        };
+        let bounds = match v.kind {
+            VarKind::Parameter(p) => {
+                let (min, max, start) = if v.ty == VarType::Int32 {
+                    (
+                        format!("{}", p.range.min as i64),
+                        format!("{}", p.range.max as i64),
+                        format!("{}", p.default as i64),
+                    )
+                } else {
+                    (num(p.range.min), num(p.range.max), num(p.default))
+                };
+                format!(" min=\"{min}\" max=\"{max}\" start=\"{start}\"")
+            }
+            _ => String::new(),
+        };
+        let d = escape(&full_description(v));
+        match version {
+            FmiVersion::Fmi3 => {
+                let (elem, unit_attr) = match v.ty {
+                    VarType::Float64 => ("Float64", unit_attr),
+                    VarType::Int32 => ("Int32", String::new()),
+                    VarType::Boolean => ("Boolean", String::new()),
+                };
+                // FMI 3: `initial` of the independent variable is not given.
+                writeln!(
+                    x,
+                    "    <{elem} name=\"{}\" valueReference=\"{}\" description=\"{d}\" causality=\"{causality}\" \
+                     variability=\"{variability}\"{initial}{unit_attr}{bounds}/>",
+                    v.name, v.vr
+                )
+                .unwrap();
+            }
+            FmiVersion::Fmi2 => {
+                let (elem, unit_attr) = match v.ty {
+                    VarType::Float64 => ("Real", unit_attr),
+                    VarType::Int32 => ("Integer", String::new()),
+                    VarType::Boolean => ("Boolean", String::new()),
+                };
+                writeln!(
+                    x,
+                    "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{d}\" causality=\"{causality}\" \
+                     variability=\"{variability}\"{initial}>\n      <{elem}{unit_attr}{bounds}/>\n    </ScalarVariable>",
+                    v.name, v.vr
+                )
+                .unwrap();
+            }
+        }
+    }
+    x.push_str("  </ModelVariables>\n");
+    x.push_str("  <ModelStructure>\n");
+    let outputs: Vec<(usize, &Variable)> = vars
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| matches!(v.kind, VarKind::Output(..)))
+        .collect();
+    match version {
+        FmiVersion::Fmi3 => {
+            for (_, v) in &outputs {
+                writeln!(
+                    x,
+                    "    <Output valueReference=\"{}\" dependencies=\"\"/>",
+                    v.vr
+                )
+                .unwrap();
+            }
+            for (_, v) in &outputs {
+                writeln!(x, "    <InitialUnknown valueReference=\"{}\"/>", v.vr).unwrap();
+            }
+        }
+        FmiVersion::Fmi2 => {
+            x.push_str("    <Outputs>\n");
+            for (k, _) in &outputs {
+                writeln!(x, "      <Unknown index=\"{}\" dependencies=\"\"/>", k + 1).unwrap();
+            }
+            x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
+            for (k, _) in &outputs {
+                writeln!(x, "      <Unknown index=\"{}\"/>", k + 1).unwrap();
+            }
+            x.push_str("    </InitialUnknowns>\n");
+        }
+    }
+    x.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
+    Ok(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::observe::TAYLOR_OBSERVABLES;
+
+    #[test]
+    fn every_unit_of_the_tables_is_defined() {
+        for v in variables() {
+            if let Some(u) = declared_unit(&v) {
+                assert!(base_units(u).is_some(), "unit {u} of {}", v.name);
+            }
+        }
+    }
+
+    #[test]
+    fn descriptions_list_every_table_row_once() {
+        for version in [FmiVersion::Fmi3, FmiVersion::Fmi2] {
+            let x = model_description(version).unwrap();
+            for p in TAYLOR_PARAMS {
+                assert_eq!(
+                    x.matches(&format!("name=\"{}\"", p.name)).count(),
+                    1,
+                    "{}",
+                    p.name
+                );
+            }
+            for o in TAYLOR_OBSERVABLES {
+                assert_eq!(
+                    x.matches(&format!("name=\"{}\"", o.name)).count(),
+                    1,
+                    "{}",
+                    o.name
+                );
+            }
+            assert!(x.contains(&instantiation_token()));
+            assert!(!x.contains("shock_radius"));
+        }
+        let x3 = model_description(FmiVersion::Fmi3).unwrap();
+        assert!(x3.contains("<Int32 name=\"particles_radial\""));
+        assert!(x3.contains("<Boolean name=\"at_rest\""));
+        assert!(x3.contains("start=\"181.0\""));
+        let x2 = model_description(FmiVersion::Fmi2).unwrap();
+        assert!(x2.contains("canNotUseMemoryManagementFunctions=\"true\""));
+        assert!(!x2.contains("name=\"time\""));
+    }
+}
