@@ -1,0 +1,70 @@
+//! The panic boundary: every entry point runs its body inside
+//! [`std::panic::catch_unwind`], so that no panic unwinds into C. A panic
+//! becomes `MI_PANIC`; a handle that panicked is marked poisoned and refuses
+//! further work, since its state may be half-updated.
+
+use super::error::{Fail, mi_result};
+use super::handle::mi_sim;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// Runs `f`, turning a panic into `MI_PANIC` (for entry points without a
+/// handle).
+pub(crate) fn guard(f: impl FnOnce() -> mi_result) -> mi_result {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or(mi_result::MI_PANIC)
+}
+
+/// The text of a panic payload.
+fn payload_text(p: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic payload".into()
+    }
+}
+
+/// Runs `f` on the handle behind `sim`: NULL gives `MI_NULL_POINTER`, a
+/// poisoned handle `MI_PANIC`; a failure is kept as the handle's last error;
+/// a panic poisons the handle.
+pub(crate) fn with_sim(
+    sim: *mut mi_sim,
+    f: impl FnOnce(&mut mi_sim) -> Result<(), Fail>,
+) -> mi_result {
+    guard(|| {
+        // SAFETY: the caller guarantees that a non-NULL `sim` is a live handle
+        // from `mi_sim_new*` not used by another thread at the same time.
+        let Some(s) = (unsafe { sim.as_mut() }) else {
+            return mi_result::MI_NULL_POINTER;
+        };
+        if s.poisoned {
+            return mi_result::MI_PANIC;
+        }
+        match catch_unwind(AssertUnwindSafe(|| f(s))) {
+            Ok(Ok(())) => mi_result::MI_OK,
+            Ok(Err(fail)) => {
+                s.set_error(fail.message);
+                fail.code
+            }
+            Err(payload) => {
+                s.poisoned = true;
+                s.set_error(format!(
+                    "panic inside meshless-impact (handle now unusable): {}",
+                    payload_text(payload.as_ref())
+                ));
+                mi_result::MI_PANIC
+            }
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_mi_panic() {
+        assert_eq!(guard(|| panic!("boom")), mi_result::MI_PANIC);
+        assert_eq!(guard(|| mi_result::MI_OK), mi_result::MI_OK);
+    }
+}

@@ -1,0 +1,707 @@
+//! The C ABI, exercised from Rust through the same `extern "C"` functions C
+//! calls: the committed header matches cbindgen's output, results are
+//! bit-identical to the Rust API, every result code is produced, buffers
+//! follow the documented convention, and handles run on separate threads.
+
+use meshless_impact::capi::*;
+use meshless_impact::{Scene, Simulation};
+use std::ffi::{CStr, CString, c_void};
+use std::ptr::{null, null_mut};
+
+/// The committed header is exactly what cbindgen generates from `src/capi/`
+/// with `cbindgen.toml` now.
+#[test]
+fn header_matches_cbindgen() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let config = cbindgen::Config::from_file(root.join("cbindgen.toml")).unwrap();
+    let bindings = cbindgen::Builder::new()
+        .with_config(config)
+        .with_src(root.join("src/capi/mod.rs"))
+        .generate()
+        .unwrap();
+    let mut generated = Vec::new();
+    bindings.write(&mut generated);
+    let generated = String::from_utf8(generated).unwrap();
+    let committed =
+        std::fs::read_to_string(root.join("include/meshless_impact.h")).unwrap_or_default();
+    if generated != committed {
+        if std::env::var_os("MI_BLESS_HEADER").is_some() {
+            std::fs::write(root.join("include/meshless_impact.h"), &generated).unwrap();
+        }
+        panic!(
+            "include/meshless_impact.h differs from cbindgen's output: run `cargo xtask header` \
+             (or this test with MI_BLESS_HEADER=1) and commit the header"
+        );
+    }
+    // The version macros are in the header and agree with the crate.
+    let v: Vec<&str> = meshless_impact::VERSION.split('.').collect();
+    for (name, value) in ["MAJOR", "MINOR", "PATCH"].iter().zip(v) {
+        assert!(
+            committed.contains(&format!("#define MI_VERSION_{name} {value}\n")),
+            "MI_VERSION_{name}"
+        );
+    }
+    assert!(committed.contains("#define MI_VERSION "));
+    assert!(committed.contains("extern \"C\" {"));
+}
+
+#[test]
+fn version_is_the_crate_version() {
+    // SAFETY: mi_version returns a static NUL-terminated string.
+    let v = unsafe { CStr::from_ptr(mi_version()) }.to_str().unwrap();
+    assert_eq!(v, meshless_impact::VERSION);
+    assert_eq!(v, MI_VERSION);
+}
+
+/// The numeric values are part of the ABI: this table must never change
+/// (new codes may only be added).
+#[test]
+fn result_codes_are_fixed() {
+    use mi_result::*;
+    let fixed = [
+        (MI_OK, 0, "MI_OK"),
+        (MI_NULL_POINTER, 1, "MI_NULL_POINTER"),
+        (MI_INVALID_UTF8, 2, "MI_INVALID_UTF8"),
+        (MI_UNKNOWN_SCENE, 3, "MI_UNKNOWN_SCENE"),
+        (MI_UNKNOWN_PARAMETER, 4, "MI_UNKNOWN_PARAMETER"),
+        (MI_UNKNOWN_OBSERVABLE, 5, "MI_UNKNOWN_OBSERVABLE"),
+        (MI_UNKNOWN_FIELD, 6, "MI_UNKNOWN_FIELD"),
+        (MI_OUT_OF_RANGE, 7, "MI_OUT_OF_RANGE"),
+        (MI_INCONSISTENT, 8, "MI_INCONSISTENT"),
+        (MI_PARSE_VALUE, 9, "MI_PARSE_VALUE"),
+        (MI_SCENE_FILE, 10, "MI_SCENE_FILE"),
+        (MI_IO, 11, "MI_IO"),
+        (MI_INVALID_STATE, 12, "MI_INVALID_STATE"),
+        (MI_BUFFER_TOO_SMALL, 13, "MI_BUFFER_TOO_SMALL"),
+        (MI_WRONG_ORDER, 14, "MI_WRONG_ORDER"),
+        (MI_SINGULAR_MOMENT_MATRIX, 20, "MI_SINGULAR_MOMENT_MATRIX"),
+        (MI_NON_FINITE, 21, "MI_NON_FINITE"),
+        (MI_THROUGH_BOUNDARY, 22, "MI_THROUGH_BOUNDARY"),
+        (MI_TIME_STEP_COLLAPSE, 23, "MI_TIME_STEP_COLLAPSE"),
+        (MI_ENERGY_DRIFT, 24, "MI_ENERGY_DRIFT"),
+        (MI_CANCELLED, 25, "MI_CANCELLED"),
+        (MI_PANIC, 30, "MI_PANIC"),
+    ];
+    for (code, value, name) in fixed {
+        assert_eq!(code as i32, value, "{name}");
+        // SAFETY: static NUL-terminated strings.
+        let n = unsafe { CStr::from_ptr(mi_result_name(value)) };
+        assert_eq!(n.to_str().unwrap(), name);
+        let d = unsafe { CStr::from_ptr(mi_result_description(value)) };
+        assert!(!d.to_bytes().is_empty());
+    }
+    let n = unsafe { CStr::from_ptr(mi_result_name(15)) };
+    assert_eq!(n.to_str().unwrap(), "MI_UNKNOWN_RESULT");
+}
+
+/// An owned handle for the tests.
+struct Sim(*mut mi_sim);
+// SAFETY: a handle is used by one thread at a time; the tests move it, never share it.
+unsafe impl Send for Sim {}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        // SAFETY: the handle came from mi_sim_new* and is freed once.
+        unsafe { mi_sim_free(self.0) }
+    }
+}
+
+fn c(s: &str) -> CString {
+    CString::new(s).unwrap()
+}
+
+fn new_sim(scene: &str) -> Sim {
+    let mut p = null_mut();
+    // SAFETY: valid string and out pointer.
+    assert_eq!(
+        unsafe { mi_sim_new(c(scene).as_ptr(), &mut p) },
+        mi_result::MI_OK
+    );
+    Sim(p)
+}
+
+impl Sim {
+    fn set(&self, name: &str, v: f64) -> mi_result {
+        // SAFETY: live handle, valid string.
+        unsafe { mi_sim_set_param(self.0, c(name).as_ptr(), v) }
+    }
+    fn error(&self) -> String {
+        let mut n = 0usize;
+        // SAFETY: live handle; size query, then a buffer of that size.
+        unsafe {
+            assert_eq!(
+                mi_sim_last_error(self.0, null_mut(), 0, &mut n),
+                mi_result::MI_OK
+            );
+            let mut buf = vec![0 as std::ffi::c_char; n];
+            assert_eq!(
+                mi_sim_last_error(self.0, buf.as_mut_ptr(), n, null_mut()),
+                mi_result::MI_OK
+            );
+            CStr::from_ptr(buf.as_ptr()).to_str().unwrap().to_string()
+        }
+    }
+    fn run(&self) -> mi_result {
+        // SAFETY: live handle.
+        unsafe { mi_sim_run(self.0) }
+    }
+    /// Copies an array by the buffer convention (size query first).
+    fn array(
+        &self,
+        f: unsafe extern "C" fn(*mut mi_sim, *mut f64, usize, *mut usize) -> mi_result,
+    ) -> Vec<f64> {
+        let mut n = 0usize;
+        // SAFETY: live handle; buffers of the queried size.
+        unsafe {
+            assert_eq!(f(self.0, null_mut(), 0, &mut n), mi_result::MI_OK);
+            let mut v = vec![f64::NAN; n];
+            let mut m = 0usize;
+            assert_eq!(f(self.0, v.as_mut_ptr(), n, &mut m), mi_result::MI_OK);
+            assert_eq!(m, n);
+            v
+        }
+    }
+    fn named(
+        &self,
+        f: unsafe extern "C" fn(
+            *mut mi_sim,
+            *const std::ffi::c_char,
+            *mut f64,
+            usize,
+            *mut usize,
+        ) -> mi_result,
+        name: &str,
+    ) -> Vec<f64> {
+        let name = c(name);
+        let mut n = 0usize;
+        // SAFETY: live handle; buffers of the queried size.
+        unsafe {
+            assert_eq!(
+                f(self.0, name.as_ptr(), null_mut(), 0, &mut n),
+                mi_result::MI_OK
+            );
+            let mut v = vec![f64::NAN; n];
+            assert_eq!(
+                f(self.0, name.as_ptr(), v.as_mut_ptr(), n, null_mut()),
+                mi_result::MI_OK
+            );
+            v
+        }
+    }
+    fn observable(&self, name: &str) -> f64 {
+        let mut v = f64::NAN;
+        // SAFETY: live handle, valid string and out pointer.
+        assert_eq!(
+            unsafe { mi_sim_observable(self.0, c(name).as_ptr(), &mut v) },
+            mi_result::MI_OK
+        );
+        v
+    }
+}
+
+fn small_taylor() -> Scene {
+    let mut scene = Scene::builtin("taylor").unwrap();
+    scene.set("particles_radial", 5.0).unwrap();
+    scene
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// A run through the C ABI gives the Rust API's numbers bit for bit: final
+/// observables, histories and every particle field.
+#[test]
+fn c_abi_equals_rust_api_bit_for_bit() {
+    let mut rust = Simulation::new(small_taylor()).unwrap();
+    rust.run().unwrap();
+
+    let s = new_sim("taylor");
+    assert_eq!(s.set("particles_radial", 5.0), mi_result::MI_OK);
+    assert_eq!(s.run(), mi_result::MI_OK);
+
+    assert_eq!(
+        bits(&s.array(mi_sim_observables)),
+        bits(&rust.observables())
+    );
+    for spec in rust.observable_specs() {
+        let v = rust.observable(spec.name).unwrap();
+        assert_eq!(
+            s.observable(spec.name).to_bits(),
+            v.to_bits(),
+            "{}",
+            spec.name
+        );
+        let h = s.named(mi_sim_history, spec.name);
+        assert_eq!(bits(&h), bits(&rust.history().column(spec.name).unwrap()));
+    }
+    assert_eq!(
+        bits(&s.array(mi_sim_history_times)),
+        bits(&rust.history().times)
+    );
+    let snap = rust.snapshot();
+    let pos: Vec<f64> = snap.positions.iter().flatten().copied().collect();
+    assert_eq!(bits(&s.named(mi_sim_field, "position")), bits(&pos));
+    for f in &snap.fields {
+        assert_eq!(
+            bits(&s.named(mi_sim_field, f.name)),
+            bits(&f.data),
+            "{}",
+            f.name
+        );
+    }
+    let (mut t, mut steps, mut n) = (0.0, 0u64, 0usize);
+    let mut fin = false;
+    // SAFETY: live handle, valid out pointers.
+    unsafe {
+        assert_eq!(mi_sim_time(s.0, &mut t), mi_result::MI_OK);
+        assert_eq!(mi_sim_steps(s.0, &mut steps), mi_result::MI_OK);
+        assert_eq!(mi_sim_particle_count(s.0, &mut n), mi_result::MI_OK);
+        assert_eq!(mi_sim_finished(s.0, &mut fin), mi_result::MI_OK);
+    }
+    assert_eq!(t.to_bits(), rust.time().to_bits());
+    assert_eq!(steps, rust.steps());
+    assert_eq!(n, rust.particles());
+    assert!(fin);
+    assert_eq!(s.observable("at_rest"), 1.0);
+}
+
+/// Advancing in pieces with a progress callback gives the same run; a
+/// callback that returns false cancels it for good.
+#[test]
+fn progress_callback_and_cancel() {
+    unsafe extern "C" fn count(user: *mut c_void, time: f64, end: f64, steps: u64) -> bool {
+        // SAFETY: user is the &mut u64 registered below.
+        let n = unsafe { &mut *(user as *mut u64) };
+        *n += 1;
+        assert!(time > 0.0 && end == 400e-6 && steps == *n);
+        true
+    }
+    unsafe extern "C" fn stop_at_10(_: *mut c_void, _: f64, _: f64, steps: u64) -> bool {
+        steps < 10
+    }
+    let mut rust = Simulation::new(small_taylor()).unwrap();
+    rust.run().unwrap();
+
+    let s = new_sim("taylor");
+    s.set("particles_radial", 5.0);
+    let mut calls = 0u64;
+    // SAFETY: live handle; `calls` outlives the runs below.
+    unsafe {
+        let ud = &mut calls as *mut u64 as *mut c_void;
+        assert_eq!(mi_sim_set_progress(s.0, Some(count), ud), mi_result::MI_OK);
+        assert_eq!(mi_sim_advance_to(s.0, 5e-6), mi_result::MI_OK);
+        assert_eq!(mi_sim_advance_to(s.0, f64::NAN), mi_result::MI_OUT_OF_RANGE);
+        assert_eq!(s.run(), mi_result::MI_OK);
+    }
+    assert_eq!(calls, rust.steps());
+    assert_eq!(
+        bits(&s.array(mi_sim_observables)),
+        bits(&rust.observables())
+    );
+    // Stepping a finished run is a wrong-order call.
+    assert_eq!(unsafe { mi_sim_step(s.0) }, mi_result::MI_WRONG_ORDER);
+
+    for advance in [false, true] {
+        let s = new_sim("taylor");
+        s.set("particles_radial", 5.0);
+        // SAFETY: live handle; the callback ignores user data.
+        unsafe {
+            mi_sim_set_progress(s.0, Some(stop_at_10), null_mut());
+            let r = if advance {
+                mi_sim_advance_to(s.0, 1e-3)
+            } else {
+                s.run()
+            };
+            assert_eq!(r, mi_result::MI_CANCELLED);
+            assert!(s.error().contains("cancelled"), "{}", s.error());
+            let mut steps = 0;
+            mi_sim_steps(s.0, &mut steps);
+            assert_eq!(steps, 10);
+            assert_eq!(s.run(), mi_result::MI_CANCELLED);
+            assert_eq!(mi_sim_step(s.0), mi_result::MI_CANCELLED);
+            let mut fin = false;
+            mi_sim_finished(s.0, &mut fin);
+            assert!(fin);
+        }
+    }
+}
+
+/// Parameters: set and get by name, the listing matches the table, setting
+/// before the first step rebuilds the initial state, after it is refused.
+#[test]
+fn parameters_and_wrong_order() {
+    let s = new_sim("taylor");
+    let specs = Scene::builtin("taylor").unwrap().param_specs();
+    let mut n = 0usize;
+    // SAFETY: live handle, valid pointers; info strings live as long as the handle.
+    unsafe {
+        assert_eq!(mi_sim_param_count(s.0, &mut n), mi_result::MI_OK);
+        assert_eq!(n, specs.len());
+        for (k, spec) in specs.iter().enumerate() {
+            let mut info = std::mem::zeroed::<mi_param_info>();
+            assert_eq!(mi_sim_param_info(s.0, k, &mut info), mi_result::MI_OK);
+            assert_eq!(CStr::from_ptr(info.name).to_str().unwrap(), spec.name);
+            assert_eq!(CStr::from_ptr(info.unit).to_str().unwrap(), spec.unit);
+            assert_eq!(info.default_value, spec.default);
+            assert_eq!(info.min, spec.range.min);
+            assert_eq!(info.max, spec.range.max);
+            assert_eq!(info.integer, spec.range.integer);
+            let mut v = 0.0;
+            assert_eq!(mi_sim_get_param(s.0, info.name, &mut v), mi_result::MI_OK);
+            assert_eq!(v, spec.default);
+        }
+        let mut info = std::mem::zeroed::<mi_param_info>();
+        assert_eq!(
+            mi_sim_param_info(s.0, n, &mut info),
+            mi_result::MI_OUT_OF_RANGE
+        );
+        assert!(info.name.is_null(), "no output on failure");
+        let mut no = 0usize;
+        mi_sim_observable_count(s.0, &mut no);
+        assert_eq!(no, 13);
+        let mut oi = std::mem::zeroed::<mi_observable_info>();
+        assert_eq!(mi_sim_observable_info(s.0, 12, &mut oi), mi_result::MI_OK);
+        assert_eq!(CStr::from_ptr(oi.name).to_str().unwrap(), "at_rest");
+        assert!(oi.is_bool);
+    }
+    // Reading the initial state, then setting, rebuilds from the new scene.
+    let mut n0 = 0usize;
+    unsafe { mi_sim_particle_count(s.0, &mut n0) };
+    assert_eq!(n0, 20 * 191);
+    assert_eq!(s.set("particles_radial", 5.0), mi_result::MI_OK);
+    assert_eq!(s.set("impact_speed", 200.0), mi_result::MI_OK);
+    let mut v = 0.0;
+    unsafe { mi_sim_get_param(s.0, c("impact_speed").as_ptr(), &mut v) };
+    assert_eq!(v, 200.0);
+    assert_eq!(s.observable("tail_velocity"), 200.0);
+    unsafe { mi_sim_particle_count(s.0, &mut n0) };
+    assert_eq!(n0, Simulation::new(small_taylor()).unwrap().particles());
+    assert_eq!(unsafe { mi_sim_step(s.0) }, mi_result::MI_OK);
+    assert_eq!(s.set("impact_speed", 100.0), mi_result::MI_WRONG_ORDER);
+    assert!(s.error().contains("the run has started"), "{}", s.error());
+    unsafe { mi_sim_get_param(s.0, c("impact_speed").as_ptr(), &mut v) };
+    assert_eq!(v, 200.0);
+    let toml = c("scene = \"noh\"\n");
+    assert_eq!(
+        unsafe { mi_sim_load_toml(s.0, toml.as_ptr()) },
+        mi_result::MI_WRONG_ORDER
+    );
+}
+
+/// The buffer convention: NULL/0 asks for the length; too small is refused
+/// with the length written and the buffer untouched; NULL with a length is a
+/// NULL-pointer error.
+#[test]
+fn buffer_convention() {
+    let s = new_sim("taylor");
+    s.set("particles_radial", 5.0);
+    let name = c("stress");
+    let mut n = 0usize;
+    // SAFETY: live handle; buffers are at least as long as passed.
+    unsafe {
+        assert_eq!(
+            mi_sim_field(s.0, name.as_ptr(), null_mut(), 0, &mut n),
+            mi_result::MI_OK
+        );
+        let particles = Simulation::new(small_taylor()).unwrap().particles();
+        assert_eq!(n, 4 * particles);
+        let mut buf = vec![-1.0; n - 1];
+        let mut m = 0usize;
+        let r = mi_sim_field(s.0, name.as_ptr(), buf.as_mut_ptr(), n - 1, &mut m);
+        assert_eq!(r, mi_result::MI_BUFFER_TOO_SMALL);
+        assert_eq!(m, n);
+        assert!(buf.iter().all(|&x| x == -1.0), "untouched on failure");
+        assert!(s.error().contains("needed"), "{}", s.error());
+        assert_eq!(
+            mi_sim_field(s.0, name.as_ptr(), null_mut(), 3, &mut m),
+            mi_result::MI_NULL_POINTER
+        );
+        let mut small = [0 as std::ffi::c_char; 4];
+        let r = mi_sim_last_error(s.0, small.as_mut_ptr(), 4, &mut m);
+        assert_eq!(r, mi_result::MI_BUFFER_TOO_SMALL);
+        assert_eq!(m, s.error().len() + 1);
+        let mut fi = std::mem::zeroed::<mi_field_info>();
+        let mut nf = 0usize;
+        assert_eq!(mi_sim_field_count(s.0, &mut nf), mi_result::MI_OK);
+        assert_eq!(nf, 8);
+        assert_eq!(mi_sim_field_info(s.0, 4, &mut fi), mi_result::MI_OK);
+        assert_eq!(CStr::from_ptr(fi.name).to_str().unwrap(), "stress");
+        assert_eq!(fi.components, 4);
+        let comps: Vec<&str> = (0..4)
+            .map(|k| CStr::from_ptr(*fi.component_names.add(k)).to_str().unwrap())
+            .collect();
+        assert_eq!(comps, ["RR", "ZZ", "TT", "RZ"]);
+        assert_eq!(
+            mi_sim_field_info(s.0, nf, &mut fi),
+            mi_result::MI_OUT_OF_RANGE
+        );
+    }
+}
+
+fn run_code(scene: &str, set: &[(&str, f64)]) -> (mi_result, String) {
+    let s = new_sim(scene);
+    for (k, v) in set {
+        assert_eq!(s.set(k, *v), mi_result::MI_OK, "{k}");
+    }
+    let r = s.run();
+    (r, s.error())
+}
+
+/// A saved state whose `vel[particle][component]` is replaced by `value`,
+/// loaded into a fresh handle: the solver's own checks then stop the next step.
+fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_result, String) {
+    let s = new_sim("taylor");
+    s.set("particles_radial", 5.0);
+    let mut n = 0usize;
+    // SAFETY: live handle; buffers of the queried size.
+    unsafe {
+        assert_eq!(mi_sim_advance_to(s.0, 1e-6), mi_result::MI_OK);
+        mi_sim_state_save(s.0, null_mut(), 0, &mut n);
+        let mut bytes = vec![0u8; n];
+        assert_eq!(
+            mi_sim_state_save(s.0, bytes.as_mut_ptr(), n, null_mut()),
+            mi_result::MI_OK
+        );
+        let mut json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        json["solver"]["Taylor"]["vel"][particle][component] = value.into();
+        let bytes = serde_json::to_vec(&json).unwrap();
+        let t = new_sim("taylor");
+        assert_eq!(
+            mi_sim_state_load(t.0, bytes.as_ptr(), bytes.len()),
+            mi_result::MI_OK
+        );
+        let r = mi_sim_step(t.0);
+        (r, t.error())
+    }
+}
+
+/// Every result code is produced through the ABI, with a message that names
+/// the problem, and none crashes.
+#[test]
+fn every_error_code_is_produced() {
+    use mi_result::*;
+    let mut seen = std::collections::BTreeSet::new();
+    let mut check = |r: mi_result, want: mi_result, msg: &str, needle: &str| {
+        assert_eq!(r, want, "{msg}");
+        assert!(msg.contains(needle), "{want:?}: `{msg}` lacks `{needle}`");
+        seen.insert(want as i32);
+    };
+    let mut p = null_mut();
+    // SAFETY: every pointer passed is NULL or valid; strings NUL-terminated.
+    unsafe {
+        check(
+            mi_sim_new(c("taylor").as_ptr(), null_mut()),
+            MI_NULL_POINTER,
+            "",
+            "",
+        );
+        check(mi_sim_new(null(), &mut p), MI_NULL_POINTER, "", "");
+        assert!(p.is_null());
+        check(
+            mi_sim_new(c("tailor").as_ptr(), &mut p),
+            MI_UNKNOWN_SCENE,
+            "",
+            "",
+        );
+        assert!(p.is_null(), "no output on failure");
+        let bad = [0xffu8, 0xfe, 0];
+        check(
+            mi_sim_new(bad.as_ptr().cast(), &mut p),
+            MI_INVALID_UTF8,
+            "",
+            "",
+        );
+        check(
+            mi_sim_new_toml(c("scene = ").as_ptr(), &mut p),
+            MI_SCENE_FILE,
+            "",
+            "",
+        );
+        let t = c("scene = \"taylor\"\n[parameters]\nimpact_speed = \"fast\"\n");
+        check(mi_sim_new_toml(t.as_ptr(), &mut p), MI_PARSE_VALUE, "", "");
+        check(
+            mi_sim_new_file(c("/nonexistent/x.toml").as_ptr(), &mut p),
+            MI_IO,
+            "",
+            "",
+        );
+        assert!(p.is_null());
+        check(mi_sim_run(null_mut()), MI_NULL_POINTER, "", "");
+
+        let s = new_sim("taylor");
+        check(
+            s.set("impact_sped", 1.0),
+            MI_UNKNOWN_PARAMETER,
+            &s.error(),
+            "impact_speed",
+        );
+        check(
+            s.set("impact_speed", -1.0),
+            MI_OUT_OF_RANGE,
+            &s.error(),
+            "(0, 2000]",
+        );
+        check(
+            s.set("impact_speed", f64::NAN),
+            MI_OUT_OF_RANGE,
+            &s.error(),
+            "NaN",
+        );
+        check(
+            s.set("particles_radial", 5.5),
+            MI_OUT_OF_RANGE,
+            &s.error(),
+            "integers",
+        );
+        let mut v = 0.0;
+        check(
+            mi_sim_observable(s.0, c("rod_lenght").as_ptr(), &mut v),
+            MI_UNKNOWN_OBSERVABLE,
+            &s.error(),
+            "rod_length",
+        );
+        check(
+            mi_sim_field(s.0, c("strain").as_ptr(), null_mut(), 0, null_mut()),
+            MI_UNKNOWN_FIELD,
+            &s.error(),
+            "plastic_strain",
+        );
+        check(
+            mi_sim_get_param(s.0, c("density").as_ptr(), null_mut()),
+            MI_NULL_POINTER,
+            &s.error(),
+            "value",
+        );
+        check(
+            mi_sim_state_load(s.0, b"not a state".as_ptr(), 11),
+            MI_INVALID_STATE,
+            &s.error(),
+            "invalid",
+        );
+        let mut small = [0.0; 2];
+        check(
+            mi_sim_observables(s.0, small.as_mut_ptr(), 2, null_mut()),
+            MI_BUFFER_TOO_SMALL,
+            &s.error(),
+            "13 needed",
+        );
+        s.set("room_temperature", 1300.0);
+        check(s.run(), MI_INCONSISTENT, &s.error(), "melt_temperature");
+        // Wrong order: a finished run cannot step; a started one cannot be reconfigured.
+        let w = new_sim("taylor");
+        w.set("particles_radial", 5.0);
+        mi_sim_step(w.0);
+        check(w.set("jc_a", 1e9), MI_WRONG_ORDER, &w.error(), "started");
+
+        let (r, m) = run_code(
+            "taylor",
+            &[("particles_radial", 5.0), ("smoothing_ratio", 0.6)],
+        );
+        check(r, MI_SINGULAR_MOMENT_MATRIX, &m, "singular");
+        let (r, m) = run_code(
+            "taylor",
+            &[("particles_radial", 5.0), ("impact_speed", 2000.0)],
+        );
+        check(r, MI_ENERGY_DRIFT, &m, "energy error");
+        let noh = [
+            ("particles_radial", 50.0),
+            ("viscosity_quadratic", 0.0),
+            ("viscosity_linear", 0.0),
+            ("smoothing_coefficient", 0.0),
+        ];
+        let (r, m) = run_code("noh", &noh);
+        check(r, MI_TIME_STEP_COLLAPSE, &m, "time step collapsed");
+        let (r, m) = patched_state_code(6, 1, -1e6);
+        check(r, MI_THROUGH_BOUNDARY, &m, "through the anvil");
+        let (r, m) = patched_state_code(11, 0, 1e308);
+        check(r, MI_NON_FINITE, &m, "non-finite");
+
+        unsafe extern "C" fn no(_: *mut c_void, _: f64, _: f64, _: u64) -> bool {
+            false
+        }
+        let s = new_sim("taylor");
+        s.set("particles_radial", 5.0);
+        mi_sim_set_progress(s.0, Some(no), null_mut());
+        check(s.run(), MI_CANCELLED, &s.error(), "cancelled");
+
+        let s = new_sim("taylor");
+        check(
+            mi_sim_debug_panic(s.0),
+            MI_PANIC,
+            &s.error(),
+            "mi_sim_debug_panic",
+        );
+        check(s.run(), MI_PANIC, &s.error(), "unusable");
+        check(s.set("jc_a", 1e9), MI_PANIC, &s.error(), "unusable");
+    }
+    // Every code but MI_OK was produced.
+    let all: std::collections::BTreeSet<i32> = (1..=30)
+        .filter(|k| {
+            // SAFETY: static string.
+            let n = unsafe { CStr::from_ptr(mi_result_name(*k)) };
+            n.to_bytes() != b"MI_UNKNOWN_RESULT"
+        })
+        .collect();
+    assert_eq!(seen, all);
+}
+
+/// A scene from TOML text equals the built-in scene with the same
+/// parameters, and `mi_sim_load_toml` reports a parse error with its message.
+#[test]
+fn toml_scenes() {
+    let toml = c("scene = \"taylor\"\n[parameters]\nparticles_radial = 5\nimpact_speed = 200.0\n");
+    let mut p = null_mut();
+    // SAFETY: valid strings and out pointer.
+    assert_eq!(
+        unsafe { mi_sim_new_toml(toml.as_ptr(), &mut p) },
+        mi_result::MI_OK
+    );
+    let a = Sim(p);
+    let b = new_sim("taylor");
+    b.set("particles_radial", 5.0);
+    b.set("impact_speed", 200.0);
+    // SAFETY: live handles.
+    unsafe {
+        mi_sim_advance_to(a.0, 3e-6);
+        mi_sim_advance_to(b.0, 3e-6);
+    }
+    assert_eq!(
+        bits(&a.array(mi_sim_observables)),
+        bits(&b.array(mi_sim_observables))
+    );
+    let s = new_sim("noh");
+    let bad = c("scene = \"taylor\"\n[parameters]\nimpact_speed = 3000\n");
+    // SAFETY: live handle, valid string.
+    assert_eq!(
+        unsafe { mi_sim_load_toml(s.0, bad.as_ptr()) },
+        mi_result::MI_OUT_OF_RANGE
+    );
+    assert!(s.error().contains("impact_speed"), "{}", s.error());
+    assert_eq!(
+        unsafe { mi_sim_load_toml(s.0, toml.as_ptr()) },
+        mi_result::MI_OK
+    );
+    assert_eq!(s.observable("tail_velocity"), 200.0);
+}
+
+/// Handles on separate threads at once give the same numbers as the same
+/// runs one after another.
+#[test]
+fn threads_equal_sequential() {
+    let speeds = [150.0, 181.0, 220.0];
+    let one = |v: f64| {
+        let s = new_sim("taylor");
+        assert_eq!(s.set("particles_radial", 5.0), mi_result::MI_OK);
+        assert_eq!(s.set("impact_speed", v), mi_result::MI_OK);
+        assert_eq!(s.run(), mi_result::MI_OK);
+        bits(&s.array(mi_sim_observables))
+    };
+    let sequential: Vec<_> = speeds.iter().map(|&v| one(v)).collect();
+    let threaded: Vec<_> = std::thread::scope(|sc| {
+        let hs: Vec<_> = speeds.iter().map(|&v| sc.spawn(move || one(v))).collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(sequential, threaded);
+    assert_ne!(sequential[0], sequential[1]);
+}
