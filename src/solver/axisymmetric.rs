@@ -26,7 +26,6 @@
 use super::boundary::{Stress, Surface, corner_free, traction_free};
 use super::{COURANT, check_time_step, first_degenerate, rows_mut, smooth, with_images};
 use crate::error::{Error, Result};
-use crate::kernel::kernel2;
 use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
 use crate::msph::{Msph2Rows, Row2};
@@ -244,13 +243,15 @@ impl TaylorSolver {
         let status: Vec<std::result::Result<(), crate::msph::Degenerate>> = rows
             .into_par_iter()
             .enumerate()
-            .map(|(i, row)| {
+            .map_init(Vec::new, |phi, (i, row)| {
                 let nb = nl.of(i);
-                let m = Msph2Rows::new(i, nb, pos, vol, h, [Row2::R, Row2::Z])?;
+                let m = Msph2Rows::new_recording(i, nb, pos, vol, h, [Row2::R, Row2::Z], phi)?;
                 let mut wsum = 0.0;
-                for (slot, &j) in row.iter_mut().zip(nb) {
-                    let g = m.weight(pos[j], vol[j]);
-                    let k = kernel2(pos[i][0] - pos[j][0], pos[i][1] - pos[j][1], h).w * vol[j];
+                for ((slot, &j), ph) in row.iter_mut().zip(nb).zip(phi.iter()) {
+                    let g = m.weight_of(ph, vol[j]);
+                    // Kernel value up to its normalisation, which cancels in
+                    // the Shepard ratio.
+                    let k = ph[0] * vol[j];
                     wsum += k;
                     *slot = [g[0], g[1], k];
                 }
