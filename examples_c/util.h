@@ -1,0 +1,49 @@
+/* Small helpers shared by the examples: report a failed call with the
+ * handle's last error message and stop. */
+#ifndef MI_EXAMPLES_UTIL_H
+#define MI_EXAMPLES_UTIL_H
+
+#include "meshless_impact.h"
+#include <stdio.h>
+#include <stdlib.h>
+
+/* The handle's last error message, in a malloc'ed string (caller frees). */
+static inline char *last_error(const mi_sim *sim) {
+    size_t n = 0;
+    char *msg;
+    if (mi_sim_last_error(sim, NULL, 0, &n) != MI_OK) return NULL; /* size query */
+    msg = (char *)malloc(n);
+    if (msg != NULL && mi_sim_last_error(sim, msg, n, NULL) != MI_OK) {
+        free(msg);
+        return NULL;
+    }
+    return msg;
+}
+
+/* Stops the program when `r` is not MI_OK. */
+static inline void check(mi_sim *sim, mi_result r, const char *what) {
+    char *msg;
+    if (r == MI_OK) return;
+    msg = sim != NULL ? last_error(sim) : NULL;
+    fprintf(stderr, "%s: %s: %s\n", what, mi_result_name(r), msg != NULL ? msg : "");
+    free(msg);
+    mi_sim_free(sim);
+    exit(1);
+}
+
+/* Applies NAME=VALUE arguments as parameters. */
+static inline void apply_settings(mi_sim *sim, int argc, char **argv) {
+    int i;
+    for (i = 1; i < argc; ++i) {
+        char name[128];
+        double value;
+        if (sscanf(argv[i], "%127[^=]=%lf", name, &value) != 2) {
+            fprintf(stderr, "expected NAME=VALUE, got `%s`\n", argv[i]);
+            mi_sim_free(sim);
+            exit(2);
+        }
+        check(sim, mi_sim_set_param(sim, name, value), name);
+    }
+}
+
+#endif
