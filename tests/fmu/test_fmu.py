@@ -1,0 +1,504 @@
+"""fmpy checks of the TaylorImpact FMUs (FMI 3.0 and FMI 2.0 Co-Simulation).
+
+Reference values come from the command-line program on the same scene
+(`meshless-impact run --json`): the FMU drives the same core, so the final
+observables must be bit-identical. Everything except the one equality check at
+the defaults runs at particles_radial = 6 (see conftest.COARSE)."""
+
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from ctypes import byref
+
+import fmpy
+from fmpy.validation import validate_fmu
+import numpy as np
+import pytest
+from fmpy import simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+    fmi2Discard,
+    fmi2LastSuccessfulTime,
+    fmi2Terminated,
+)
+from fmpy.fmi3 import FMU3Slave
+
+from conftest import COARSE, cli_run
+
+# ---------------------------------------------------------------- loggers
+# One logger of each kind for the whole process (fmpy keeps one per process);
+# each test reads the messages it caused by clearing MESSAGES first.
+MESSAGES = []
+
+
+def _log3(env, status, category, message):
+    MESSAGES.append((status, category.decode(), message.decode()))
+
+
+def _log2(env, instance_name, status, category, message):
+    MESSAGES.append((status, category.decode(), message.decode()))
+
+
+CALLBACKS2 = fmi2CallbackFunctions()
+CALLBACKS2.logger = fmi2CallbackLoggerTYPE(_log2)
+CALLBACKS2.allocateMemory = fmi2CallbackAllocateMemoryTYPE(fmpy.calloc)
+CALLBACKS2.freeMemory = fmi2CallbackFreeMemoryTYPE(fmpy.free)
+try:
+    from fmpy.logging import addLoggerProxy
+
+    addLoggerProxy(byref(CALLBACKS2))  # formats the printf-style FMI 2 message
+except Exception:  # pragma: no cover - fmpy without the proxy library
+    pass
+
+
+def messages(category=None):
+    return [m for (_, c, m) in MESSAGES if category is None or c == category]
+
+
+# ---------------------------------------------------------------- drivers
+def slave3(m, name="a", logging_on=False, early_return=False):
+    s = FMU3Slave(guid=m.md.guid, unzipDirectory=m.unzipdir,
+                  modelIdentifier=m.md.coSimulation.modelIdentifier, instanceName=name)
+    s.instantiate(loggingOn=logging_on, earlyReturnAllowed=early_return, logMessage=_log3)
+    return s
+
+
+def slave2(m, name="a", logging_on=False):
+    s = FMU2Slave(guid=m.md.guid, unzipDirectory=m.unzipdir,
+                  modelIdentifier=m.md.coSimulation.modelIdentifier, instanceName=name)
+    s.instantiate(callbacks=CALLBACKS2, loggingOn=logging_on)
+    return s
+
+
+def set_params(s, m, params):
+    for name, value in params.items():
+        v = m.var(name)
+        if v.type in ("Int32", "Integer"):
+            (s.setInt32 if hasattr(s, "setInt32") else s.setInteger)([v.valueReference], [int(value)])
+        else:
+            (s.setFloat64 if hasattr(s, "setFloat64") else s.setReal)([v.valueReference], [float(value)])
+
+
+def outputs(s, m):
+    out = {}
+    for v in m.outputs:
+        if v.type == "Boolean":
+            out[v.name] = bool(s.getBoolean([v.valueReference])[0])
+        elif hasattr(s, "getFloat64"):
+            out[v.name] = s.getFloat64([v.valueReference])[0]
+        else:
+            out[v.name] = s.getReal([v.valueReference])[0]
+    return out
+
+
+def init3(m, params, **kw):
+    s = slave3(m, **kw)
+    set_params(s, m, params)
+    s.enterInitializationMode(startTime=0.0)
+    s.exitInitializationMode()
+    return s
+
+
+def init2(m, params, **kw):
+    s = slave2(m, **kw)
+    set_params(s, m, params)
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    return s
+
+
+def run3(m, params, step=1e-6, **kw):
+    """Steps an FMI 3 instance until it asks to terminate; final outputs."""
+    s = init3(m, params, **kw)
+    n = 0
+    while True:
+        _, terminate, _, _ = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+        n += 1
+        if terminate:
+            break
+    out = outputs(s, m)
+    s.terminate()
+    s.freeInstance()
+    return out
+
+
+def coarse_cli(tmp_path_factory, *sets):
+    return cli_run(tmp_path_factory, f"particles_radial={COARSE}", *sets)
+
+
+def assert_equal_to_cli(out, ref):
+    for name, value in out.items():
+        if name == "at_rest":
+            assert value is True and ref[name] is True
+        else:
+            assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
+
+
+# ---------------------------------------------------------------- checks
+@pytest.mark.parametrize("which", ["fmu3", "fmu2"])
+def test_fmpy_validate_and_fmutool_check(which, request):
+    m = request.getfixturevalue(which)
+    assert validate_fmu(str(m.path)) == []
+    bindir = Path(sys.executable).parent
+    r = subprocess.run([str(bindir / "fmpy"), "validate", str(m.path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    r = subprocess.run([str(bindir / "fmutool"), "-input", str(m.path), "-check"], capture_output=True, text=True)
+    log = r.stdout + r.stderr
+    assert r.returncode == 0, log
+    assert "seems to be compliant" in log and "No semantic error" in log, log
+    assert "ERROR" not in log, log
+
+
+def test_variables_match_the_tables(fmu3, fmu2, tmp_path_factory):
+    names3 = {v.name for v in fmu3.md.modelVariables}
+    names2 = {v.name for v in fmu2.md.modelVariables}
+    assert names3 - names2 == {"time"}
+    params = [v for v in fmu3.md.modelVariables if v.causality == "parameter"]
+    assert len(params) == 20
+    assert all(v.variability == "fixed" and v.start is not None for v in params)
+    assert fmu3.var("particles_radial").type == "Int32" and fmu2.var("particles_radial").type == "Integer"
+    assert fmu3.var("at_rest").type == "Boolean" and fmu3.var("at_rest").causality == "output"
+    assert fmu3.var("impact_speed").unit == "m/s" and float(fmu3.var("impact_speed").start) == 181.0
+    assert float(fmu3.var("density").max) == 1e5
+    out = {v.name for v in fmu3.outputs}
+    ref = coarse_cli(tmp_path_factory)
+    assert out == set(ref) - {"particles", "steps", "end_time", "wall_time_s"}
+    assert not names3 & {"shock_radius", "post_shock_density", "pre_shock_density_l1"}
+    xml3 = (Path(fmu3.unzipdir) / "modelDescription.xml").read_text()
+    xml2 = (Path(fmu2.unzipdir) / "modelDescription.xml").read_text()
+    assert 'canGetAndSetFMUState="true"' in xml3 and 'canSerializeFMUState="true"' in xml3
+    assert 'canGetAndSetFMUstate="true"' in xml2 and 'canSerializeFMUstate="true"' in xml2
+    assert 'canNotUseMemoryManagementFunctions="true"' in xml2
+    assert fmu3.md.guid == fmu2.md.guid
+
+
+def test_defaults_equal_the_cli(fmu3, tmp_path_factory):
+    """The one run at the default resolution (20 particles across the radius)."""
+    ref = cli_run(tmp_path_factory)
+    r = simulate_fmu(str(fmu3.path), output=["rod_length", "mushroom_radius", "at_rest"])
+    assert r["rod_length"][-1] == ref["rod_length"]
+    assert r["mushroom_radius"][-1] == ref["mushroom_radius"]
+    assert r["at_rest"][-1] and not r["at_rest"][0]
+    assert abs(ref["rod_length"] - 34.75e-3) < 0.01e-3  # VALIDATION.md, test 7
+    # The run stopped at rest, well before stopTime (400 µs).
+    assert r["time"][-1] < 60e-6
+
+
+def test_fmi2_equals_fmi3_equals_cli(fmu3, fmu2, tmp_path_factory):
+    ref = coarse_cli(tmp_path_factory)
+    names = [v.name for v in fmu3.outputs]
+    r3 = simulate_fmu(str(fmu3.path), start_values={"particles_radial": COARSE}, output=names)
+    r2 = simulate_fmu(str(fmu2.path), start_values={"particles_radial": COARSE}, output=names)
+    for name in names:
+        assert r3[name][-1] == r2[name][-1] == ref[name] or name == "at_rest", name
+    assert r3["at_rest"][-1] and r2["at_rest"][-1]
+    # FMI 2 stops with fmi2Discard at the last successful time: the moment the
+    # rod came to rest, as the CLI reports it.
+    assert r2["time"][-1] == ref["end_time"]
+    # FMI 3 with early return allowed reports the same moment.
+    r3e = simulate_fmu(str(fmu3.path), start_values={"particles_radial": COARSE}, output=["rod_length"],
+                       early_return_allowed=True)
+    assert r3e["time"][-1] == ref["end_time"]
+    assert r3e["rod_length"][-1] == ref["rod_length"]
+
+
+def test_start_values_act_in_the_physical_direction(fmu3, tmp_path_factory):
+    slow = run3(fmu3, {"particles_radial": COARSE, "impact_speed": 181.0})
+    fast = run3(fmu3, {"particles_radial": COARSE, "impact_speed": 250.0})
+    assert fast["rod_length"] < slow["rod_length"] - 1e-3
+    assert fast["mushroom_radius"] > slow["mushroom_radius"] + 0.2e-3
+    assert fast["max_plastic_strain"] > slow["max_plastic_strain"]
+    strong = run3(fmu3, {"particles_radial": COARSE, "jc_a": 1.2e9})
+    assert strong["rod_length"] > slow["rod_length"]
+    assert_equal_to_cli(fast, coarse_cli(tmp_path_factory, "impact_speed=250"))
+
+
+@pytest.mark.parametrize("which", ["fmu3", "fmu2"])
+@pytest.mark.parametrize("step", [1e-7, 1e-6, 1e-5])
+def test_any_communication_step(which, step, request, tmp_path_factory):
+    m = request.getfixturevalue(which)
+    names = [v.name for v in m.outputs]
+    r = simulate_fmu(str(m.path), start_values={"particles_radial": COARSE}, output=names,
+                     output_interval=step, stop_time=1e-4)
+    ref = coarse_cli(tmp_path_factory)
+    assert_equal_to_cli({n: (bool(r[n][-1]) if n == "at_rest" else r[n][-1]) for n in names}, ref)
+    assert len(r) >= int(ref["end_time"] / step)
+
+
+def test_fixed_parameter_refused_after_initialization(fmu3, fmu2):
+    for init in (init3, init2):
+        m = fmu3 if init is init3 else fmu2
+        s = init(m, {"particles_radial": COARSE})
+        MESSAGES.clear()
+        with pytest.raises(FMICallException) as e:
+            set_params(s, m, {"impact_speed": 200.0})
+        assert e.value.status == 3
+        assert any("`impact_speed` is a fixed parameter and cannot be changed after initialization" in x
+                   for x in messages("logStatusError")), MESSAGES
+        s.freeInstance()
+
+
+def test_bad_value_is_refused_with_its_name_value_and_range(fmu3, fmu2):
+    for m, make in ((fmu3, slave3), (fmu2, slave2)):
+        s = make(m)
+        MESSAGES.clear()
+        with pytest.raises(FMICallException):
+            set_params(s, m, {"density": -5.0})
+        assert "parameter `density` = -5 is out of range: allowed (0, 100000]" in messages("logStatusError")
+        s.freeInstance()
+    # A cross-check fails when initialization ends.
+    s = slave3(fmu3)
+    set_params(s, fmu3, {"initial_temperature": 1500.0})
+    s.enterInitializationMode(startTime=0.0)
+    MESSAGES.clear()
+    with pytest.raises(FMICallException):
+        s.exitInitializationMode()
+    assert any("initial_temperature = 1500 K must be below melt_temperature" in x for x in messages()), MESSAGES
+    s.freeInstance()
+
+
+def test_start_value_on_an_output_is_refused(fmu3, fmu2):
+    for m in (fmu3, fmu2):
+        with pytest.raises(Exception, match="could not be set: rod_length"):
+            simulate_fmu(str(m.path), start_values={"rod_length": 0.01, "particles_radial": COARSE})
+    s = slave3(fmu3)
+    MESSAGES.clear()
+    with pytest.raises(FMICallException):
+        s.setFloat64([fmu3.vr("rod_length")], [0.01])
+    assert "fmi3SetFloat64: `rod_length` is an output and cannot be set" in messages("logStatusError")
+    s.freeInstance()
+
+
+def test_wrong_time_and_nonpositive_step_are_refused(fmu3, fmu2):
+    cases = [(0.5e-6, 1e-6, "does not match the FMU's time"), (0.0, 0.0, "must be positive"),
+             (0.0, -1e-6, "must be positive")]
+    for current, step, text in cases:
+        s = init3(fmu3, {"particles_radial": COARSE})
+        MESSAGES.clear()
+        with pytest.raises(FMICallException) as e:
+            s.doStep(currentCommunicationPoint=current, communicationStepSize=step)
+        assert e.value.status == 3
+        assert any(text in x for x in messages("logStatusError")), MESSAGES
+        # Error leads to Terminated: stepping is no longer allowed ...
+        with pytest.raises(FMICallException):
+            s.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-6)
+        assert any("not allowed in state Terminated" in x for x in messages())
+        # ... but outputs can be read and the instance freed.
+        assert s.getFloat64([fmu3.vr("rod_length")])[0] == pytest.approx(0.03797)
+        s.freeInstance()
+    s = init2(fmu2, {"particles_radial": COARSE})
+    with pytest.raises(FMICallException):
+        s.doStep(currentCommunicationPoint=1e-6, communicationStepSize=1e-6)
+    s.freeInstance()
+    # A call out of sequence is refused too.
+    s = slave3(fmu3)
+    MESSAGES.clear()
+    with pytest.raises(FMICallException):
+        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-6)
+    assert "fmi3DoStep: not allowed in state Instantiated" in messages("logStatusError")
+    s.freeInstance()
+
+
+def test_two_interleaved_instances_equal_two_separate_runs(fmu3, tmp_path_factory):
+    a = init3(fmu3, {"particles_radial": COARSE}, name="a")
+    b = init3(fmu3, {"particles_radial": COARSE, "impact_speed": 250.0}, name="b")
+    step, n, done = 1e-6, 0, {}
+    while len(done) < 2:
+        for name, s in (("a", a), ("b", b)):
+            if name in done:
+                continue
+            _, terminate, _, _ = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+            if terminate:
+                done[name] = outputs(s, fmu3)
+        n += 1
+    assert_equal_to_cli(done["a"], coarse_cli(tmp_path_factory))
+    assert_equal_to_cli(done["b"], coarse_cli(tmp_path_factory, "impact_speed=250"))
+    a.freeInstance()
+    b.freeInstance()
+
+
+def test_instances_run_in_parallel_threads(fmu3, tmp_path_factory):
+    results = {}
+
+    def work(speed):
+        results[speed] = run3(fmu3, {"particles_radial": COARSE, "impact_speed": speed}, name=f"v{speed}")
+
+    threads = [threading.Thread(target=work, args=(v,)) for v in (181.0, 250.0)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert_equal_to_cli(results[181.0], coarse_cli(tmp_path_factory))
+    assert_equal_to_cli(results[250.0], coarse_cli(tmp_path_factory, "impact_speed=250"))
+
+
+def _step_until_end(s, step=1e-6):
+    n = 0
+    while True:
+        _, terminate, _, _ = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+        n += 1
+        if terminate:
+            return n
+
+
+def test_reset_then_second_run_is_bit_identical(fmu3):
+    s = init3(fmu3, {"particles_radial": COARSE, "impact_speed": 220.0})
+    _step_until_end(s)
+    first = outputs(s, fmu3)
+    s.terminate()
+    s.reset()
+    # Reset restores the default parameters.
+    s.enterInitializationMode(startTime=0.0)
+    assert s.getInt32([fmu3.vr("particles_radial")]) == [20]
+    s.reset()
+    set_params(s, fmu3, {"particles_radial": COARSE, "impact_speed": 220.0})
+    s.enterInitializationMode(startTime=0.0)
+    s.exitInitializationMode()
+    _step_until_end(s)
+    second = outputs(s, fmu3)
+    assert first == second
+    assert np.array([first[k] for k in first]).tobytes() == np.array([second[k] for k in second]).tobytes()
+    s.freeInstance()
+
+
+def test_fmu_state_rolls_back_a_step_exactly_fmi3(fmu3):
+    s = init3(fmu3, {"particles_radial": COARSE})
+    step = 1e-6
+    for n in range(10):
+        s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+    state = s.getFMUState()
+    s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    after = outputs(s, fmu3)
+    s.doStep(currentCommunicationPoint=11 * step, communicationStepSize=step)
+    assert outputs(s, fmu3) != after
+    s.setFMUState(state)
+    s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    assert outputs(s, fmu3) == after
+    # Through bytes, into a second instance.
+    data = s.serializeFMUState(state)
+    assert len(data) > 1000
+    t = slave3(fmu3, name="copy")
+    restored = t.deserializeFMUState(data)
+    t.setFMUState(restored)
+    t.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    assert outputs(t, fmu3) == after
+    # Rolling back also recovers from the end of the run.
+    _step_until_end_from(t, 11 * step)
+    t.setFMUState(restored)
+    t.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    assert outputs(t, fmu3) == after
+    for x in (s, t):
+        x.freeFMUState(state if x is s else restored)
+        x.freeInstance()
+
+
+def _step_until_end_from(s, t0, step=1e-6):
+    n = 0
+    while True:
+        _, terminate, _, _ = s.doStep(currentCommunicationPoint=t0 + n * step, communicationStepSize=step)
+        n += 1
+        if terminate:
+            return
+
+
+def test_fmu_state_rolls_back_a_step_exactly_fmi2(fmu2):
+    s = init2(fmu2, {"particles_radial": COARSE})
+    step = 1e-6
+    for n in range(10):
+        s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+    state = s.getFMUstate()
+    s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    after = outputs(s, fmu2)
+    s.setFMUstate(state)
+    s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    assert outputs(s, fmu2) == after
+    data = s.serializeFMUstate(state)
+    s.freeFMUstate(state)
+    s.setFMUstate(s.deSerializeFMUstate(data))
+    s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
+    assert outputs(s, fmu2) == after
+    s.freeInstance()
+
+
+def test_fmi2_early_stop_reports_discard_terminated_and_last_time(fmu2, tmp_path_factory):
+    ref = coarse_cli(tmp_path_factory)
+    s = init2(fmu2, {"particles_radial": COARSE})
+    step, n = 1e-6, 0
+    while True:
+        try:
+            s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+        except FMICallException as e:
+            assert e.status == fmi2Discard
+            break
+        n += 1
+    assert s.getBooleanStatus(fmi2Terminated)
+    assert s.getRealStatus(fmi2LastSuccessfulTime) == ref["end_time"]
+    assert_equal_to_cli(outputs(s, fmu2), ref)
+    s.terminate()
+    s.freeInstance()
+
+
+def test_logging_respects_logging_on(fmu3, fmu2):
+    MESSAGES.clear()
+    run3(fmu3, {"particles_radial": COARSE}, logging_on=False)
+    assert MESSAGES == []
+    MESSAGES.clear()
+    run3(fmu3, {"particles_radial": COARSE}, logging_on=True)
+    assert any(m.startswith("t = ") for m in messages("logProgress"))
+    assert any("the rod is at rest" in m for m in messages("logEvents"))
+    # Only the chosen categories.
+    s = init3(fmu3, {"particles_radial": COARSE})
+    s.setDebugLogging(True, ["logEvents"])
+    MESSAGES.clear()
+    _step_until_end(s)
+    assert messages("logProgress") == [] and len(messages("logEvents")) == 1
+    with pytest.raises(FMICallException):
+        s.setDebugLogging(True, ["noSuchCategory"])
+    assert any("unknown log category `noSuchCategory`" in m for m in messages("logStatusError"))
+    s.freeInstance()
+    # FMI 2: the same through the printf-style logger ('%' arrives intact).
+    MESSAGES.clear()
+    s = init2(fmu2, {"particles_radial": COARSE}, logging_on=True)
+    s.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-6)
+    assert any(m.startswith("t = 1.0") for m in messages("logProgress")), MESSAGES
+    s.freeInstance()
+
+
+@pytest.mark.parametrize("which", ["fmu3", "fmu2"])
+def test_thousand_load_instantiate_free_unload_cycles(which, request):
+    m = request.getfixturevalue(which)
+    for k in range(1000):
+        if which == "fmu3":
+            s = FMU3Slave(guid=m.md.guid, unzipDirectory=m.unzipdir,
+                          modelIdentifier=m.md.coSimulation.modelIdentifier, instanceName=f"c{k}")
+            s.instantiate(logMessage=_log3)
+        else:
+            s = FMU2Slave(guid=m.md.guid, unzipDirectory=m.unzipdir,
+                          modelIdentifier=m.md.coSimulation.modelIdentifier, instanceName=f"c{k}")
+            s.instantiate(callbacks=CALLBACKS2)
+        s.freeInstance()
+        s.freeLibrary()
+    # Still usable afterwards.
+    if which == "fmu3":
+        assert run3(m, {"particles_radial": 4})["at_rest"] is True
+    else:
+        s = init2(m, {"particles_radial": 4})
+        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=2e-6)
+        assert 0.0370 < outputs(s, m)["rod_length"] < 0.03797
+        s.freeInstance()
+
+
+def test_wrong_token_is_refused(fmu3):
+    s = FMU3Slave(guid="{00000000-0000-0000-0000-000000000000}", unzipDirectory=fmu3.unzipdir,
+                  modelIdentifier="TaylorImpact", instanceName="x")
+    MESSAGES.clear()
+    with pytest.raises(Exception):
+        s.instantiate(logMessage=_log3)
+    assert any("does not match this FMU's" in m for m in messages("logStatusError"))
