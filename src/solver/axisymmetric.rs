@@ -24,12 +24,13 @@
 //!    the free surfaces, next time step.
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
-use super::{COURANT, check_time_step, first_degenerate, rows_mut, smooth, with_images};
+use super::{COURANT, check_time_step, smoothed};
 use crate::error::{Error, Result};
+use crate::kernel::SUPPORT;
 use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
-use crate::msph::{Msph2Rows, Row2};
-use crate::neighbors::{NeighborList, cell_list_first};
+use crate::msph::{Neighbourhood, Row2};
+use crate::neighbors::cell_list_first;
 use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
 use crate::scene::taylor::TaylorParams;
 use rayon::prelude::*;
@@ -77,11 +78,91 @@ pub struct TaylorSolver {
     at_rest: bool,
     /// Smallest spacing seen between neighbours, relative to the initial one.
     min_spacing: f64,
+    #[serde(skip)]
+    ws: Workspace,
 }
 
-/// Per-pair weights: dW-based derivative weights (R, Z) and the Shepard
-/// smoothing weight.
-type PairWeights = [f64; 3];
+/// Neighbour-list skin, in units of h: the candidate lists hold every pair
+/// within `(2 + SKIN) h` and are rebuilt once a particle has moved more than
+/// half the skin. Pairs outside the support contribute exactly nothing, so
+/// the result does not depend on when the lists were rebuilt.
+pub const SKIN: f64 = 0.3;
+
+/// Smallest number of particles a thread takes at a time.
+const MIN_LEN: usize = 64;
+
+/// Per-particle results of the pair pass.
+#[derive(Debug, Clone, Copy, Default)]
+struct PairPass {
+    /// Neighbours in the support.
+    len: u32,
+    /// Condition number of a degenerate moment matrix, or zero.
+    condition: f64,
+    /// Smallest squared distance to another particle in the support.
+    min_d2: f64,
+}
+
+/// Per-particle result of the constitutive update.
+#[derive(Debug, Clone, Copy, Default)]
+struct Update {
+    dev: Stress,
+    pressure: f64,
+    rho: f64,
+    plastic_strain: f64,
+    temp: f64,
+    energy: f64,
+}
+
+/// Buffers reused from step to step (no allocation in the time loop but when
+/// the neighbour lists are rebuilt). Not part of the state: rebuilt from the
+/// positions after a restore.
+#[derive(Debug, Clone, Default)]
+struct Workspace {
+    /// Real particle copied by each mirror image; image `k` has index `n + k`.
+    ghosts: Vec<u32>,
+    /// Row length of the padded neighbour arrays.
+    stride: usize,
+    /// Candidate neighbours of particle `i`: `nbr[i * stride..][..nbr_len[i]]`,
+    /// ascending, images included.
+    nbr: Vec<u32>,
+    nbr_len: Vec<u32>,
+    /// Positions when the lists were built.
+    built_at: Vec<[f64; 2]>,
+    /// Fields of the particles and their images.
+    pos: Vec<[f64; 2]>,
+    vol: Vec<f64>,
+    sbc: Vec<Stress>,
+    vel: Vec<[f64; 2]>,
+    vel_s: Vec<[f64; 2]>,
+    rho: Vec<[f64; 1]>,
+    /// Neighbours in the support this step, and their MSPH derivative
+    /// weights (d/dR, d/dZ) and Shepard weights, in the padded layout.
+    act: Vec<u32>,
+    wr: Vec<f64>,
+    wz: Vec<f64>,
+    ws: Vec<f64>,
+    part: Vec<PairPass>,
+    grads: Vec<[f64; 4]>,
+    upd: Vec<Update>,
+    /// Number of rebuilds of the lists.
+    rebuilds: u64,
+}
+
+/// Writes the image values `f[n + k] = mirror(f[ghosts[k]])`.
+fn fill_images<T: Copy>(f: &mut [T], n: usize, ghosts: &[u32], mirror: impl Fn(T) -> T) {
+    let (real, images) = f.split_at_mut(n);
+    for (img, &g) in images.iter_mut().zip(ghosts) {
+        *img = mirror(real[g as usize]);
+    }
+}
+
+/// Kinetic energy of particles of masses `m` and velocities `v`.
+fn kinetic(v: &[[f64; 2]], m: &[f64]) -> f64 {
+    v.iter()
+        .zip(m)
+        .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
+        .sum()
+}
 
 impl TaylorSolver {
     /// Sets up the rod at the instant of impact. `p` must be validated.
@@ -165,6 +246,7 @@ impl TaylorSolver {
             contact_dissipation: 0.0,
             at_rest: false,
             min_spacing: 1.0,
+            ws: Workspace::default(),
             p,
         };
         s.dt = s.stable_dt();
@@ -230,167 +312,283 @@ impl TaylorSolver {
         COURANT * self.h / worst
     }
 
-    /// MSPH derivative weights and Shepard weights for every neighbour pair.
-    fn pair_weights(
-        &self,
-        nl: &NeighborList,
-        pos: &[[f64; 2]],
-        vol: &[f64],
-    ) -> Result<Vec<PairWeights>> {
-        let mut w = vec![[0.0; 3]; nl.indices.len()];
-        let rows = rows_mut(&mut w, &nl.offsets);
-        let h = self.h;
-        let status: Vec<std::result::Result<(), crate::msph::Degenerate>> = rows
-            .into_par_iter()
-            .enumerate()
-            .map_init(Vec::new, |phi, (i, row)| {
-                let nb = nl.of(i);
-                let m = Msph2Rows::new_recording(i, nb, pos, vol, h, [Row2::R, Row2::Z], phi)?;
-                let mut wsum = 0.0;
-                for ((slot, &j), ph) in row.iter_mut().zip(nb).zip(phi.iter()) {
-                    let g = m.weight_of(ph, vol[j]);
-                    // Kernel value up to its normalisation, which cancels in
-                    // the Shepard ratio.
-                    let k = ph[0] * vol[j];
-                    wsum += k;
-                    *slot = [g[0], g[1], k];
-                }
-                for slot in row.iter_mut() {
-                    slot[2] /= wsum;
-                }
-                Ok(())
-            })
-            .collect();
-        first_degenerate(status, self.time)?;
-        Ok(w)
+    /// Rebuilds the mirror images and the candidate neighbour lists, with a
+    /// skin of [`SKIN`] h, from the current positions.
+    fn rebuild_neighbours(&self, ws: &mut Workspace) {
+        let n = self.particles();
+        let nr = self.nr;
+        let reach = (SUPPORT + SKIN) * self.h;
+        ws.ghosts.clear();
+        ws.ghosts.extend(
+            (0..n)
+                .filter(|&i| !i.is_multiple_of(nr) && self.pos[i][0] < reach)
+                .map(|i| i as u32),
+        );
+        let m = n + ws.ghosts.len();
+        ws.pos.resize(m, [0.0; 2]);
+        ws.pos[..n].copy_from_slice(&self.pos);
+        fill_images(&mut ws.pos, n, &ws.ghosts, |x| [-x[0], x[1]]);
+        let nl = cell_list_first(&ws.pos, n, reach);
+        // Rows padded to whole SIMD lanes.
+        let stride = (0..n)
+            .map(|i| nl.of(i).len())
+            .max()
+            .unwrap_or(0)
+            .next_multiple_of(4);
+        ws.stride = stride;
+        ws.nbr.clear();
+        ws.nbr.resize(n * stride, 0);
+        ws.nbr_len.clear();
+        for i in 0..n {
+            let row = nl.of(i);
+            for (slot, &j) in ws.nbr[i * stride..].iter_mut().zip(row) {
+                *slot = j as u32;
+            }
+            ws.nbr_len.push(row.len() as u32);
+        }
+        ws.built_at.clear();
+        ws.built_at.extend_from_slice(&self.pos);
+        ws.act.resize(n * stride, 0);
+        ws.wr.resize(n * stride, 0.0);
+        ws.wz.resize(n * stride, 0.0);
+        ws.ws.resize(n * stride, 0.0);
+        ws.vol.resize(m, 0.0);
+        ws.sbc.resize(m, [0.0; 4]);
+        ws.vel.resize(m, [0.0; 2]);
+        ws.vel_s.resize(m, [0.0; 2]);
+        ws.rho.resize(m, [0.0]);
+        ws.part.resize(n, PairPass::default());
+        ws.grads.resize(n, [0.0; 4]);
+        ws.upd.resize(n, Update::default());
+        ws.rebuilds += 1;
+    }
+
+    /// Whether a particle moved more than half the skin since the lists were
+    /// built (or they were never built).
+    fn needs_rebuild(&self, ws: &Workspace) -> bool {
+        if ws.built_at.len() != self.particles() {
+            return true;
+        }
+        let limit = 0.5 * SKIN * self.h;
+        let limit2 = limit * limit;
+        self.pos.iter().zip(&ws.built_at).any(|(x, x0)| {
+            let (a, b) = (x[0] - x0[0], x[1] - x0[1]);
+            a * a + b * b > limit2
+        })
     }
 
     /// Advances one step.
     pub fn step(&mut self) -> Result<()> {
+        let mut ws = std::mem::take(&mut self.ws);
+        let result = self.step_in(&mut ws);
+        self.ws = ws;
+        result
+    }
+
+    fn step_in(&mut self, ws: &mut Workspace) -> Result<()> {
         let n = self.particles();
         let dt = self.dt;
         let alpha = self.p.smoothing_coefficient;
-        let vol: Vec<f64> = self
-            .mass
-            .iter()
-            .zip(&self.rho)
-            .map(|(m, r)| m / r)
-            .collect();
         let nr = self.nr;
         let axis = |i: usize| i.is_multiple_of(nr);
-        // Mirror images across the axis of the particles within one support
-        // radius of it, so that particles near the axis see a symmetric
-        // neighbourhood: U_R and sigma_RZ change sign, the rest is even.
-        let ghosts: Vec<usize> = (0..n)
-            .filter(|&i| !axis(i) && self.pos[i][0] < 2.0 * self.h)
-            .collect();
-        let pos_ext = with_images(&self.pos, &ghosts, |x| [-x[0], x[1]]);
-        let vol_ext = with_images(&vol, &ghosts, |v| v);
-        let nl = cell_list_first(&pos_ext, n, 2.0 * self.h);
-        let w = self.pair_weights(&nl, &pos_ext, &vol_ext)?;
+        // Mirror images across the axis of the particles near it, so that
+        // particles near the axis see a symmetric neighbourhood: U_R and
+        // sigma_RZ change sign, the rest is even.
+        if self.needs_rebuild(ws) {
+            self.rebuild_neighbours(ws);
+        }
+        let Workspace {
+            ghosts,
+            stride,
+            nbr,
+            nbr_len,
+            pos,
+            vol,
+            sbc,
+            vel,
+            vel_s,
+            rho: rho_raw,
+            act,
+            wr,
+            wz,
+            ws: wk,
+            part,
+            grads,
+            upd,
+            ..
+        } = ws;
+        let stride = (*stride).max(1);
+        pos[..n].copy_from_slice(&self.pos);
+        fill_images(pos, n, ghosts, |x| [-x[0], x[1]]);
+        for ((v, m), r) in vol.iter_mut().zip(&self.mass).zip(&self.rho) {
+            *v = m / r;
+        }
+        fill_images(vol, n, ghosts, |v| v);
+        sbc[..n].copy_from_slice(&self.stress_bc);
+        fill_images(sbc, n, ghosts, |s| [s[0], s[1], s[2], -s[3]]);
 
-        // 2. Momentum: v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
-        let sbc = with_images(&self.stress_bc, &ghosts, |s| [s[0], s[1], s[2], -s[3]]);
-        let (pos, sbc, rho) = (&self.pos, &sbc, &self.rho);
-        let mut vel: Vec<[f64; 2]> = (0..n)
+        // 1-2. Per particle: the MSPH moment matrix over the neighbours in
+        // the support, the derivative and Shepard weights of each pair, and
+        // the momentum equation v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
+        let h = self.h;
+        let inv_h = 1.0 / h;
+        let (pos, vol, sbc) = (&*pos, &*vol, &*sbc);
+        (
+            act.par_chunks_mut(stride),
+            wr.par_chunks_mut(stride),
+            wz.par_chunks_mut(stride),
+            wk.par_chunks_mut(stride),
+            nbr.par_chunks(stride),
+            part.par_iter_mut(),
+            vel[..n].par_iter_mut(),
+        )
             .into_par_iter()
-            .map(|i| {
-                let (a, b) = (nl.offsets[i], nl.offsets[i + 1]);
-                let si = sbc[i];
-                let (mut drr_r, mut drz_z, mut drz_r, mut dzz_z) = (0.0, 0.0, 0.0, 0.0);
-                for (&j, g) in nl.indices[a..b].iter().zip(&w[a..b]) {
-                    let sj = sbc[j];
-                    drr_r += g[0] * (sj[0] - si[0]);
-                    drz_r += g[0] * (sj[3] - si[3]);
-                    drz_z += g[1] * (sj[3] - si[3]);
-                    dzz_z += g[1] * (sj[1] - si[1]);
-                }
-                let v = self.vel[i];
-                if axis(i) {
-                    [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho[i]]
-                } else {
-                    let r = pos[i][0];
-                    [
-                        v[0] + dt * (drr_r + (si[0] - si[2]) / r + drz_z) / rho[i],
-                        v[1] + dt * (drz_r + si[3] / r + dzz_z) / rho[i],
-                    ]
-                }
-            })
-            .collect();
-        self.contact_dissipation += self.hold_on_anvil(&mut vel);
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each_init(
+                || Neighbourhood::with_capacity(stride),
+                |hood, (i, (act_i, wr_i, wz_i, wk_i, nbr_i, part_i, v_out))| {
+                    let xi = pos[i];
+                    let mut min_d2 = f64::INFINITY;
+                    hood.clear();
+                    for &j in &nbr_i[..nbr_len[i] as usize] {
+                        let xj = pos[j as usize];
+                        let (dr, dz) = (xj[0] - xi[0], xj[1] - xi[1]);
+                        let (sr, sz) = (dr * inv_h, dz * inv_h);
+                        if sr * sr + sz * sz > SUPPORT * SUPPORT {
+                            continue;
+                        }
+                        if j as usize != i {
+                            min_d2 = min_d2.min(dr * dr + dz * dz);
+                        }
+                        act_i[hood.len()] = j;
+                        hood.push(sr, sz, vol[j as usize]);
+                    }
+                    let len = hood.len();
+                    *part_i = PairPass {
+                        len: len as u32,
+                        condition: 0.0,
+                        min_d2,
+                    };
+                    let m = match hood.moments().solve(i, xi, h, [Row2::R, Row2::Z]) {
+                        Ok(m) => m,
+                        Err(e) => {
+                            part_i.condition = e.condition;
+                            part_i.len = 0;
+                            *v_out = self.vel[i];
+                            return;
+                        }
+                    };
+                    hood.weights(&m, [&mut *wr_i, &mut *wz_i], wk_i);
+                    // Shepard weights W_ij V_j / sum_j W_ij V_j (the kernel's
+                    // normalisation cancels).
+                    let wsum: f64 = wk_i[..len].iter().sum();
+                    let si = sbc[i];
+                    let (mut drr_r, mut drz_z, mut drz_r, mut dzz_z) = (0.0, 0.0, 0.0, 0.0);
+                    for k in 0..len {
+                        wk_i[k] /= wsum;
+                        let sj = sbc[act_i[k] as usize];
+                        let (gr, gz) = (wr_i[k], wz_i[k]);
+                        drr_r += gr * (sj[0] - si[0]);
+                        drz_r += gr * (sj[3] - si[3]);
+                        drz_z += gz * (sj[3] - si[3]);
+                        dzz_z += gz * (sj[1] - si[1]);
+                    }
+                    let v = self.vel[i];
+                    let rho = self.rho[i];
+                    *v_out = if axis(i) {
+                        [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho]
+                    } else {
+                        let r = xi[0];
+                        [
+                            v[0] + dt * (drr_r + (si[0] - si[2]) / r + drz_z) / rho,
+                            v[1] + dt * (drz_r + si[3] / r + dzz_z) / rho,
+                        ]
+                    };
+                },
+            );
+        if let Some((i, p)) = part.iter().enumerate().find(|(_, p)| p.condition != 0.0) {
+            return Err(Error::SingularMomentMatrix {
+                particle: i,
+                time: self.time,
+                condition: p.condition,
+            });
+        }
+        let min_d2 = part.iter().map(|p| p.min_d2).fold(f64::INFINITY, f64::min);
+        let d0 = self.r0 / (self.nr - 1) as f64;
+        self.min_spacing = self.min_spacing.min(min_d2.sqrt() / d0);
+        self.contact_dissipation += self.hold_on_anvil(&mut vel[..n]);
 
         // 3. Conservative smoothing of the velocity.
-        let shepard: Vec<f64> = w.iter().map(|x| x[2]).collect();
-        let ke = |v: &[[f64; 2]]| -> f64 {
-            v.iter()
-                .zip(&self.mass)
-                .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
-                .sum()
-        };
-        let ke_before = ke(&vel);
-        let mut vel = smooth(
-            &nl,
-            &shepard,
-            &with_images(&vel, &ghosts, |v| [-v[0], v[1]]),
-            alpha,
-        );
-        for i in (0..n).step_by(nr) {
-            vel[i][0] = 0.0;
+        let ke_before = kinetic(&vel[..n], &self.mass);
+        fill_images(vel, n, ghosts, |v| [-v[0], v[1]]);
+        let (act, wr, wz, wk, part) = (&*act, &*wr, &*wz, &*wk, &*part);
+        // Pair slots of `i`: its neighbours in the support.
+        let row = |i: usize| i * stride..i * stride + part[i].len as usize;
+        {
+            let vel = &*vel;
+            vel_s[..n]
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(MIN_LEN)
+                .for_each(|(i, out)| {
+                    let r = row(i);
+                    let mut v = smoothed(i, &act[r.clone()], &wk[r], vel, alpha);
+                    if axis(i) {
+                        v[0] = 0.0;
+                    }
+                    if self.contact[i] {
+                        v[1] = 0.0;
+                    }
+                    *out = v;
+                });
         }
-        for (v, &c) in vel.iter_mut().zip(&self.contact) {
-            if c {
-                v[1] = 0.0;
-            }
-        }
-        self.smoothing_dissipation += ke_before - ke(&vel);
+        self.smoothing_dissipation += ke_before - kinetic(&vel_s[..n], &self.mass);
 
         // 4. Velocity gradients and continuity.
-        let vel_ext = with_images(&vel, &ghosts, |v| [-v[0], v[1]]);
-        let grads: Vec<[f64; 4]> = (0..n)
+        fill_images(vel_s, n, ghosts, |v| [-v[0], v[1]]);
+        let vel = &*vel_s;
+        (grads.par_iter_mut(), rho_raw[..n].par_iter_mut())
             .into_par_iter()
-            .map(|i| {
-                let (a, b) = (nl.offsets[i], nl.offsets[i + 1]);
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(i, (gr, rho_out))| {
                 let vi = vel[i];
-                let mut gr = [0.0; 4]; // dvr/dR, dvr/dZ, dvz/dR, dvz/dZ
-                for (&j, g) in nl.indices[a..b].iter().zip(&w[a..b]) {
-                    let dv = [vel_ext[j][0] - vi[0], vel_ext[j][1] - vi[1]];
-                    gr[0] += g[0] * dv[0];
-                    gr[1] += g[1] * dv[0];
-                    gr[2] += g[0] * dv[1];
-                    gr[3] += g[1] * dv[1];
+                let r = row(i);
+                let mut g4 = [0.0; 4]; // dvr/dR, dvr/dZ, dvz/dR, dvz/dZ
+                for ((&j, &gr), &gz) in act[r.clone()].iter().zip(&wr[r.clone()]).zip(&wz[r]) {
+                    let vj = vel[j as usize];
+                    let dv = [vj[0] - vi[0], vj[1] - vi[1]];
+                    g4[0] += gr * dv[0];
+                    g4[1] += gz * dv[0];
+                    g4[2] += gr * dv[1];
+                    g4[3] += gz * dv[1];
                 }
-                gr
-            })
-            .collect();
-        let hoop_rate = |i: usize| -> f64 {
-            if axis(i) {
-                grads[i][0]
-            } else {
-                vel[i][0] / self.pos[i][0]
-            }
-        };
-        let rho_new: Vec<[f64; 1]> = (0..n)
-            .map(|i| {
-                let div = grads[i][0] + grads[i][3] + hoop_rate(i);
-                [self.rho[i] * (1.0 - dt * div)]
-            })
-            .collect();
-        let rho_new = smooth(&nl, &shepard, &with_images(&rho_new, &ghosts, |r| r), alpha);
+                *gr = g4;
+                let hoop = if axis(i) { g4[0] } else { vi[0] / pos[i][0] };
+                let div = g4[0] + g4[3] + hoop;
+                *rho_out = [self.rho[i] * (1.0 - dt * div)];
+            });
+        fill_images(rho_raw, n, ghosts, |r| r);
 
-        // 5. Constitutive update.
+        // 5. Conservative smoothing of the density, constitutive update.
         let (jc, eos, mu, cap) = (
             self.jc,
             self.eos,
             self.p.shear_modulus,
             self.p.specific_heat,
         );
-        let updates: Vec<(Stress, f64, f64, f64, f64)> = (0..n)
-            .into_par_iter()
-            .map(|i| {
+        let (grads, rho_raw) = (&*grads, &*rho_raw);
+        upd.par_iter_mut()
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(i, out)| {
+                let r = row(i);
+                let [rho] = smoothed(i, &act[r.clone()], &wk[r], rho_raw, alpha);
                 let g = grads[i];
                 let d_rr = g[0];
                 let d_zz = g[3];
-                let d_tt = hoop_rate(i);
+                let d_tt = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
                 // On the axis, symmetry gives dU_R/dZ = dU_Z/dR = 0: no shear
                 // and no spin (sigma_RZ is odd in R).
                 let (d_rz, omega) = if axis(i) {
@@ -409,9 +607,7 @@ impl TaylorSolver {
                 let rate = (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
                 let sy = jc.flow_stress(self.eps_p[i], rate, self.temp[i]);
                 let ret = radial_return(&trial, sy, mu);
-                let rho = rho_new[i][0];
                 let p_new = eos.pressure(rho);
-                let dtemp = ret.plastic_work / (rho * cap);
                 // Stress power with the mid-step stress, per unit mass.
                 let p_old = self.pressure[i];
                 let sm = |k: usize, p: f64| 0.5 * (s[k] + ret.stress[k]) - p;
@@ -420,31 +616,35 @@ impl TaylorSolver {
                     + sm(1, pm) * d_zz
                     + sm(2, pm) * d_tt
                     + 2.0 * 0.5 * (s[3] + ret.stress[3]) * d_rz;
-                let de = dt * power * self.mass[i] / rho;
-                (ret.stress, p_new, ret.plastic_strain, dtemp, de)
-            })
-            .collect();
-        for (i, (s, p, deps, dtemp, de)) in updates.into_iter().enumerate() {
-            self.dev[i] = s;
-            self.pressure[i] = p;
-            self.eps_p[i] += deps;
-            self.temp[i] += dtemp;
-            self.rho[i] = rho_new[i][0];
-            self.internal_energy += de;
+                *out = Update {
+                    dev: ret.stress,
+                    pressure: p_new,
+                    rho,
+                    plastic_strain: ret.plastic_strain,
+                    temp: ret.plastic_work / (rho * cap),
+                    energy: dt * power * self.mass[i] / rho,
+                };
+            });
+        for (i, u) in upd.iter().enumerate() {
+            self.dev[i] = u.dev;
+            self.pressure[i] = u.pressure;
+            self.eps_p[i] += u.plastic_strain;
+            self.temp[i] += u.temp;
+            self.rho[i] = u.rho;
+            self.internal_energy += u.energy;
         }
 
         // 6. Positions, anvil contact.
-        for (x, v) in self.pos.iter_mut().zip(&vel) {
+        for (x, v) in self.pos.iter_mut().zip(&vel[..n]) {
             x[0] += dt * v[0];
             x[1] += dt * v[1];
         }
-        self.vel = vel;
+        self.vel.copy_from_slice(&vel[..n]);
         self.time += dt;
         self.steps += 1;
         self.update_contact()?;
         self.check_finite()?;
         self.apply_stress_bc();
-        self.track_spacing(&nl, &pos_ext);
 
         let e = self.energy_error();
         if e > ENERGY_ERROR_BOUND {
@@ -583,30 +783,8 @@ impl TaylorSolver {
         }
     }
 
-    fn track_spacing(&mut self, nl: &NeighborList, pos: &[[f64; 2]]) {
-        let d0 = self.r0 / (self.nr - 1) as f64;
-        let min2 = (0..nl.len())
-            .into_par_iter()
-            .map(|i| {
-                nl.of(i)
-                    .iter()
-                    .filter(|&&j| j != i)
-                    .map(|&j| {
-                        let (a, b) = (pos[i][0] - pos[j][0], pos[i][1] - pos[j][1]);
-                        a * a + b * b
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .reduce(|| f64::INFINITY, f64::min);
-        self.min_spacing = self.min_spacing.min(min2.sqrt() / d0);
-    }
-
     fn kinetic_energy(&self) -> f64 {
-        self.vel
-            .iter()
-            .zip(&self.mass)
-            .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
-            .sum()
+        kinetic(&self.vel, &self.mass)
     }
 
     fn energy_error(&self) -> f64 {

@@ -8,9 +8,6 @@ pub mod axisymmetric;
 pub mod boundary;
 pub mod radial;
 
-use crate::neighbors::NeighborList;
-use rayon::prelude::*;
-
 /// Courant number of eq. (3.22).
 pub const COURANT: f64 = 0.2;
 
@@ -30,46 +27,32 @@ pub(crate) fn rows_mut<'a, T>(mut buf: &'a mut [T], offsets: &[usize]) -> Vec<&'
     rows
 }
 
-/// Conservative smoothing, eq. (3.23): `f_i + alpha (sum_j s_ij f_j - f_i)`,
-/// where `s_ij` are the Shepard weights `W_ij V_j / sum_j W_ij V_j` stored in
-/// CSR order, for the particles that have rows in `nl` (`f` may extend past
-/// them with mirror images). Runs in parallel; the result does not depend on
-/// thread count.
-pub(crate) fn smooth<const K: usize>(
-    nl: &NeighborList,
+/// Conservative smoothing, eq. (3.23), of particle `i`'s value:
+/// `f_i + alpha (sum_j s_ij f_j - f_i)`, where `s_ij` are the Shepard weights
+/// `W_ij V_j / sum_j W_ij V_j` of its neighbours `nbrs` (indices into `f`,
+/// which may extend past the particles with mirror images). With
+/// `alpha = 0` the value is returned unchanged.
+#[inline]
+pub(crate) fn smoothed<const K: usize>(
+    i: usize,
+    nbrs: &[u32],
     shepard: &[f64],
     f: &[[f64; K]],
     alpha: f64,
-) -> Vec<[f64; K]> {
-    (0..nl.len())
-        .into_par_iter()
-        .map(|i| {
-            if alpha == 0.0 {
-                return f[i];
-            }
-            let (a, b) = (nl.offsets[i], nl.offsets[i + 1]);
-            let mut mean = [0.0; K];
-            for (&j, &s) in nl.indices[a..b].iter().zip(&shepard[a..b]) {
-                for k in 0..K {
-                    mean[k] += s * f[j][k];
-                }
-            }
-            let mut out = f[i];
-            for k in 0..K {
-                out[k] += alpha * (mean[k] - f[i][k]);
-            }
-            out
-        })
-        .collect()
-}
-
-/// Values of the real particles followed by those of their mirror images
-/// across the axis: `ghosts[k]` is the real particle the `k`-th image copies,
-/// and `mirror` maps a value to its image.
-pub(crate) fn with_images<T: Copy>(f: &[T], ghosts: &[usize], mirror: impl Fn(T) -> T) -> Vec<T> {
-    let mut out = Vec::with_capacity(f.len() + ghosts.len());
-    out.extend_from_slice(f);
-    out.extend(ghosts.iter().map(|&i| mirror(f[i])));
+) -> [f64; K] {
+    let mut out = f[i];
+    if alpha == 0.0 {
+        return out;
+    }
+    let mut mean = [0.0; K];
+    for (&j, &s) in nbrs.iter().zip(shepard) {
+        for k in 0..K {
+            mean[k] += s * f[j as usize][k];
+        }
+    }
+    for k in 0..K {
+        out[k] += alpha * (mean[k] - out[k]);
+    }
     out
 }
 
@@ -128,18 +111,27 @@ mod tests {
         let p: Vec<[f64; 2]> = (0..20).map(|k| [k as f64, 0.0]).collect();
         let nl = cell_list(&p, 1.0);
         // Equal weights among the (up to three) neighbours.
-        let s: Vec<f64> = (0..p.len())
-            .flat_map(|i| {
-                let n = nl.of(i).len() as f64;
-                std::iter::repeat_n(1.0 / n, nl.of(i).len())
-            })
-            .collect();
+        let smooth_all = |f: &[[f64; 1]]| -> Vec<[f64; 1]> {
+            (0..p.len())
+                .map(|i| {
+                    let nb: Vec<u32> = nl.of(i).iter().map(|&j| j as u32).collect();
+                    let s = vec![1.0 / nb.len() as f64; nb.len()];
+                    smoothed(i, &nb, &s, f, 0.3)
+                })
+                .collect()
+        };
         let c = vec![[3.0]; 20];
-        assert_eq!(smooth(&nl, &s, &c, 0.3), c);
+        for (a, b) in smooth_all(&c).iter().zip(&c) {
+            assert!((a[0] - b[0]).abs() < 1e-14);
+        }
         let mut spike = vec![[0.0]; 20];
         spike[10] = [3.0];
-        let out = smooth(&nl, &s, &spike, 0.3);
+        let out = smooth_all(&spike);
         assert!((out[10][0] - (3.0 + 0.3 * (1.0 - 3.0))).abs() < 1e-12);
         assert!((out[9][0] - 0.3).abs() < 1e-12);
+        assert_eq!(
+            smoothed(4, &[3, 4, 5], &[0.2, 0.5, 0.3], &spike, 0.0),
+            spike[4]
+        );
     }
 }
