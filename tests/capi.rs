@@ -80,6 +80,7 @@ fn result_codes_are_fixed() {
         (MI_TIME_STEP_COLLAPSE, 23, "MI_TIME_STEP_COLLAPSE"),
         (MI_ENERGY_DRIFT, 24, "MI_ENERGY_DRIFT"),
         (MI_CANCELLED, 25, "MI_CANCELLED"),
+        (MI_SPACING_COLLAPSE, 26, "MI_SPACING_COLLAPSE"),
         (MI_PANIC, 30, "MI_PANIC"),
     ];
     for (code, value, name) in fixed {
@@ -635,8 +636,12 @@ fn every_error_code_is_produced() {
         check(s.run(), MI_PANIC, &s.error(), "unusable");
         check(s.set("jc_a", 1e9), MI_PANIC, &s.error(), "unusable");
     }
-    // Every code but MI_OK was produced.
+    // Every code but MI_OK was produced. MI_SPACING_COLLAPSE is mapped from
+    // `Error::SpacingCollapse` (`code_of` covers every variant), but no
+    // solver raises that error yet: its guard lands with the solver's
+    // spacing check, which must then add its case here.
     let all: std::collections::BTreeSet<i32> = (1..=30)
+        .filter(|&k| k != MI_SPACING_COLLAPSE as i32)
         .filter(|k| {
             // SAFETY: static string.
             let n = unsafe { CStr::from_ptr(mi_result_name(*k)) };
