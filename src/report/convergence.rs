@@ -50,6 +50,8 @@ pub struct TaylorPoint {
     pub lu: f64,
     /// Energy error at the end.
     pub energy_error: f64,
+    /// Smallest neighbour spacing over the initial one, over the run.
+    pub min_spacing: f64,
     /// Outcome label.
     pub outcome: String,
 }
@@ -83,10 +85,7 @@ fn local_orders(resolution: &[f64], error: &[f64]) -> Vec<String> {
             if k == 0 {
                 "—".into()
             } else {
-                sig(
-                    observed_order(&resolution[k - 1..=k], &error[k - 1..=k]),
-                    3,
-                )
+                sig(observed_order(&resolution[k - 1..=k], &error[k - 1..=k]), 3)
             }
         })
         .collect()
@@ -229,10 +228,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
     let reference = crate::Scene::builtin("taylor")?.reference;
     for &n in &plan.taylor {
         eprintln!("report: Taylor test 7, {n} particles across the radius");
-        let run = run_case(
-            scene("taylor", &[("particles_radial", n as f64)]),
-            &probe,
-        );
+        let run = run_case(scene("taylor", &[("particles_radial", n as f64)]), &probe);
         points.push(TaylorPoint {
             across: n,
             particles: run.particles,
@@ -242,6 +238,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
             df: 2.0 * run.get("mushroom_radius"),
             lu: run.get("undeformed_length"),
             energy_error: run.get("energy_error"),
+            min_spacing: run.min_spacing,
             outcome: run.outcome.label().to_string(),
         });
         if n as f64 == plan.figures {
@@ -274,6 +271,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
             "Lu_vs_exp",
             "Lu_vs_finest",
             "energy_error",
+            "min_spacing_ratio",
             "outcome",
         ],
     );
@@ -290,6 +288,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
             row.push(pct(*v, fine[k]));
         }
         row.push(sig(p.energy_error, 3));
+        row.push(sig(p.min_spacing, 3));
         row.push(p.outcome.clone());
         t.push(row);
     }
@@ -304,7 +303,11 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
         finest.across
     ));
     doc.table(&t)?;
-    let names = ["final length Lf", "impact-face diameter Df", "undeformed length Lu"];
+    let names = [
+        "final length Lf",
+        "impact-face diameter Df",
+        "undeformed length Lu",
+    ];
     for (file, title, against, skip_finest) in [
         (
             "taylor_error_vs_time_experiment.svg",

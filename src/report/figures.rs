@@ -144,7 +144,7 @@ pub(super) fn test7(plan: &Plan, doc: &mut Doc, run: CaseRun) -> Result<()> {
         ] {
             let file = format!("test7_{field}_{label}.svg");
             let title = format!("Test 7, t = {time}: {unit}");
-            plot::map(&doc.dir.join(&file), &title, unit, &snap.positions, values)?;
+            plot::map(&doc.dir.join(&file), &title, &snap.positions, values)?;
             doc.image(&file, &title);
         }
         let max = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);

@@ -273,10 +273,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     sensitivity::table1(&plan, &mut doc)?;
     let stability = stability::matrix(&plan, &mut doc)?;
     let wall_s = start.elapsed().as_secs_f64();
-    let _ = writeln!(
-        doc.text,
-        "---\n\nWhole report: {wall_s:.1} s wall time."
-    );
+    let _ = writeln!(doc.text, "---\n\nWhole report: {wall_s:.1} s wall time.");
     let index = dir.join("index.md");
     std::fs::write(&index, &doc.text).map_err(|e| Error::io(&index, e))?;
     doc.files.push("index.md".into());

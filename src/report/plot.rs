@@ -98,7 +98,11 @@ fn usable(p: &(f64, f64), ax: &Axes) -> bool {
 
 /// Draws `series` on the given axes into an SVG file.
 pub fn lines(path: &Path, ax: Axes, series: &[Series]) -> Result<()> {
-    let pts = || series.iter().flat_map(|s| s.points.iter().filter(|p| usable(p, &ax)));
+    let pts = || {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(|p| usable(p, &ax)))
+    };
     let (mut x0, mut x1) = bounds(pts().map(|p| p.0), ax.log_x);
     let (mut y0, mut y1) = bounds(pts().map(|p| p.1), ax.log_y);
     if ax.diagonal {
@@ -129,10 +133,13 @@ where
         .y_label_area_size(70)
         .build_cartesian_2d(xs, ys)
         .map_err(|e| plot_err(path, e))?;
+    let fmt = |v: &f64| super::sig(*v, 3);
     chart
         .configure_mesh()
         .x_desc(ax.x)
         .y_desc(ax.y)
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
         .draw()
         .map_err(|e| plot_err(path, e))?;
     if ax.diagonal {
@@ -146,7 +153,12 @@ where
     }
     for (k, s) in series.iter().enumerate() {
         let color = palette(k);
-        let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(|p| usable(p, &ax)).collect();
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| usable(p, &ax))
+            .collect();
         if !s.markers_only {
             chart
                 .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
@@ -167,7 +179,11 @@ where
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK.mix(0.3))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(if ax.diagonal {
+            SeriesLabelPosition::UpperLeft
+        } else {
+            SeriesLabelPosition::UpperRight
+        })
         .draw()
         .map_err(|e| plot_err(path, e))?;
     root.present().map_err(|e| plot_err(path, e))
@@ -175,7 +191,7 @@ where
 
 /// Particles in the R-Z plane coloured by `values` (viridis), with a colour
 /// bar. Lengths are plotted in millimetres.
-pub fn map(path: &Path, title: &str, unit: &str, positions: &[[f64; 2]], values: &[f64]) -> Result<()> {
+pub fn map(path: &Path, title: &str, positions: &[[f64; 2]], values: &[f64]) -> Result<()> {
     let (v0, v1) = values
         .iter()
         .filter(|v| v.is_finite())
@@ -187,7 +203,7 @@ pub fn map(path: &Path, title: &str, unit: &str, positions: &[[f64; 2]], values:
     let zmax = positions.iter().map(|p| p[1]).fold(0.0, f64::max) * 1e3;
     // Equal scales on both axes: the plot's height follows the rod's aspect.
     let width = 420u32;
-    let height = ((width as f64 - 90.0) * zmax / rmax.max(1e-9) + 80.0).clamp(300.0, 1400.0) as u32;
+    let height = ((width as f64 - 90.0) * zmax / rmax.max(1e-9) + 80.0).clamp(300.0, 900.0) as u32;
     let root = SVGBackend::new(path, (width + 110, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
     let (left, right) = root.split_horizontally(width);
@@ -200,6 +216,8 @@ pub fn map(path: &Path, title: &str, unit: &str, positions: &[[f64; 2]], values:
         .map_err(|e| plot_err(path, e))?;
     chart
         .configure_mesh()
+        .disable_x_mesh()
+        .disable_y_mesh()
         .x_desc("R (mm)")
         .y_desc("Z (mm)")
         .draw()
@@ -222,10 +240,14 @@ pub fn map(path: &Path, title: &str, unit: &str, positions: &[[f64; 2]], values:
         .right_y_label_area_size(45)
         .build_cartesian_2d(0.0..1.0, v0..v1)
         .map_err(|e| plot_err(path, e))?;
+    let fmt = |v: &f64| super::sig(*v, 3);
     bar.configure_mesh()
         .disable_x_mesh()
+        .disable_y_mesh()
         .disable_x_axis()
-        .y_desc(unit)
+        .y_labels(8)
+        .y_label_style(("sans-serif", 12))
+        .y_label_formatter(&fmt)
         .draw()
         .map_err(|e| plot_err(path, e))?;
     let n = 64;

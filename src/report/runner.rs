@@ -141,7 +141,9 @@ fn max_speed(snap: &Snapshot) -> f64 {
 fn min_radial_gap(snap: &Snapshot) -> f64 {
     let mut r: Vec<f64> = snap.positions.iter().map(|p| p[0]).collect();
     r.sort_by(f64::total_cmp);
-    r.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min)
+    r.windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Runs `scene` (or reports why it was refused) and measures it.
@@ -184,7 +186,8 @@ pub fn run_case(scene: crate::Result<Scene>, probe: &Probe) -> CaseRun {
         if sim.time() < probe.per_step_until {
             record(&sim, &mut per_step);
         }
-        while next_snap < probe.snapshot_times.len() && sim.time() >= probe.snapshot_times[next_snap]
+        while next_snap < probe.snapshot_times.len()
+            && sim.time() >= probe.snapshot_times[next_snap]
         {
             snapshots.push(sim.snapshot());
             next_snap += 1;

@@ -57,6 +57,7 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
             "Lu_mm",
             "energy_error",
             "smoothing_dissipation_J",
+            "min_spacing_ratio",
         ],
     );
     for ((name, v), r) in cases.iter().zip(&runs) {
@@ -75,6 +76,7 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
             format!("{:.3}", r.get("undeformed_length") * 1e3),
             sig(r.get("energy_error"), 3),
             sig(r.get("smoothing_dissipation"), 4),
+            sig(r.min_spacing, 3),
         ]);
     }
     doc.para(&format!(
@@ -90,7 +92,12 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
     );
     for ((name, v), r) in cases.iter().zip(&runs) {
         for (t_us, u) in tail_history(r) {
-            hist.push(vec![name.to_string(), v.to_string(), sig(t_us, 5), sig(u, 5)]);
+            hist.push(vec![
+                name.to_string(),
+                v.to_string(),
+                sig(t_us, 5),
+                sig(u, 5),
+            ]);
         }
     }
     hist.write_csv(doc.dir)?;
@@ -151,9 +158,26 @@ pub(super) fn table1(plan: &Plan, doc: &mut Doc) -> Result<()> {
     let mut t = Table::new(
         "table1",
         &[
-            "test", "V_mps", "L0_mm", "D0_mm", "Lf_sim", "Lf_exp", "Lf_paper", "Lf_err",
-            "Lu_sim", "Lu_exp", "Lu_paper", "Lu_err", "Df_sim", "Df_exp", "Df_paper",
-            "Df_err", "energy_error", "wall_s", "outcome",
+            "test",
+            "V_mps",
+            "L0_mm",
+            "D0_mm",
+            "Lf_sim",
+            "Lf_exp",
+            "Lf_paper",
+            "Lf_err",
+            "Lu_sim",
+            "Lu_exp",
+            "Lu_paper",
+            "Lu_err",
+            "Df_sim",
+            "Df_exp",
+            "Df_paper",
+            "Df_err",
+            "energy_error",
+            "min_spacing_ratio",
+            "wall_s",
+            "outcome",
         ],
     );
     // Parity points: (experiment, simulated) and (experiment, paper), mm.
@@ -188,6 +212,7 @@ pub(super) fn table1(plan: &Plan, doc: &mut Doc) -> Result<()> {
         }
         cells.extend([
             sig(r.get("energy_error"), 3),
+            sig(r.min_spacing, 3),
             sig(r.wall_s, 3),
             r.outcome.label().to_string(),
         ]);
