@@ -651,6 +651,61 @@ fn every_error_code_is_produced() {
     assert_eq!(seen, all);
 }
 
+/// Each invalid input of the stability matrix (docs/report) is refused
+/// through the C ABI with its named code and a message that names it.
+#[test]
+fn invalid_inputs_are_refused_with_named_codes() {
+    use mi_result::*;
+    for (name, value, code, needle) in [
+        ("density", -7830.0, MI_OUT_OF_RANGE, "`density` = -7830"),
+        (
+            "initial_diameter",
+            0.0,
+            MI_OUT_OF_RANGE,
+            "`initial_diameter` = 0",
+        ),
+        (
+            "impact_speed",
+            f64::NAN,
+            MI_OUT_OF_RANGE,
+            "`impact_speed` = NaN",
+        ),
+        (
+            "impact_speed",
+            f64::INFINITY,
+            MI_OUT_OF_RANGE,
+            "`impact_speed` = inf",
+        ),
+        (
+            "particles_radial",
+            0.0,
+            MI_OUT_OF_RANGE,
+            "`particles_radial` = 0",
+        ),
+        (
+            "impact_sped",
+            200.0,
+            MI_UNKNOWN_PARAMETER,
+            "unknown parameter `impact_sped`",
+        ),
+    ] {
+        let s = new_sim("taylor");
+        assert_eq!(s.set(name, value), code, "{name} = {value}");
+        let msg = s.error();
+        assert!(msg.contains(needle), "{name}: `{msg}`");
+    }
+    // melt_temperature <= room_temperature: each value is in range, the pair
+    // is refused when the simulation is built.
+    let s = new_sim("taylor");
+    assert_eq!(s.set("melt_temperature", 293.0), MI_OK);
+    assert_eq!(s.run(), MI_INCONSISTENT);
+    assert!(
+        s.error().contains("must exceed room_temperature"),
+        "{}",
+        s.error()
+    );
+}
+
 /// A scene from TOML text equals the built-in scene with the same
 /// parameters, and `mi_sim_load_toml` reports a parse error with its message.
 #[test]

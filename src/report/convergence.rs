@@ -177,14 +177,11 @@ pub(super) fn noh(plan: &Plan, doc: &mut Doc) -> Result<(Vec<NohPoint>, f64)> {
     ];
     doc.lines(
         "noh_error_vs_time.svg",
-        Axes {
-            title: "Noh: error against wall time",
-            x: "wall time (s)",
-            y: "relative error",
-            log_x: true,
-            log_y: true,
-            diagonal: false,
-        },
+        Axes::log_log(
+            "Noh: error against wall time",
+            "wall time (s)",
+            "relative error",
+        ),
         &series,
     )?;
     let series: Vec<Series> = series
@@ -196,14 +193,11 @@ pub(super) fn noh(plan: &Plan, doc: &mut Doc) -> Result<(Vec<NohPoint>, f64)> {
         .collect();
     doc.lines(
         "noh_error_vs_particles.svg",
-        Axes {
-            title: "Noh: error against particle count",
-            x: "particles",
-            y: "relative error",
-            log_x: true,
-            log_y: true,
-            diagonal: false,
-        },
+        Axes::log_log(
+            "Noh: error against particle count",
+            "particles",
+            "relative error",
+        ),
         &series,
     )?;
     Ok((points, order_l1))
@@ -336,14 +330,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
             .collect();
         doc.lines(
             file,
-            Axes {
-                title,
-                x: "wall time (s)",
-                y: "relative error",
-                log_x: true,
-                log_y: true,
-                diagonal: false,
-            },
+            Axes::log_log(title, "wall time (s)", "relative error"),
             &series,
         )?;
     }

@@ -54,14 +54,7 @@ pub(super) fn test7(plan: &Plan, doc: &mut Doc, run: CaseRun) -> Result<()> {
     }
     hist.write_csv(doc.dir)?;
     doc.files.push("test7_history.csv".into());
-    let ax = |title, y| Axes {
-        title,
-        x: "time (µs)",
-        y,
-        log_x: false,
-        log_y: false,
-        diagonal: false,
-    };
+    let ax = |title, y| Axes::linear(title, "time (µs)", y);
     doc.lines(
         "test7_tail_velocity.svg",
         ax("Test 7: tail axial velocity", "velocity (m/s)"),

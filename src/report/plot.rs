@@ -57,6 +57,29 @@ pub struct Axes<'a> {
     pub diagonal: bool,
 }
 
+impl<'a> Axes<'a> {
+    /// Linear axes.
+    pub fn linear(title: &'a str, x: &'a str, y: &'a str) -> Self {
+        Axes {
+            title,
+            x,
+            y,
+            log_x: false,
+            log_y: false,
+            diagonal: false,
+        }
+    }
+
+    /// Logarithmic axes.
+    pub fn log_log(title: &'a str, x: &'a str, y: &'a str) -> Self {
+        Axes {
+            log_x: true,
+            log_y: true,
+            ..Axes::linear(title, x, y)
+        }
+    }
+}
+
 fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::io(path, e)
 }

@@ -246,3 +246,16 @@ pub fn run_case(scene: crate::Result<Scene>, probe: &Probe) -> CaseRun {
         non_finite,
     }
 }
+
+/// Runs cases side by side (they share the cores) with the given wall budget.
+pub fn run_parallel(scenes: Vec<crate::Result<Scene>>, wall_budget: f64) -> Vec<CaseRun> {
+    use rayon::prelude::*;
+    let probe = Probe {
+        wall_budget,
+        ..Probe::default()
+    };
+    scenes
+        .into_par_iter()
+        .map(|s| run_case(s, &probe))
+        .collect()
+}

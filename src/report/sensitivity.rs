@@ -3,11 +3,10 @@
 //! and the paper's MSPH values.
 
 use super::plot::{Axes, Series};
-use super::runner::{CaseRun, Probe, run_case, scene};
+use super::runner::{CaseRun, run_parallel, scene};
 use super::{Doc, Plan, Table, pct, sig};
 use crate::Table1Row;
 use crate::error::Result;
-use rayon::prelude::*;
 
 const RATIOS: [f64; 3] = [1.5, 2.0, 2.5];
 const COEFFICIENTS: [f64; 6] = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5];
@@ -27,19 +26,13 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
         .chain(COEFFICIENTS.iter().map(|&v| ("smoothing_coefficient", v)))
         .collect();
     eprintln!("report: {} smoothing cases in parallel", cases.len());
-    let probe = Probe {
-        wall_budget: plan.wall_budget,
-        ..Probe::default()
-    };
-    let runs: Vec<CaseRun> = cases
-        .par_iter()
-        .map(|&(name, v)| {
-            run_case(
-                scene("taylor", &[("particles_radial", n), (name, v)]),
-                &probe,
-            )
-        })
-        .collect();
+    let runs = run_parallel(
+        cases
+            .iter()
+            .map(|&(name, v)| scene("taylor", &[("particles_radial", n), (name, v)]))
+            .collect(),
+        plan.wall_budget,
+    );
     let reference = crate::Scene::builtin("taylor")?.reference;
     let mut t = Table::new(
         "sensitivity_smoothing",
@@ -124,14 +117,7 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
             .collect();
         doc.lines(
             file,
-            Axes {
-                title,
-                x: "time (µs)",
-                y: "tail velocity (m/s)",
-                log_x: false,
-                log_y: false,
-                diagonal: false,
-            },
+            Axes::linear(title, "time (µs)", "tail velocity (m/s)"),
             &series,
         )?;
     }
@@ -143,18 +129,15 @@ pub(super) fn table1(plan: &Plan, doc: &mut Doc) -> Result<()> {
     let n = plan.resolution;
     let rows = Table1Row::all();
     eprintln!("report: Table 1, {} tests in parallel", rows.len());
-    let probe = Probe {
-        wall_budget: plan.wall_budget,
-        ..Probe::default()
-    };
-    let runs: Vec<CaseRun> = rows
-        .par_iter()
-        .map(|r| {
-            let mut s = r.scene();
-            let s = s.set("particles_radial", n).map(|_| s);
-            run_case(s, &probe)
-        })
-        .collect();
+    let runs = run_parallel(
+        rows.iter()
+            .map(|r| {
+                let mut s = r.scene();
+                s.set("particles_radial", n).map(|_| s)
+            })
+            .collect(),
+        plan.wall_budget,
+    );
     let mut t = Table::new(
         "table1",
         &[

@@ -2,11 +2,10 @@
 //! finish with finite fields and a reported energy error, or stop early with
 //! a named error; never a NaN in an output, never a hang, never a crash.
 
-use super::runner::{CaseRun, Outcome, Probe, run_case, scene};
+use super::runner::{CaseRun, Outcome, run_parallel, scene};
 use super::{Doc, Plan, Table, sig};
 use crate::error::Result;
 use crate::scene::taylor::TaylorParams;
-use rayon::prelude::*;
 
 /// One row of the stability matrix.
 #[derive(Debug, Clone)]
@@ -153,14 +152,10 @@ fn setup_text(d: &Def) -> String {
 pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
     let defs = cases(plan);
     eprintln!("report: stability matrix, {} cases in parallel", defs.len());
-    let probe = Probe {
-        wall_budget: plan.wall_budget,
-        ..Probe::default()
-    };
-    let runs: Vec<CaseRun> = defs
-        .par_iter()
-        .map(|d| run_case(scene(d.scene, &d.sets), &probe))
-        .collect();
+    let runs = run_parallel(
+        defs.iter().map(|d| scene(d.scene, &d.sets)).collect(),
+        plan.wall_budget,
+    );
     let mut t = Table::new(
         "stability",
         &[
