@@ -132,6 +132,11 @@ typedef enum {
      */
     MI_CANCELLED = 25,
     /**
+     * The run stopped: two neighbouring particles came closer than the
+     * bound on their spacing (a fraction of the initial spacing).
+     */
+    MI_SPACING_COLLAPSE = 26,
+    /**
      * A panic inside the library was caught at the boundary. The handle is
      * unusable afterwards (every call but `mi_sim_last_error` and
      * `mi_sim_free` returns `MI_PANIC`).

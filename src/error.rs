@@ -104,6 +104,20 @@ pub enum Error {
         /// Simulated time.
         time: f64,
     },
+    /// Two neighbouring particles came closer than a fraction of the initial
+    /// spacing: the particle arrangement collapsed, and the MSPH sums that
+    /// follow would be garbage.
+    #[error(
+        "particle spacing collapsed to {ratio:.3e} of the initial spacing, below the bound {bound} (t = {time:.4e} s)"
+    )]
+    SpacingCollapse {
+        /// Smallest neighbour distance over the initial spacing.
+        ratio: f64,
+        /// Bound on that ratio.
+        bound: f64,
+        /// Simulated time.
+        time: f64,
+    },
     /// The caller cancelled the run from a progress callback.
     #[error("run cancelled by the caller at t = {time:.4e} s")]
     Cancelled {
@@ -124,6 +138,28 @@ pub enum Error {
 }
 
 impl Error {
+    /// The variant's name (for example `"EnergyDrift"`): a stable label for
+    /// tables and tests.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Error::OutOfRange { .. } => "OutOfRange",
+            Error::UnknownParameter { .. } => "UnknownParameter",
+            Error::UnknownScene { .. } => "UnknownScene",
+            Error::ParseValue { .. } => "ParseValue",
+            Error::Inconsistent(_) => "Inconsistent",
+            Error::SceneFile(_) => "SceneFile",
+            Error::SingularMomentMatrix { .. } => "SingularMomentMatrix",
+            Error::NonFinite { .. } => "NonFinite",
+            Error::ThroughBoundary { .. } => "ThroughBoundary",
+            Error::TimeStepCollapse { .. } => "TimeStepCollapse",
+            Error::EnergyDrift { .. } => "EnergyDrift",
+            Error::SpacingCollapse { .. } => "SpacingCollapse",
+            Error::Cancelled { .. } => "Cancelled",
+            Error::InvalidState(_) => "InvalidState",
+            Error::Io { .. } => "Io",
+        }
+    }
+
     /// Builds an [`Error::Io`] from a path and an I/O error.
     pub fn io(path: impl AsRef<std::path::Path>, e: impl std::fmt::Display) -> Self {
         Error::Io {

@@ -30,6 +30,7 @@ pub mod material;
 pub mod msph;
 pub mod neighbors;
 pub mod observe;
+pub mod report;
 pub mod scene;
 mod sim;
 pub mod solver;

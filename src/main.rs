@@ -25,6 +25,17 @@ enum Command {
     Run(RunArgs),
     /// Run a family of scenes in parallel: `table1` is the twelve tests of Table 1.
     Sweep(SweepArgs),
+    /// Regenerate the verification report (error against run time,
+    /// sensitivity, Table 1, figures, stability matrix) as DIR/index.md with
+    /// CSV tables and SVG figures.
+    Report {
+        /// Output directory.
+        #[arg(long, value_name = "DIR", default_value = "report")]
+        out: PathBuf,
+        /// Coarse resolutions and a reduced stability matrix (about a minute).
+        #[arg(long)]
+        quick: bool,
+    },
     /// List the parameters of a scene with units, defaults and allowed ranges.
     Params {
         /// Scene name.
@@ -94,6 +105,7 @@ fn main() {
         }),
         Some(Command::Run(a)) => run(a),
         Some(Command::Sweep(a)) => sweep(a),
+        Some(Command::Report { out, quick }) => report(out, quick),
         Some(Command::Params { scene }) => params(&scene),
         Some(Command::Observables { scene }) => observables(&scene),
         Some(Command::Scene { name }) => Scene::builtin(&name).map(|s| print!("{}", s.to_toml())),
@@ -248,6 +260,20 @@ fn print_summary(sim: &Simulation, wall: f64) {
         };
         println!("{:<24} {:>14} {:>14} {:>9}  {}", s.name, val, r, e, s.unit);
     }
+}
+
+fn report(out: PathBuf, quick: bool) -> Result<(), Error> {
+    let r = meshless_impact::report::generate(&meshless_impact::report::ReportOptions {
+        out: out.clone(),
+        quick,
+    })?;
+    println!(
+        "report written to {} ({} files, {:.1} s)",
+        out.join("index.md").display(),
+        r.files.len(),
+        r.wall_s
+    );
+    Ok(())
 }
 
 fn params(scene: &str) -> Result<(), Error> {

@@ -129,6 +129,15 @@ impl Simulation {
         self.error.as_ref()
     }
 
+    /// Smallest distance between neighbouring particles over the run so far,
+    /// relative to the initial spacing, where the solver tracks it (Taylor).
+    pub fn min_spacing_ratio(&self) -> Option<f64> {
+        match &self.solver {
+            Solver::Taylor(s) => Some(s.min_spacing_ratio()),
+            Solver::Noh(_) => None,
+        }
+    }
+
     /// Names, units and meanings of this scene's observables.
     pub fn observable_specs(&self) -> &'static [ObservableSpec] {
         self.kind().observable_specs()

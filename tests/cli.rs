@@ -24,9 +24,12 @@ fn unknown_parameter_is_a_clear_error_listing_allowed_names() {
 fn out_of_range_value_names_parameter_value_and_range() {
     for (set, needle) in [
         ("density=-5", "`density` = -5"),
+        ("initial_diameter=0", "`initial_diameter` = 0"),
         ("impact_speed=nan", "`impact_speed` = NaN"),
+        ("impact_speed=inf", "`impact_speed` = inf"),
         ("particles_radial=0", "`particles_radial` = 0"),
         ("melt_temperature=200", "melt_temperature"),
+        ("melt_temperature=293", "must exceed room_temperature"),
     ] {
         let out = bin().args(["run", "--set", set]).output().unwrap();
         assert!(!out.status.success(), "{set}");

@@ -58,6 +58,9 @@ pub enum mi_result {
     MI_ENERGY_DRIFT = 24,
     /// The run stopped: the progress callback returned false.
     MI_CANCELLED = 25,
+    /// The run stopped: two neighbouring particles came closer than the
+    /// bound on their spacing (a fraction of the initial spacing).
+    MI_SPACING_COLLAPSE = 26,
     /// A panic inside the library was caught at the boundary. The handle is
     /// unusable afterwards (every call but `mi_sim_last_error` and
     /// `mi_sim_free` returns `MI_PANIC`).
@@ -164,6 +167,11 @@ pub(crate) const RESULTS: &[(mi_result, &str, &str)] = &[
         "cancelled by the progress callback\0",
     ),
     (
+        mi_result::MI_SPACING_COLLAPSE,
+        "MI_SPACING_COLLAPSE\0",
+        "the particle spacing collapsed\0",
+    ),
+    (
         mi_result::MI_PANIC,
         "MI_PANIC\0",
         "a panic inside the library was caught\0",
@@ -202,6 +210,7 @@ pub(crate) fn code_of(e: &Error) -> mi_result {
         Error::ThroughBoundary { .. } => MI_THROUGH_BOUNDARY,
         Error::TimeStepCollapse { .. } => MI_TIME_STEP_COLLAPSE,
         Error::EnergyDrift { .. } => MI_ENERGY_DRIFT,
+        Error::SpacingCollapse { .. } => MI_SPACING_COLLAPSE,
         Error::Cancelled { .. } => MI_CANCELLED,
         Error::InvalidState(_) => MI_INVALID_STATE,
         Error::Io { .. } => MI_IO,
@@ -246,6 +255,6 @@ mod tests {
             assert!(name.ends_with('\0') && desc.ends_with('\0'));
             assert_eq!(format!("{code:?}\0"), *name);
         }
-        assert_eq!(RESULTS.len(), 22);
+        assert_eq!(RESULTS.len(), 23);
     }
 }

@@ -1,0 +1,172 @@
+//! `meshless-impact report --quick`: the report regenerates, every file it
+//! links exists, the Noh error falls with resolution at a positive observed
+//! order, the elastic impact rebounds as theory says, and every case of the
+//! stability matrix ends the way it is expected to (finished with finite
+//! outputs, or stopped or refused with a named error).
+
+use meshless_impact::report::observed_order;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+
+type Rows = Vec<BTreeMap<String, String>>;
+
+fn read_csv(path: &Path) -> Rows {
+    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header = r.headers().unwrap().clone();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            header
+                .iter()
+                .zip(rec.iter())
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(row: &BTreeMap<String, String>, key: &str) -> f64 {
+    row[key]
+        .parse()
+        .unwrap_or_else(|_| panic!("{key} = `{}` is not a number", row[key]))
+}
+
+/// Expected outcome of each stability case in quick mode (6 particles across
+/// the radius unless the case sets it).
+const EXPECTED: &[(&str, &str)] = &[
+    ("elastic_10mps", "finished"),
+    // Finish, but with the impact-face row and the row above it collapsed
+    // onto each other (min_spacing_ratio 0): the solver's spacing guard
+    // (Error::SpacingCollapse, bound 0.1) is to stop these; when it lands
+    // these two become "SpacingCollapse".
+    ("speed_400", "finished"),
+    ("speed_600", "finished"),
+    ("speed_800", "EnergyDrift"),
+    ("bulk_x10", "finished"),
+    ("bulk_x100", "finished"),
+    ("soft_plastic", "EnergyDrift"),
+    ("near_melt", "EnergyDrift"),
+    ("coarse_3", "finished"),
+    ("coarse_4", "finished"),
+    ("fine", "finished"),
+    ("aspect_0.5", "finished"),
+    ("aspect_20", "finished"),
+    ("smoothing_ratio_1.0", "SingularMomentMatrix"),
+    ("smoothing_ratio_3.0", "finished"),
+    ("smoothing_coefficient_0", "EnergyDrift"),
+    ("noh_50", "finished"),
+    ("noh_fine", "finished"),
+    ("noh_small_column", "SingularMomentMatrix"),
+    ("invalid_density", "OutOfRange"),
+    ("invalid_diameter", "OutOfRange"),
+    ("invalid_speed_nan", "OutOfRange"),
+    ("invalid_speed_inf", "OutOfRange"),
+    ("invalid_melt", "Inconsistent"),
+    ("invalid_particles", "OutOfRange"),
+    ("invalid_name", "UnknownParameter"),
+];
+
+#[test]
+fn quick_report_regenerates_and_meets_its_claims() {
+    let dir = std::env::temp_dir().join(format!("mi-report-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
+        .args(["report", "--quick", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    // Every linked table and figure exists; figures are SVG.
+    let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
+    assert!(index.contains("report --out") && index.contains("--quick"));
+    let mut links = 0;
+    for part in index.split("](").skip(1) {
+        let file = &part[..part.find(')').unwrap()];
+        let text =
+            std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        if file.ends_with(".svg") {
+            assert!(text.starts_with("<svg"), "{file}");
+        }
+        links += 1;
+    }
+    assert!(links >= 20, "{links} links");
+
+    // Noh: the L1 density error and the shock-position error fall as the
+    // resolution rises, at a positive observed order.
+    let noh = read_csv(&dir.join("noh_convergence.csv"));
+    assert_eq!(noh.len(), 3);
+    let n: Vec<f64> = noh.iter().map(|r| num(r, "particles")).collect();
+    let l1: Vec<f64> = noh.iter().map(|r| num(r, "density_l1")).collect();
+    let shock: Vec<f64> = noh.iter().map(|r| num(r, "shock_error")).collect();
+    for k in 1..l1.len() {
+        assert!(l1[k] < l1[k - 1], "density L1 error {l1:?}");
+        assert!(shock[k] < shock[k - 1], "shock error {shock:?}");
+    }
+    let order = observed_order(&n, &l1);
+    assert!(order > 0.5, "observed order {order}");
+    assert!(observed_order(&n, &shock) > 0.0);
+
+    // Taylor test 7: the final length moves toward the finest run.
+    let taylor = read_csv(&dir.join("taylor_convergence.csv"));
+    let lf: Vec<f64> = taylor.iter().map(|r| num(r, "Lf_mm")).collect();
+    let finest = *lf.last().unwrap();
+    assert!((lf[0] - finest).abs() > (lf[1] - finest).abs(), "{lf:?}");
+    assert!(taylor.iter().all(|r| r["outcome"] == "finished"));
+
+    // The stability matrix: each case ends as expected, and no output of any
+    // case holds a NaN or an infinity, except the one known solver issue.
+    let cases = read_csv(&dir.join("stability.csv"));
+    let got: Vec<(&str, &str)> = cases
+        .iter()
+        .map(|r| (r["case"].as_str(), r["outcome"].as_str()))
+        .collect();
+    assert_eq!(got, EXPECTED);
+    for r in &cases {
+        let name = r["case"].as_str();
+        if name == "noh_small_column" {
+            // KNOWN SOLVER ISSUE (reported): with the gas column inside
+            // r <= 0.05 the Noh observables averaged over empty windows are
+            // NaN (src/solver/radial.rs, `mean_over`). When it is fixed this
+            // case must report "none" like every other.
+            assert!(r["non_finite_outputs"].contains("post_shock_density"));
+            continue;
+        }
+        assert_eq!(r["non_finite_outputs"], "none", "{name}");
+        if name.starts_with("invalid") {
+            assert_eq!(r["steps"], "0", "{name}: refused before running");
+            assert!(!r["message"].is_empty(), "{name}");
+            continue;
+        }
+        let e = num(r, "energy_error");
+        assert!(e.is_finite() && e >= 0.0, "{name}: energy_error {e}");
+        assert!(num(r, "max_speed_mps").is_finite(), "{name}");
+        if r["outcome"] == "finished" {
+            assert!(e < 0.5, "{name}: energy_error {e}");
+        } else {
+            assert!(!r["message"].is_empty(), "{name}");
+        }
+    }
+
+    // Elastic impact at 10 m/s: no plastic strain, the rod rebounds with its
+    // initial length, and contact lasts two transits of the bar wave.
+    let elastic: BTreeMap<String, f64> = read_csv(&dir.join("elastic_impact.csv"))
+        .iter()
+        .map(|r| (r["quantity"].clone(), num(r, "value")))
+        .collect();
+    assert_eq!(elastic["max_plastic_strain"], 0.0);
+    assert!(elastic["length_change"].abs() < 0.1, "{elastic:?}");
+    let (t, t_bar) = (elastic["contact_duration"], elastic["two_L0_over_c_bar"]);
+    assert!(
+        (t - t_bar).abs() < 0.05 * t_bar,
+        "contact {t} µs vs 2 L0/c_bar {t_bar} µs"
+    );
+    assert!(elastic["final_tail_velocity"] < -9.0, "{elastic:?}");
+    assert!(elastic["energy_error"] < 0.05, "{elastic:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
