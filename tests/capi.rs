@@ -605,6 +605,11 @@ fn every_error_code_is_produced() {
             &[("particles_radial", 5.0), ("impact_speed", 2000.0)],
         );
         check(r, MI_ENERGY_DRIFT, &m, "energy error");
+        let (r, m) = run_code(
+            "taylor",
+            &[("particles_radial", 6.0), ("impact_speed", 400.0)],
+        );
+        check(r, MI_SPACING_COLLAPSE, &m, "spacing");
         let noh = [
             ("particles_radial", 50.0),
             ("viscosity_quadratic", 0.0),
@@ -636,12 +641,8 @@ fn every_error_code_is_produced() {
         check(s.run(), MI_PANIC, &s.error(), "unusable");
         check(s.set("jc_a", 1e9), MI_PANIC, &s.error(), "unusable");
     }
-    // Every code but MI_OK was produced. MI_SPACING_COLLAPSE is mapped from
-    // `Error::SpacingCollapse` (`code_of` covers every variant), but no
-    // solver raises that error yet: its guard lands with the solver's
-    // spacing check, which must then add its case here.
+    // Every code but MI_OK was produced.
     let all: std::collections::BTreeSet<i32> = (1..=30)
-        .filter(|&k| k != MI_SPACING_COLLAPSE as i32)
         .filter(|k| {
             // SAFETY: static string.
             let n = unsafe { CStr::from_ptr(mi_result_name(*k)) };

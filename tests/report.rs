@@ -36,13 +36,11 @@ fn num(row: &BTreeMap<String, String>, key: &str) -> f64 {
 /// the radius unless the case sets it).
 const EXPECTED: &[(&str, &str)] = &[
     ("elastic_10mps", "finished"),
-    // Finish, but with the impact-face row and the row above it collapsed
-    // onto each other (min_spacing_ratio 0): the solver's spacing guard
-    // (Error::SpacingCollapse, bound 0.1) is to stop these; when it lands
-    // these two become "SpacingCollapse".
-    ("speed_400", "finished"),
-    ("speed_600", "finished"),
-    ("speed_800", "EnergyDrift"),
+    // The impact-face row and the row above it close onto each other: the
+    // spacing guard (bound 0.1 of the initial spacing) stops the run.
+    ("speed_400", "SpacingCollapse"),
+    ("speed_600", "SpacingCollapse"),
+    ("speed_800", "SpacingCollapse"),
     ("bulk_x10", "finished"),
     ("bulk_x100", "finished"),
     ("soft_plastic", "EnergyDrift"),
@@ -57,7 +55,7 @@ const EXPECTED: &[(&str, &str)] = &[
     ("smoothing_coefficient_0", "EnergyDrift"),
     ("noh_50", "finished"),
     ("noh_fine", "finished"),
-    ("noh_small_column", "SingularMomentMatrix"),
+    ("noh_small_column", "Inconsistent"),
     ("invalid_density", "OutOfRange"),
     ("invalid_diameter", "OutOfRange"),
     ("invalid_speed_nan", "OutOfRange"),
@@ -120,7 +118,7 @@ fn quick_report_regenerates_and_meets_its_claims() {
     assert!(taylor.iter().all(|r| r["outcome"] == "finished"));
 
     // The stability matrix: each case ends as expected, and no output of any
-    // case holds a NaN or an infinity, except the one known solver issue.
+    // case holds a NaN or an infinity.
     let cases = read_csv(&dir.join("stability.csv"));
     let got: Vec<(&str, &str)> = cases
         .iter()
@@ -129,16 +127,9 @@ fn quick_report_regenerates_and_meets_its_claims() {
     assert_eq!(got, EXPECTED);
     for r in &cases {
         let name = r["case"].as_str();
-        if name == "noh_small_column" {
-            // KNOWN SOLVER ISSUE (reported): with the gas column inside
-            // r <= 0.05 the Noh observables averaged over empty windows are
-            // NaN (src/solver/radial.rs, `mean_over`). When it is fixed this
-            // case must report "none" like every other.
-            assert!(r["non_finite_outputs"].contains("post_shock_density"));
-            continue;
-        }
         assert_eq!(r["non_finite_outputs"], "none", "{name}");
-        if name.starts_with("invalid") {
+        let refused = ["OutOfRange", "Inconsistent", "UnknownParameter"];
+        if refused.contains(&r["outcome"].as_str()) {
             assert_eq!(r["steps"], "0", "{name}: refused before running");
             assert!(!r["message"].is_empty(), "{name}");
             continue;

@@ -4,6 +4,12 @@
 
 use super::params::{Range, param_table};
 
+/// Window `(r_min, r_max)` of `post_shock_density`.
+pub const POST_SHOCK_WINDOW: (f64, f64) = (0.1, 0.18);
+
+/// Window `(r_min, r_max)` of `pre_shock_density_l1`.
+pub const PRE_SHOCK_WINDOW: (f64, f64) = (0.25, 0.9);
+
 param_table! {
     /// Parameters of the cylindrical Noh scene (dimensionless units of the
     /// problem: initial density 1, inflow speed 1).
@@ -28,8 +34,19 @@ param_table! {
 }
 
 impl NohParams {
-    /// Cross-parameter checks (none beyond the ranges today).
+    /// Cross-parameter checks: the gas streams inward at unit speed, so the
+    /// column must start at least `0.9 + end_time` wide for the windows of
+    /// the observables (`pre_shock_density_l1` over 0.25 <= r <= 0.9,
+    /// `post_shock_density` over 0.1 <= r <= 0.18) to hold gas to the end.
     pub fn check_consistency(&self) -> crate::Result<()> {
+        let need = PRE_SHOCK_WINDOW.1 + self.end_time;
+        if self.outer_radius < need {
+            return Err(crate::Error::Inconsistent(format!(
+                "outer_radius = {} must be at least 0.9 + end_time = {need} so that gas \
+                 fills the observation windows (0.1 <= r <= 0.9) until the end",
+                self.outer_radius
+            )));
+        }
         Ok(())
     }
 }

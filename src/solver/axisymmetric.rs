@@ -38,6 +38,12 @@ use rayon::prelude::*;
 /// Radial strain below which the rod counts as undeformed (0.2 %).
 pub const UNDEFORMED_STRAIN: f64 = 0.002;
 
+/// Smallest distance between two neighbouring particles, relative to the
+/// initial spacing, below which a run stops with [`Error::SpacingCollapse`]:
+/// particles that close no longer resolve the material between them (the
+/// validation runs stay above 0.4).
+pub const SPACING_COLLAPSE_BOUND: f64 = 0.1;
+
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
 pub const ENERGY_ERROR_BOUND: f64 = 0.5;
 
@@ -517,6 +523,13 @@ impl TaylorSolver {
         let min_d2 = part.iter().map(|p| p.min_d2).fold(f64::INFINITY, f64::min);
         let d0 = self.r0 / (self.nr - 1) as f64;
         self.min_spacing = self.min_spacing.min(min_d2.sqrt() / d0);
+        if self.min_spacing < SPACING_COLLAPSE_BOUND {
+            return Err(Error::SpacingCollapse {
+                ratio: self.min_spacing,
+                bound: SPACING_COLLAPSE_BOUND,
+                time: self.time,
+            });
+        }
         self.contact_dissipation += self.hold_on_anvil(&mut vel[..n]);
 
         // 3. Conservative smoothing of the velocity.

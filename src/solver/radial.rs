@@ -43,7 +43,7 @@ use crate::material::ideal_gas::IdealGas;
 use crate::msph::{Msph1Rows, Row1};
 use crate::neighbors::{NeighborList, cell_list};
 use crate::observe::{Field, NOH_OBSERVABLES, Snapshot};
-use crate::scene::noh::NohParams;
+use crate::scene::noh::{NohParams, POST_SHOCK_WINDOW, PRE_SHOCK_WINDOW};
 use rayon::prelude::*;
 
 /// Inner and outer radius of each shell: the midpoints to its neighbours,
@@ -379,10 +379,21 @@ impl NohSolver {
                     c += 1;
                 }
             }
-            if c == 0 { f64::NAN } else { s / c as f64 }
+            if c > 0 {
+                return s / c as f64;
+            }
+            // No particle in the window (a very coarse run): the value of the
+            // particle nearest to its centre.
+            let mid = 0.5 * (lo + hi.min(self.r[n - 1]));
+            let nearest = (0..n)
+                .min_by(|&a, &b| (self.r[a] - mid).abs().total_cmp(&(self.r[b] - mid).abs()))
+                .unwrap_or(0);
+            f(nearest)
         };
-        let post = mean_over(0.1, 0.18, &|i| self.rho[i]);
-        let pre = mean_over(0.25, 0.9, &|i| {
+        let (post_lo, post_hi) = POST_SHOCK_WINDOW;
+        let (pre_lo, pre_hi) = PRE_SHOCK_WINDOW;
+        let post = mean_over(post_lo, post_hi, &|i| self.rho[i]);
+        let pre = mean_over(pre_lo, pre_hi, &|i| {
             let ex = 1.0 + t / self.r[i];
             (self.rho[i] - ex).abs() / ex
         });
