@@ -12,8 +12,7 @@
 //! A particle (a ring in the axisymmetric case) weighs `V_j = m_j / rho_j`.
 
 use crate::kernel::{EXP_M4, SUPPORT};
-use nalgebra::{Matrix3, Matrix6, SVector};
-use wide::f64x4;
+use wide::{f64x2, f64x4};
 
 /// Largest 1-norm condition number of a scaled moment matrix that is accepted.
 /// Beyond it the particle arrangement cannot support a second-order
@@ -129,9 +128,9 @@ impl Moments2 {
         which: [Row2; K],
     ) -> Result<Msph2Rows<K>, Degenerate> {
         let inv_h = 1.0 / h;
-        let b = Matrix6::from_fn(|a, c| self.b[c][a]);
+        let b: [[f64; 6]; 6] = std::array::from_fn(|a| std::array::from_fn(|c| self.b[c][a]));
         let inv = invert_checked(i, b)?;
-        let rows = which.map(|r| inv.row(r as usize).transpose());
+        let rows = which.map(|r| inv[r as usize]);
         let scale = which.map(|r| inv_h.powi(r.order()));
         Ok(Msph2Rows {
             rows,
@@ -188,23 +187,23 @@ pub struct Neighbourhood {
 }
 
 impl Neighbourhood {
-    /// An empty neighbourhood with room for `n` neighbours.
+    /// An empty neighbourhood with room for `n` neighbours (it grows when
+    /// needed).
     pub fn with_capacity(n: usize) -> Self {
-        let cap = n.next_multiple_of(4);
-        Neighbourhood {
-            sr: Vec::with_capacity(cap),
-            sz: Vec::with_capacity(cap),
-            v: Vec::with_capacity(cap),
-            e: Vec::with_capacity(cap),
-            len: 0,
+        let mut hood = Neighbourhood::default();
+        hood.reserve(n);
+        hood
+    }
+
+    fn reserve(&mut self, n: usize) {
+        let cap = n.next_multiple_of(4).max(4);
+        for x in [&mut self.sr, &mut self.sz, &mut self.v, &mut self.e] {
+            x.resize(cap, 0.0);
         }
     }
 
     /// Forgets every neighbour.
     pub fn clear(&mut self) {
-        self.sr.clear();
-        self.sz.clear();
-        self.v.clear();
         self.len = 0;
     }
 
@@ -219,22 +218,32 @@ impl Neighbourhood {
     }
 
     /// Adds a neighbour at scaled offset `(sr, sz) = (x_j - x_i) / h`, which
-    /// must lie in the support, with weight `v = m_j / rho_j`.
+    /// must lie in the support, with weight `v = m_j / rho_j`, and evaluates
+    /// its Gaussian `exp(-|s|^2)`.
     #[inline]
     pub fn push(&mut self, sr: f64, sz: f64, v: f64) {
-        self.sr.push(sr);
-        self.sz.push(sz);
-        self.v.push(v);
-        self.len += 1;
+        let k = self.len;
+        if k + 4 > self.sr.len() {
+            self.reserve(2 * self.sr.len() + 4);
+        }
+        self.sr[k] = sr;
+        self.sz[k] = sz;
+        self.v[k] = v;
+        self.e[k] = (-(sr * sr + sz * sz)).exp();
+        self.len = k + 1;
     }
 
-    /// Pads to whole lanes with neighbours of zero weight, which add nothing.
-    fn pad(&mut self) {
+    /// Number of neighbours rounded up to whole lanes of four, the lanes
+    /// past the last neighbour holding zero weight, which adds nothing.
+    fn padded(&mut self) -> usize {
         let padded = self.len.next_multiple_of(4);
-        self.sr.resize(padded, 0.0);
-        self.sz.resize(padded, 0.0);
-        self.v.resize(padded, 0.0);
-        self.e.resize(padded, 0.0);
+        for k in self.len..padded {
+            self.sr[k] = 0.0;
+            self.sz[k] = 0.0;
+            self.v[k] = 0.0;
+            self.e[k] = 0.0;
+        }
+        padded
     }
 
     #[inline]
@@ -242,23 +251,19 @@ impl Neighbourhood {
         f64x4::new([x[c], x[c + 1], x[c + 2], x[c + 3]])
     }
 
-    /// Assembles the moment matrix, evaluating the Gaussian of each pair once
-    /// (kept for [`Neighbourhood::weights`]). The sums run in a fixed order.
+    /// Assembles the moment matrix from the power sums. The sums run in a
+    /// fixed order (two interleaved partial sums, then their total), so the
+    /// result does not depend on the thread that computes it.
     pub fn moments(&mut self) -> Moments2 {
-        self.pad();
-        let mut acc = [f64x4::ZERO; 21];
-        for c in (0..self.sr.len()).step_by(4) {
-            let (sr, sz, v) = (
-                Self::lanes(&self.sr, c),
-                Self::lanes(&self.sz, c),
-                Self::lanes(&self.v, c),
-            );
+        let padded = self.padded();
+        let mut acc = [f64x2::ZERO; 21];
+        for c in (0..padded).step_by(2) {
+            let pair = |x: &[f64]| f64x2::new([x[c], x[c + 1]]);
+            let (sr, sz, v) = (pair(&self.sr), pair(&self.sz), pair(&self.v));
+            let ev = pair(&self.e) * v;
             let (r2, rz, z2) = (sr * sr, sr * sz, sz * sz);
-            let e = (-(r2 + z2)).exp();
-            self.e[c..c + 4].copy_from_slice(&e.to_array());
-            let ev = e * v;
             let mons = [
-                f64x4::ONE,
+                f64x2::ONE,
                 sr,
                 sz,
                 r2,
@@ -283,7 +288,7 @@ impl Neighbourhood {
         }
         let sums = acc.map(|a| {
             let l = a.to_array();
-            (l[0] + l[1]) + (l[2] + l[3])
+            l[0] + l[1]
         });
         let (m, n) = sums.split_at(15);
         let mut b = [[0.0; 6]; 6];
@@ -316,7 +321,7 @@ impl Neighbourhood {
             std::array::from_fn(|k| std::array::from_fn(|a| f64x4::splat(rows.rows[k][a])));
         let scale: [f64x4; K] = rows.scale.map(f64x4::splat);
         let (two, four, e4) = (f64x4::splat(2.0), f64x4::splat(4.0), f64x4::splat(EXP_M4));
-        for c in (0..self.sr.len()).step_by(4) {
+        for c in (0..self.len.next_multiple_of(4)).step_by(4) {
             let (sr, sz, v, e) = (
                 Self::lanes(&self.sr, c),
                 Self::lanes(&self.sz, c),
@@ -347,7 +352,7 @@ impl Neighbourhood {
 /// `i`, ready to form shape functions with [`Msph2Rows::weight`].
 #[derive(Debug, Clone, Copy)]
 pub struct Msph2Rows<const K: usize> {
-    rows: [SVector<f64, 6>; K],
+    rows: [[f64; 6]; K],
     scale: [f64; K],
     xi: [f64; 2],
     inv_h: f64,
@@ -426,22 +431,58 @@ impl<const K: usize> Msph2Rows<K> {
     }
 }
 
-fn invert_checked<const N: usize>(
-    i: usize,
-    b: nalgebra::SMatrix<f64, N, N>,
-) -> Result<nalgebra::SMatrix<f64, N, N>, Degenerate>
-where
-    nalgebra::Const<N>: nalgebra::DimMin<nalgebra::Const<N>, Output = nalgebra::Const<N>>,
-{
-    let inv = b.try_inverse().ok_or(Degenerate {
+/// Inverse of `a` (row-major) by Gauss-Jordan elimination with partial
+/// pivoting, or `None` when a pivot vanishes.
+pub fn invert<const N: usize>(a: [[f64; N]; N]) -> Option<[[f64; N]; N]> {
+    let mut a = a;
+    let mut inv: [[f64; N]; N] =
+        std::array::from_fn(|r| std::array::from_fn(|c| if r == c { 1.0 } else { 0.0 }));
+    for col in 0..N {
+        let mut p = col;
+        for r in col + 1..N {
+            if a[r][col].abs() > a[p][col].abs() {
+                p = r;
+            }
+        }
+        let pivot = a[p][col];
+        if pivot == 0.0 || !pivot.is_finite() {
+            return None;
+        }
+        a.swap(col, p);
+        inv.swap(col, p);
+        let d = 1.0 / pivot;
+        for c in 0..N {
+            a[col][c] *= d;
+            inv[col][c] *= d;
+        }
+        for r in 0..N {
+            let f = a[r][col];
+            if r != col && f != 0.0 {
+                for c in 0..N {
+                    a[r][c] -= f * a[col][c];
+                    inv[r][c] -= f * inv[col][c];
+                }
+            }
+        }
+    }
+    Some(inv)
+}
+
+/// Largest absolute column sum.
+fn norm1<const N: usize>(m: &[[f64; N]; N]) -> f64 {
+    (0..N)
+        .map(|c| m.iter().map(|row| row[c].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// The inverse of the moment matrix `b` of particle `i`, or [`Degenerate`]
+/// when it is singular or its 1-norm condition number passes
+/// [`MAX_CONDITION`].
+fn invert_checked<const N: usize>(i: usize, b: [[f64; N]; N]) -> Result<[[f64; N]; N], Degenerate> {
+    let inv = invert(b).ok_or(Degenerate {
         particle: i,
         condition: f64::INFINITY,
     })?;
-    let norm1 = |m: &nalgebra::SMatrix<f64, N, N>| {
-        (0..N)
-            .map(|c| m.column(c).iter().map(|x| x.abs()).sum::<f64>())
-            .fold(0.0, f64::max)
-    };
     let cond = norm1(&b) * norm1(&inv);
     if !cond.is_finite() || cond > MAX_CONDITION {
         return Err(Degenerate {
@@ -477,7 +518,7 @@ fn phi1(s: f64) -> Option<[f64; 3]> {
 /// Selected rows of the inverse of the scaled 1-D (radial) moment matrix.
 #[derive(Debug, Clone, Copy)]
 pub struct Msph1Rows<const K: usize> {
-    rows: [nalgebra::Vector3<f64>; K],
+    rows: [[f64; 3]; K],
     scale: [f64; K],
     xi: f64,
     inv_h: f64,
@@ -495,19 +536,19 @@ impl<const K: usize> Msph1Rows<K> {
     ) -> Result<Self, Degenerate> {
         let xi = pos[i];
         let inv_h = 1.0 / h;
-        let mut b = Matrix3::<f64>::zeros();
+        let mut b = [[0.0; 3]; 3];
         for &j in neighbors {
             let s = (pos[j] - xi) * inv_h;
             let Some(phi) = phi1(s) else { continue };
             let th = [1.0, s, 0.5 * s * s];
             for a in 0..3 {
                 for c in 0..3 {
-                    b[(a, c)] += phi[a] * vol[j] * th[c];
+                    b[a][c] += phi[a] * vol[j] * th[c];
                 }
             }
         }
         let inv = invert_checked(i, b)?;
-        let rows = which.map(|r| inv.row(r as usize).transpose());
+        let rows = which.map(|r| inv[r as usize]);
         let scale = which.map(|r| inv_h.powi(r as i32));
         Ok(Self {
             rows,
@@ -694,6 +735,42 @@ mod tests {
             assert!((e[1] - (-3.0 + 10.0 * x)).abs() < 1e-6);
             assert!((e[2] - 10.0).abs() < 1e-4, "{}", e[2]);
         }
+    }
+
+    #[test]
+    fn gauss_jordan_inverse_equals_nalgebra() {
+        let mut s = 99u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for _ in 0..200 {
+            let a: [[f64; 6]; 6] = std::array::from_fn(|_| std::array::from_fn(|_| next()));
+            let ours = invert(a).unwrap();
+            let m = nalgebra::Matrix6::from_fn(|r, c| a[r][c]);
+            let theirs = m.try_inverse().unwrap();
+            let scale = theirs.abs().max();
+            for r in 0..6 {
+                for c in 0..6 {
+                    assert!((ours[r][c] - theirs[(r, c)]).abs() < 1e-10 * scale);
+                }
+            }
+        }
+        let a3 = [[2.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 4.0]];
+        let inv3 = invert(a3).unwrap();
+        let theirs = nalgebra::Matrix3::from_fn(|r, c| a3[r][c])
+            .try_inverse()
+            .unwrap();
+        for r in 0..3 {
+            for c in 0..3 {
+                assert!((inv3[r][c] - theirs[(r, c)]).abs() < 1e-14);
+            }
+        }
+        // A repeated row: singular.
+        let sing = [[1.0, 2.0, 3.0], [1.0, 2.0, 3.0], [0.0, 1.0, 5.0]];
+        assert!(invert(sing).is_none());
     }
 
     #[test]

@@ -24,7 +24,7 @@
 //!    the free surfaces, next time step.
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
-use super::{COURANT, check_time_step, smoothed};
+use super::{COURANT, check_time_step, pair_sum, smoothed};
 use crate::error::{Error, Result};
 use crate::kernel::SUPPORT;
 use crate::material::eos::LinearEos;
@@ -386,7 +386,10 @@ impl TaylorSolver {
     /// Advances one step.
     pub fn step(&mut self) -> Result<()> {
         let mut ws = std::mem::take(&mut self.ws);
-        let result = self.step_in(&mut ws);
+        // The whole step runs on one worker of the thread pool, so its
+        // parallel passes are shared with the other workers without handing
+        // each one over from the calling thread.
+        let result = rayon::scope(|_| self.step_in(&mut ws));
         self.ws = ws;
         result
     }
@@ -488,18 +491,21 @@ impl TaylorSolver {
                     hood.weights(&m, [&mut *wr_i, &mut *wz_i], wk_i);
                     // Shepard weights W_ij V_j / sum_j W_ij V_j (the kernel's
                     // normalisation cancels).
-                    let wsum: f64 = wk_i[..len].iter().sum();
+                    let [wsum] = pair_sum(len, |k| [wk_i[k]]);
+                    for w in &mut wk_i[..len] {
+                        *w /= wsum;
+                    }
                     let si = sbc[i];
-                    let (mut drr_r, mut drz_z, mut drz_r, mut dzz_z) = (0.0, 0.0, 0.0, 0.0);
-                    for k in 0..len {
-                        wk_i[k] /= wsum;
+                    let [drr_r, drz_r, drz_z, dzz_z] = pair_sum(len, |k| {
                         let sj = sbc[act_i[k] as usize];
                         let (gr, gz) = (wr_i[k], wz_i[k]);
-                        drr_r += gr * (sj[0] - si[0]);
-                        drz_r += gr * (sj[3] - si[3]);
-                        drz_z += gz * (sj[3] - si[3]);
-                        dzz_z += gz * (sj[1] - si[1]);
-                    }
+                        [
+                            gr * (sj[0] - si[0]),
+                            gr * (sj[3] - si[3]),
+                            gz * (sj[3] - si[3]),
+                            gz * (sj[1] - si[1]),
+                        ]
+                    });
                     let v = self.vel[i];
                     let rho = self.rho[i];
                     *v_out = if axis(i) {
@@ -568,15 +574,13 @@ impl TaylorSolver {
             .for_each(|(i, (gr, rho_out))| {
                 let vi = vel[i];
                 let r = row(i);
-                let mut g4 = [0.0; 4]; // dvr/dR, dvr/dZ, dvz/dR, dvz/dZ
-                for ((&j, &gr), &gz) in act[r.clone()].iter().zip(&wr[r.clone()]).zip(&wz[r]) {
-                    let vj = vel[j as usize];
+                let (act, wr, wz) = (&act[r.clone()], &wr[r.clone()], &wz[r]);
+                // dvr/dR, dvr/dZ, dvz/dR, dvz/dZ
+                let g4 = pair_sum(act.len(), |k| {
+                    let vj = vel[act[k] as usize];
                     let dv = [vj[0] - vi[0], vj[1] - vi[1]];
-                    g4[0] += gr * dv[0];
-                    g4[1] += gz * dv[0];
-                    g4[2] += gr * dv[1];
-                    g4[3] += gz * dv[1];
-                }
+                    [wr[k] * dv[0], wz[k] * dv[0], wr[k] * dv[1], wz[k] * dv[1]]
+                });
                 *gr = g4;
                 let hoop = if axis(i) { g4[0] } else { vi[0] / pos[i][0] };
                 let div = g4[0] + g4[3] + hoop;

@@ -27,6 +27,37 @@ pub(crate) fn rows_mut<'a, T>(mut buf: &'a mut [T], offsets: &[usize]) -> Vec<&'
     rows
 }
 
+/// `sum_k term(k)` over `k < n`, component by component, in two interleaved
+/// partial sums (even and odd `k`) added at the end: a fixed order, so the
+/// result does not depend on the thread, and two independent chains of
+/// additions instead of one long one.
+#[inline(always)]
+pub(crate) fn pair_sum<const K: usize>(
+    n: usize,
+    mut term: impl FnMut(usize) -> [f64; K],
+) -> [f64; K] {
+    let (mut even, mut odd) = ([0.0; K], [0.0; K]);
+    let mut k = 0;
+    while k + 1 < n {
+        let (x, y) = (term(k), term(k + 1));
+        for c in 0..K {
+            even[c] += x[c];
+            odd[c] += y[c];
+        }
+        k += 2;
+    }
+    if k < n {
+        let x = term(k);
+        for c in 0..K {
+            even[c] += x[c];
+        }
+    }
+    for c in 0..K {
+        even[c] += odd[c];
+    }
+    even
+}
+
 /// Conservative smoothing, eq. (3.23), of particle `i`'s value:
 /// `f_i + alpha (sum_j s_ij f_j - f_i)`, where `s_ij` are the Shepard weights
 /// `W_ij V_j / sum_j W_ij V_j` of its neighbours `nbrs` (indices into `f`,
@@ -44,12 +75,11 @@ pub(crate) fn smoothed<const K: usize>(
     if alpha == 0.0 {
         return out;
     }
-    let mut mean = [0.0; K];
-    for (&j, &s) in nbrs.iter().zip(shepard) {
-        for k in 0..K {
-            mean[k] += s * f[j as usize][k];
-        }
-    }
+    let n = nbrs.len().min(shepard.len());
+    let mean = pair_sum(n, |k| {
+        let fj = f[nbrs[k] as usize];
+        fj.map(|x| shepard[k] * x)
+    });
     for k in 0..K {
         out[k] += alpha * (mean[k] - out[k]);
     }
