@@ -607,7 +607,7 @@ fn every_error_code_is_produced() {
         check(r, MI_ENERGY_DRIFT, &m, "energy error");
         let (r, m) = run_code(
             "taylor",
-            &[("particles_radial", 6.0), ("impact_speed", 400.0)],
+            &[("particles_radial", 6.0), ("impact_speed", 600.0)],
         );
         check(r, MI_SPACING_COLLAPSE, &m, "spacing");
         let noh = [

@@ -36,11 +36,14 @@ fn num(row: &BTreeMap<String, String>, key: &str) -> f64 {
 /// the radius unless the case sets it).
 const EXPECTED: &[(&str, &str)] = &[
     ("elastic_10mps", "finished"),
-    // The impact-face row and the row above it close onto each other: the
-    // spacing guard (bound 0.1 of the initial spacing) stops the run.
-    ("speed_400", "SpacingCollapse"),
+    // At 400 m/s the row above the impact face reaches the face row (the
+    // stagnation zone, left out of the spacing guard; min_spacing_ratio 0)
+    // and the run ends with an energy error near 0.24. At 600 m/s rows off
+    // the face collapse as well: the spacing guard stops the run. At 800 m/s
+    // the energy balance fails first.
+    ("speed_400", "finished"),
     ("speed_600", "SpacingCollapse"),
-    ("speed_800", "SpacingCollapse"),
+    ("speed_800", "EnergyDrift"),
     ("bulk_x10", "finished"),
     ("bulk_x100", "finished"),
     ("soft_plastic", "EnergyDrift"),
