@@ -37,21 +37,25 @@ fn test7_points() -> Vec<[f64; 2]> {
 
 fn kernel(c: &mut Criterion) {
     let s = lattice_neighbourhood();
-    c.bench_function("kernel2 x neighbourhood (29 pairs)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for x in &s {
-                let k = kernel2(black_box(x[0]), x[1], 1.0);
-                acc += k.w + k.w_r + k.w_z;
-            }
-            acc
-        })
-    });
+    c.bench_function(
+        &format!("kernel2 x neighbourhood ({} pairs)", s.len()),
+        |b| {
+            b.iter(|| {
+                let mut acc = 0.0;
+                for x in &s {
+                    let k = kernel2(black_box(x[0]), x[1], 1.0);
+                    acc += k.w + k.w_r + k.w_z;
+                }
+                acc
+            })
+        },
+    );
     let mut hood = Neighbourhood::with_capacity(s.len());
     let mut wr = vec![0.0; s.len().next_multiple_of(4)];
     let mut wz = wr.clone();
     let mut wk = wr.clone();
-    c.bench_function("msph moments + solve + weights (29 pairs)", |b| {
+    let name = format!("msph moments + solve + weights ({} pairs)", s.len());
+    c.bench_function(&name, |b| {
         b.iter(|| {
             hood.clear();
             for x in &s {
