@@ -369,35 +369,15 @@ impl<const K: usize> Msph2Rows<K> {
         h: f64,
         which: [Row2; K],
     ) -> Result<Self, Degenerate> {
-        Self::new_recording(i, neighbors, pos, vol, h, which, &mut Vec::new())
-    }
-
-    /// Like [`Msph2Rows::new`], and records in `phi` the scaled test
-    /// functions of each neighbour (zero outside the support), in neighbour
-    /// order, for [`Msph2Rows::weight_of`]: the kernel is then evaluated once
-    /// per pair. `phi[k][0]` is the kernel value up to its normalisation.
-    pub fn new_recording(
-        i: usize,
-        neighbors: &[usize],
-        pos: &[[f64; 2]],
-        vol: &[f64],
-        h: f64,
-        which: [Row2; K],
-        phi: &mut Vec<[f64; 6]>,
-    ) -> Result<Self, Degenerate> {
         let xi = pos[i];
         let inv_h = 1.0 / h;
         let mut b = Moments2::default();
-        phi.clear();
         for &j in neighbors {
             let sr = (pos[j][0] - xi[0]) * inv_h;
             let sz = (pos[j][1] - xi[1]) * inv_h;
-            let Some(phi_j) = phi2(sr, sz) else {
-                phi.push([0.0; 6]);
-                continue;
-            };
-            phi.push(phi_j);
-            b.add(&phi_j, sr, sz, vol[j]);
+            if let Some(phi) = phi2(sr, sz) {
+                b.add(&phi, sr, sz, vol[j]);
+            }
         }
         b.solve(i, xi, h, which)
     }
@@ -409,25 +389,20 @@ impl<const K: usize> Msph2Rows<K> {
         let sr = (xj[0] - self.xi[0]) * self.inv_h;
         let sz = (xj[1] - self.xi[1]) * self.inv_h;
         match phi2(sr, sz) {
-            Some(phi) => self.weight_of(&phi, vj),
+            Some(phi) => {
+                let mut out = [0.0; K];
+                for k in 0..K {
+                    let r = &self.rows[k];
+                    let mut s = 0.0;
+                    for a in 0..6 {
+                        s += r[a] * phi[a];
+                    }
+                    out[k] = s * vj * self.scale[k];
+                }
+                out
+            }
             None => [0.0; K],
         }
-    }
-
-    /// Shape-function weights from a neighbour's recorded test functions
-    /// (see [`Msph2Rows::new_recording`]) and its weight `vj`.
-    #[inline]
-    pub fn weight_of(&self, phi: &[f64; 6], vj: f64) -> [f64; K] {
-        let mut out = [0.0; K];
-        for k in 0..K {
-            let r = &self.rows[k];
-            let mut s = 0.0;
-            for a in 0..6 {
-                s += r[a] * phi[a];
-            }
-            out[k] = s * vj * self.scale[k];
-        }
-        out
     }
 }
 

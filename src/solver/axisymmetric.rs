@@ -161,12 +161,10 @@ struct Workspace {
     act: Vec<u32>,
     wr: Vec<f64>,
     wz: Vec<f64>,
-    ws: Vec<f64>,
+    wk: Vec<f64>,
     part: Vec<PairPass>,
     grads: Vec<[f64; 4]>,
     upd: Vec<Update>,
-    /// Number of rebuilds of the lists.
-    rebuilds: u64,
 }
 
 /// Writes the image values `f[n + k] = mirror(f[ghosts[k]])`.
@@ -372,7 +370,7 @@ impl TaylorSolver {
         ws.act.resize(n * stride, 0);
         ws.wr.resize(n * stride, 0.0);
         ws.wz.resize(n * stride, 0.0);
-        ws.ws.resize(n * stride, 0.0);
+        ws.wk.resize(n * stride, 0.0);
         ws.vol.resize(m, 0.0);
         ws.sbc.resize(m, [0.0; 4]);
         ws.face_row.clear();
@@ -385,7 +383,6 @@ impl TaylorSolver {
         ws.part.resize(n, PairPass::default());
         ws.grads.resize(n, [0.0; 4]);
         ws.upd.resize(n, Update::default());
-        ws.rebuilds += 1;
     }
 
     /// Whether a particle moved more than half the skin since the lists were
@@ -440,7 +437,7 @@ impl TaylorSolver {
             act,
             wr,
             wz,
-            ws: wk,
+            wk,
             part,
             grads,
             upd,
