@@ -51,7 +51,7 @@ fn kernel(c: &mut Criterion) {
         },
     );
     let mut hood = Neighbourhood::with_capacity(s.len());
-    let mut wr = vec![0.0; s.len().next_multiple_of(4)];
+    let mut wr = vec![0.0; s.len().next_multiple_of(meshless_impact::lanes::W)];
     let mut wz = wr.clone();
     let mut wk = wr.clone();
     let name = format!("msph moments + solve + weights ({} pairs)", s.len());

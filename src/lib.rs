@@ -26,6 +26,7 @@ pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi;
 pub mod kernel;
+pub mod lanes;
 pub mod material;
 pub mod msph;
 pub mod neighbors;

@@ -12,7 +12,7 @@
 //! A particle (a ring in the axisymmetric case) weighs `V_j = m_j / rho_j`.
 
 use crate::kernel::{EXP_M4, SUPPORT};
-use wide::{f64x2, f64x4};
+use crate::lanes::{Lanes, W};
 
 /// Largest 1-norm condition number of a scaled moment matrix that is accepted.
 /// Beyond it the particle arrangement cannot support a second-order
@@ -169,9 +169,62 @@ const PHI: [&[(usize, usize, f64)]; 6] = [
     &[(1, 1, 4.0)],
 ];
 
+/// Number of power sums behind a 2-D moment matrix: the 15 monomials
+/// `s_R^p s_Z^q` (`p + q <= 4`) weighted by `V_j exp(-|s_j|^2)`, then the 6 of
+/// degree at most 2 weighted by `V_j` alone.
+pub const POWER_SUMS: usize = 21;
+
+/// The scaled moment matrix `B` (row-major: `B[a][c] = sum_j V_j Phi_a(s_j)
+/// Theta_c(s_j)`) from its power sums (see [`Neighbourhood::power_sums`]).
+#[inline(always)]
+pub fn moment_matrix(sums: &[f64; POWER_SUMS]) -> [[f64; 6]; 6] {
+    let (m, n) = sums.split_at(15);
+    let mut b = [[0.0; 6]; 6];
+    for (c, &(pc, qc, tc)) in THETA.iter().enumerate() {
+        for (a, terms) in PHI.iter().enumerate() {
+            let mut x = 0.0;
+            for &(p, q, k) in terms.iter() {
+                x += k * tc * m[monomial(p + pc, q + qc)];
+            }
+            if a == 0 {
+                x -= EXP_M4 * tc * n[monomial(pc, qc)];
+            }
+            b[a][c] = x;
+        }
+    }
+    b
+}
+
+/// [`moment_matrix`] of [`W`] particles at once, lane `l` of the power sums
+/// giving lane `l` of the matrix (the same operations in the same order).
+#[inline(always)]
+pub fn moment_matrix_lanes(sums: &[Lanes; POWER_SUMS]) -> crate::lanes::LaneMatrix<6> {
+    let (m, n) = sums.split_at(15);
+    let mut b = [[[0.0; W]; 6]; 6];
+    for (c, &(pc, qc, tc)) in THETA.iter().enumerate() {
+        for (a, terms) in PHI.iter().enumerate() {
+            let mut x = [0.0; W];
+            for &(p, q, k) in terms.iter() {
+                let mk = &m[monomial(p + pc, q + qc)];
+                for l in 0..W {
+                    x[l] += k * tc * mk[l];
+                }
+            }
+            if a == 0 {
+                let nk = &n[monomial(pc, qc)];
+                for l in 0..W {
+                    x[l] -= EXP_M4 * tc * nk[l];
+                }
+            }
+            b[a][c] = x;
+        }
+    }
+    b
+}
+
 /// The neighbours of one particle in structure-of-arrays form (scaled
-/// offsets and weights), for a vectorised assembly of the moment matrix and
-/// of the shape-function weights, four pairs at a time.
+/// offsets, weights and Gaussians), for a vectorised assembly of the moment
+/// matrix and of the shape-function weights, [`W`] pairs at a time.
 ///
 /// The kernel is a Gaussian times a polynomial, so every entry of `B` is a
 /// combination of the power sums `sum_j V_j exp(-|s_j|^2) s_R^p s_Z^q`
@@ -186,6 +239,12 @@ pub struct Neighbourhood {
     len: usize,
 }
 
+/// The lane of `x` that starts at `c`.
+#[inline(always)]
+fn lane(x: &[f64], c: usize) -> Lanes {
+    x[c..c + W].try_into().expect("a whole lane")
+}
+
 impl Neighbourhood {
     /// An empty neighbourhood with room for `n` neighbours (it grows when
     /// needed).
@@ -195,8 +254,17 @@ impl Neighbourhood {
         hood
     }
 
-    fn reserve(&mut self, n: usize) {
-        let cap = n.next_multiple_of(4).max(4);
+    /// Makes room for `n` neighbours and a whole lane more.
+    #[inline(always)]
+    pub fn reserve(&mut self, n: usize) {
+        if self.sr.len() < n + W {
+            self.grow(n);
+        }
+    }
+
+    #[cold]
+    fn grow(&mut self, n: usize) {
+        let cap = (n + W).next_multiple_of(W);
         for x in [&mut self.sr, &mut self.sz, &mut self.v, &mut self.e] {
             x.resize(cap, 0.0);
         }
@@ -212,139 +280,188 @@ impl Neighbourhood {
         self.len
     }
 
+    /// Number of neighbours rounded up to whole lanes of [`W`].
+    pub fn padded_len(&self) -> usize {
+        self.len.next_multiple_of(W)
+    }
+
     /// True when there is no neighbour.
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
 
     /// Adds a neighbour at scaled offset `(sr, sz) = (x_j - x_i) / h`, which
-    /// must lie in the support, with weight `v = m_j / rho_j`, and evaluates
-    /// its Gaussian `exp(-|s|^2)`.
+    /// must lie in the support, with weight `v = m_j / rho_j`.
     #[inline]
     pub fn push(&mut self, sr: f64, sz: f64, v: f64) {
+        self.push_if(true, sr, sz, v);
+    }
+
+    /// Adds the neighbour as [`Neighbourhood::push`] does when `keep` holds,
+    /// and otherwise leaves the neighbourhood as it was, without a branch.
+    #[inline(always)]
+    pub fn push_if(&mut self, keep: bool, sr: f64, sz: f64, v: f64) {
+        self.reserve(self.len + 1);
         let k = self.len;
-        if k + 4 > self.sr.len() {
-            self.reserve(2 * self.sr.len() + 4);
-        }
         self.sr[k] = sr;
         self.sz[k] = sz;
         self.v[k] = v;
-        self.e[k] = (-(sr * sr + sz * sz)).exp();
-        self.len = k + 1;
+        self.len = k + keep as usize;
     }
 
-    /// Number of neighbours rounded up to whole lanes of four, the lanes
-    /// past the last neighbour holding zero weight, which adds nothing.
-    fn padded(&mut self) -> usize {
-        let padded = self.len.next_multiple_of(4);
+    /// [`Neighbourhood::push_if`] for a lane of candidates, in lane order.
+    #[inline(always)]
+    pub fn push_lanes(&mut self, keep: [bool; W], sr: Lanes, sz: Lanes, v: Lanes) {
+        self.reserve(self.len + W);
+        let (out_r, out_z, out_v) = (
+            &mut self.sr[self.len..self.len + 2 * W],
+            &mut self.sz[self.len..self.len + 2 * W],
+            &mut self.v[self.len..self.len + 2 * W],
+        );
+        let mut k = 0;
+        for l in 0..W {
+            out_r[k] = sr[l];
+            out_z[k] = sz[l];
+            out_v[k] = v[l];
+            k += keep[l] as usize;
+        }
+        self.len += k;
+    }
+
+    /// Zero-weight lanes after the last neighbour up to a whole lane, and
+    /// the Gaussians `exp(-|s|^2)` of every neighbour.
+    #[inline(always)]
+    fn gaussians(&mut self) -> usize {
+        let padded = self.padded_len();
         for k in self.len..padded {
             self.sr[k] = 0.0;
             self.sz[k] = 0.0;
             self.v[k] = 0.0;
-            self.e[k] = 0.0;
+        }
+        for c in (0..padded).step_by(W) {
+            let (sr, sz) = (lane(&self.sr, c), lane(&self.sz, c));
+            let e = crate::lanes::exp(std::array::from_fn(|l| -(sr[l] * sr[l] + sz[l] * sz[l])));
+            self.e[c..c + W].copy_from_slice(&e);
         }
         padded
     }
 
-    #[inline]
-    fn lanes(x: &[f64], c: usize) -> f64x4 {
-        f64x4::new([x[c], x[c + 1], x[c + 2], x[c + 3]])
+    /// Evaluates the Gaussians and returns the [`POWER_SUMS`] power sums of
+    /// the moment matrix (for [`moment_matrix`]). Each sum runs in a fixed
+    /// order ([`W`] lane partial sums, then [`crate::lanes::total`]), so the
+    /// result does not depend on the thread or the instruction set.
+    #[inline(always)]
+    pub fn power_sums(&mut self) -> [f64; POWER_SUMS] {
+        let padded = self.gaussians();
+        let mut acc = [[0.0; W]; POWER_SUMS];
+        for c in (0..padded).step_by(W) {
+            let (sr, sz, v, e) = (
+                lane(&self.sr, c),
+                lane(&self.sz, c),
+                lane(&self.v, c),
+                lane(&self.e, c),
+            );
+            for l in 0..W {
+                let (r, z) = (sr[l], sz[l]);
+                let ev = e[l] * v[l];
+                let (r2, rz, z2) = (r * r, r * z, z * z);
+                let mons = [
+                    1.0,
+                    r,
+                    z,
+                    r2,
+                    rz,
+                    z2,
+                    r2 * r,
+                    r2 * z,
+                    rz * z,
+                    z2 * z,
+                    r2 * r2,
+                    r2 * rz,
+                    r2 * z2,
+                    rz * z2,
+                    z2 * z2,
+                ];
+                for k in 0..15 {
+                    acc[k][l] += ev * mons[k];
+                }
+                for k in 0..6 {
+                    acc[15 + k][l] += v[l] * mons[k];
+                }
+            }
+        }
+        acc.map(crate::lanes::total)
     }
 
-    /// Assembles the moment matrix from the power sums. The sums run in a
-    /// fixed order (two interleaved partial sums, then their total), so the
-    /// result does not depend on the thread that computes it.
+    /// Assembles the moment matrix (see [`Neighbourhood::power_sums`]).
     pub fn moments(&mut self) -> Moments2 {
-        let padded = self.padded();
-        let mut acc = [f64x2::ZERO; 21];
-        for c in (0..padded).step_by(2) {
-            let pair = |x: &[f64]| f64x2::new([x[c], x[c + 1]]);
-            let (sr, sz, v) = (pair(&self.sr), pair(&self.sz), pair(&self.v));
-            let ev = pair(&self.e) * v;
-            let (r2, rz, z2) = (sr * sr, sr * sz, sz * sz);
-            let mons = [
-                f64x2::ONE,
-                sr,
-                sz,
-                r2,
-                rz,
-                z2,
-                r2 * sr,
-                r2 * sz,
-                rz * sz,
-                z2 * sz,
-                r2 * r2,
-                r2 * rz,
-                r2 * z2,
-                rz * z2,
-                z2 * z2,
-            ];
-            for k in 0..15 {
-                acc[k] += ev * mons[k];
-            }
-            for k in 0..6 {
-                acc[15 + k] += v * mons[k];
-            }
+        let b = moment_matrix(&self.power_sums());
+        Moments2 {
+            b: std::array::from_fn(|c| std::array::from_fn(|a| b[a][c])),
         }
-        let sums = acc.map(|a| {
-            let l = a.to_array();
-            l[0] + l[1]
-        });
-        let (m, n) = sums.split_at(15);
-        let mut b = [[0.0; 6]; 6];
-        for (c, &(pc, qc, tc)) in THETA.iter().enumerate() {
-            for (a, terms) in PHI.iter().enumerate() {
-                let mut x = 0.0;
-                for &(p, q, k) in terms.iter() {
-                    x += k * tc * m[monomial(p + pc, q + qc)];
-                }
-                if a == 0 {
-                    x -= EXP_M4 * tc * n[monomial(pc, qc)];
-                }
-                b[c][a] = x;
-            }
-        }
-        Moments2 { b }
     }
 
     /// Shape-function weights of every neighbour for each row of `rows`
     /// (after [`Neighbourhood::moments`]), and the kernel value times `V_j`
     /// up to its normalisation in `kernel`. Each output must hold the padded
-    /// length, the number of neighbours rounded up to a multiple of four.
+    /// length ([`Neighbourhood::padded_len`]); the padded lanes get zero.
     pub fn weights<const K: usize>(
         &self,
         rows: &Msph2Rows<K>,
         out: [&mut [f64]; K],
         kernel: &mut [f64],
     ) {
-        let coef: [[f64x4; 6]; K] =
-            std::array::from_fn(|k| std::array::from_fn(|a| f64x4::splat(rows.rows[k][a])));
-        let scale: [f64x4; K] = rows.scale.map(f64x4::splat);
-        let (two, four, e4) = (f64x4::splat(2.0), f64x4::splat(4.0), f64x4::splat(EXP_M4));
-        for c in (0..self.len.next_multiple_of(4)).step_by(4) {
+        self.weights_of(&rows.rows, &rows.scale, out, kernel);
+    }
+
+    /// [`Neighbourhood::weights`] for rows of the inverse moment matrix
+    /// given as they are, each with its scale (`h^-order`). Returns the sum
+    /// of the kernel values (lane partial sums, then
+    /// [`crate::lanes::total`]).
+    #[inline(always)]
+    pub fn weights_of<const K: usize>(
+        &self,
+        rows: &[[f64; 6]; K],
+        scale: &[f64; K],
+        out: [&mut [f64]; K],
+        kernel: &mut [f64],
+    ) -> f64 {
+        let mut sum = [0.0; W];
+        for c in (0..self.padded_len()).step_by(W) {
             let (sr, sz, v, e) = (
-                Self::lanes(&self.sr, c),
-                Self::lanes(&self.sz, c),
-                Self::lanes(&self.v, c),
-                Self::lanes(&self.e, c),
+                lane(&self.sr, c),
+                lane(&self.sz, c),
+                lane(&self.v, c),
+                lane(&self.e, c),
             );
-            let phi = [
-                e - e4,
-                two * e * sr,
-                two * e * sz,
-                e * (four * sr * sr - two),
-                e * (four * sz * sz - two),
-                four * e * sr * sz,
-            ];
-            for k in 0..K {
-                let mut s = coef[k][0] * phi[0];
-                for a in 1..6 {
-                    s += coef[k][a] * phi[a];
+            let mut w = [[0.0; W]; K];
+            let mut kern = [0.0; W];
+            for l in 0..W {
+                let (r, z, e) = (sr[l], sz[l], e[l]);
+                let phi = [
+                    e - EXP_M4,
+                    2.0 * e * r,
+                    2.0 * e * z,
+                    e * (4.0 * r * r - 2.0),
+                    e * (4.0 * z * z - 2.0),
+                    4.0 * e * r * z,
+                ];
+                for k in 0..K {
+                    let mut s = rows[k][0] * phi[0];
+                    for a in 1..6 {
+                        s += rows[k][a] * phi[a];
+                    }
+                    w[k][l] = s * v[l] * scale[k];
                 }
-                out[k][c..c + 4].copy_from_slice(&(s * v * scale[k]).to_array());
+                kern[l] = phi[0] * v[l];
+                sum[l] += kern[l];
             }
-            kernel[c..c + 4].copy_from_slice(&(phi[0] * v).to_array());
+            for k in 0..K {
+                out[k][c..c + W].copy_from_slice(&w[k]);
+            }
+            kernel[c..c + W].copy_from_slice(&kern);
         }
+        crate::lanes::total(sum)
     }
 }
 
@@ -634,7 +751,7 @@ mod tests {
                 }
             }
             let m = hood.moments().solve(i, p[i], h, all).unwrap();
-            let padded = inside.len().next_multiple_of(4);
+            let padded = hood.padded_len();
             let mut out = [(); 6].map(|_| vec![f64::NAN; padded]);
             let mut kern = vec![f64::NAN; padded];
             let [o0, o1, o2, o3, o4, o5] = &mut out;

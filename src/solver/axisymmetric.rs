@@ -24,12 +24,16 @@
 //!    the free surfaces, next time step.
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
-use super::{COURANT, check_time_step, pair_sum, smoothed};
+use super::pairs::{
+    PairInputs, PairOutputs, PairPass, Rows, Scratch, pair_batch, shepard_means, smooth,
+    velocity_gradients,
+};
+use super::{COURANT, check_time_step};
 use crate::error::{Error, Result};
 use crate::kernel::SUPPORT;
+use crate::lanes::W;
 use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
-use crate::msph::{Neighbourhood, Row2};
 use crate::neighbors::cell_list_first;
 use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
 use crate::scene::taylor::TaylorParams;
@@ -106,20 +110,6 @@ pub const SKIN: f64 = 0.3;
 /// Smallest number of particles a thread takes at a time.
 const MIN_LEN: usize = 64;
 
-/// Per-particle results of the pair pass.
-#[derive(Debug, Clone, Copy, Default)]
-struct PairPass {
-    /// Neighbours in the support.
-    len: u32,
-    /// Condition number of a degenerate moment matrix, or zero.
-    condition: f64,
-    /// Smallest squared distance to another particle in the support.
-    min_d2: f64,
-    /// The same among particles not from the impact face (infinite for a
-    /// particle of the face).
-    min_d2_free: f64,
-}
-
 /// Per-particle result of the constitutive update.
 #[derive(Debug, Clone, Copy, Default)]
 struct Update {
@@ -150,9 +140,9 @@ struct Workspace {
     pos: Vec<[f64; 2]>,
     vol: Vec<f64>,
     sbc: Vec<Stress>,
-    /// Whether a particle (or the particle an image copies) started on the
-    /// impact face.
-    face_row: Vec<bool>,
+    /// Index ranges of the particles that started on the impact face and of
+    /// their images (the images come in the order of the particles).
+    face: [[u32; 2]; 2],
     vel: Vec<[f64; 2]>,
     vel_s: Vec<[f64; 2]>,
     rho: Vec<[f64; 1]>,
@@ -353,7 +343,7 @@ impl TaylorSolver {
             .map(|i| nl.of(i).len())
             .max()
             .unwrap_or(0)
-            .next_multiple_of(4);
+            .next_multiple_of(W);
         ws.stride = stride;
         ws.nbr.clear();
         ws.nbr.resize(n * stride, 0);
@@ -367,16 +357,16 @@ impl TaylorSolver {
         }
         ws.built_at.clear();
         ws.built_at.extend_from_slice(&self.pos);
-        ws.act.resize(n * stride, 0);
-        ws.wr.resize(n * stride, 0.0);
-        ws.wz.resize(n * stride, 0.0);
-        ws.wk.resize(n * stride, 0.0);
+        // Whole batches of W rows.
+        let rows = n.next_multiple_of(W) * stride;
+        ws.act.resize(rows, 0);
+        ws.wr.resize(rows, 0.0);
+        ws.wz.resize(rows, 0.0);
+        ws.wk.resize(rows, 0.0);
         ws.vol.resize(m, 0.0);
         ws.sbc.resize(m, [0.0; 4]);
-        ws.face_row.clear();
-        ws.face_row.extend((0..n).map(|i| i < nr));
-        ws.face_row
-            .extend(ws.ghosts.iter().map(|&g| (g as usize) < nr));
+        let face_images = ws.ghosts.iter().take_while(|&&g| (g as usize) < nr).count();
+        ws.face = [[0, nr as u32], [n as u32, (n + face_images) as u32]];
         ws.vel.resize(m, [0.0; 2]);
         ws.vel_s.resize(m, [0.0; 2]);
         ws.rho.resize(m, [0.0]);
@@ -430,7 +420,7 @@ impl TaylorSolver {
             pos,
             vol,
             sbc,
-            face_row,
+            face,
             vel,
             vel_s,
             rho: rho_raw,
@@ -455,91 +445,46 @@ impl TaylorSolver {
 
         // 1-2. Per particle: the MSPH moment matrix over the neighbours in
         // the support, the derivative and Shepard weights of each pair, and
-        // the momentum equation v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
-        let h = self.h;
-        let inv_h = 1.0 / h;
-        let (pos, vol, sbc, face_row) = (&*pos, &*vol, &*sbc, &*face_row);
+        // the momentum equation v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho,
+        // W particles at a time (src/solver/pairs.rs).
+        let inputs = PairInputs {
+            pos,
+            vol,
+            sbc,
+            face: *face,
+            nbr,
+            nbr_len,
+            stride,
+            vel: &self.vel,
+            rho: &self.rho,
+            nr,
+            h: self.h,
+            dt,
+        };
+        let batch = W * stride;
         (
-            act.par_chunks_mut(stride),
-            wr.par_chunks_mut(stride),
-            wz.par_chunks_mut(stride),
-            wk.par_chunks_mut(stride),
-            nbr.par_chunks(stride),
-            part.par_iter_mut(),
-            vel[..n].par_iter_mut(),
+            act.par_chunks_mut(batch),
+            wr.par_chunks_mut(batch),
+            wz.par_chunks_mut(batch),
+            wk.par_chunks_mut(batch),
+            part.par_chunks_mut(W),
+            vel[..n].par_chunks_mut(W),
         )
             .into_par_iter()
             .enumerate()
-            .with_min_len(MIN_LEN)
+            .with_min_len(MIN_LEN / W)
             .for_each_init(
-                || Neighbourhood::with_capacity(stride),
-                |hood, (i, (act_i, wr_i, wz_i, wk_i, nbr_i, part_i, v_out))| {
-                    let xi = pos[i];
-                    let mut min_d2 = f64::INFINITY;
-                    let mut min_d2_free = f64::INFINITY;
-                    hood.clear();
-                    for &j in &nbr_i[..nbr_len[i] as usize] {
-                        let xj = pos[j as usize];
-                        let (dr, dz) = (xj[0] - xi[0], xj[1] - xi[1]);
-                        let (sr, sz) = (dr * inv_h, dz * inv_h);
-                        if sr * sr + sz * sz > SUPPORT * SUPPORT {
-                            continue;
-                        }
-                        if j as usize != i {
-                            let d2 = dr * dr + dz * dz;
-                            min_d2 = min_d2.min(d2);
-                            if !face_row[i] && !face_row[j as usize] {
-                                min_d2_free = min_d2_free.min(d2);
-                            }
-                        }
-                        act_i[hood.len()] = j;
-                        hood.push(sr, sz, vol[j as usize]);
-                    }
-                    let len = hood.len();
-                    *part_i = PairPass {
-                        len: len as u32,
-                        condition: 0.0,
-                        min_d2,
-                        min_d2_free,
+                || Scratch::new(stride),
+                |scratch, (b, (act, wr, wz, wk, part, vel))| {
+                    let out = PairOutputs {
+                        act,
+                        wr,
+                        wz,
+                        wk,
+                        part,
+                        vel,
                     };
-                    let m = match hood.moments().solve(i, xi, h, [Row2::R, Row2::Z]) {
-                        Ok(m) => m,
-                        Err(e) => {
-                            part_i.condition = e.condition;
-                            part_i.len = 0;
-                            *v_out = self.vel[i];
-                            return;
-                        }
-                    };
-                    hood.weights(&m, [&mut *wr_i, &mut *wz_i], wk_i);
-                    // Shepard weights W_ij V_j / sum_j W_ij V_j (the kernel's
-                    // normalisation cancels).
-                    let [wsum] = pair_sum(len, |k| [wk_i[k]]);
-                    for w in &mut wk_i[..len] {
-                        *w /= wsum;
-                    }
-                    let si = sbc[i];
-                    let [drr_r, drz_r, drz_z, dzz_z] = pair_sum(len, |k| {
-                        let sj = sbc[act_i[k] as usize];
-                        let (gr, gz) = (wr_i[k], wz_i[k]);
-                        [
-                            gr * (sj[0] - si[0]),
-                            gr * (sj[3] - si[3]),
-                            gz * (sj[3] - si[3]),
-                            gz * (sj[1] - si[1]),
-                        ]
-                    });
-                    let v = self.vel[i];
-                    let rho = self.rho[i];
-                    *v_out = if axis(i) {
-                        [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho]
-                    } else {
-                        let r = xi[0];
-                        [
-                            v[0] + dt * (drr_r + (si[0] - si[2]) / r + drz_z) / rho,
-                            v[1] + dt * (drz_r + si[3] / r + dzz_z) / rho,
-                        ]
-                    };
+                    pair_batch(&inputs, b * W, out, scratch);
                 },
             );
         if let Some((i, p)) = part.iter().enumerate().find(|(_, p)| p.condition != 0.0) {
@@ -568,25 +513,32 @@ impl TaylorSolver {
         // 3. Conservative smoothing of the velocity.
         let ke_before = kinetic(&vel[..n], &self.mass);
         fill_images(vel, n, ghosts, |v| [-v[0], v[1]]);
-        let (act, wr, wz, wk, part) = (&*act, &*wr, &*wz, &*wk, &*part);
-        // Pair slots of `i`: its neighbours in the support.
-        let row = |i: usize| i * stride..i * stride + part[i].len as usize;
+        let rows = Rows {
+            act,
+            wr,
+            wz,
+            wk,
+            part,
+            stride,
+        };
         {
             let vel = &*vel;
             vel_s[..n]
-                .par_iter_mut()
+                .par_chunks_mut(MIN_LEN)
                 .enumerate()
-                .with_min_len(MIN_LEN)
-                .for_each(|(i, out)| {
-                    let r = row(i);
-                    let mut v = smoothed(i, &act[r.clone()], &wk[r], vel, alpha);
-                    if axis(i) {
-                        v[0] = 0.0;
+                .for_each(|(c, out)| {
+                    let i0 = c * MIN_LEN;
+                    shepard_means(rows, vel, i0, out);
+                    for (k, v) in out.iter_mut().enumerate() {
+                        let i = i0 + k;
+                        *v = smooth(vel[i], *v, alpha);
+                        if axis(i) {
+                            v[0] = 0.0;
+                        }
+                        if self.contact[i] {
+                            v[1] = 0.0;
+                        }
                     }
-                    if self.contact[i] {
-                        v[1] = 0.0;
-                    }
-                    *out = v;
                 });
         }
         self.smoothing_dissipation += ke_before - kinetic(&vel_s[..n], &self.mass);
@@ -594,24 +546,22 @@ impl TaylorSolver {
         // 4. Velocity gradients and continuity.
         fill_images(vel_s, n, ghosts, |v| [-v[0], v[1]]);
         let vel = &*vel_s;
-        (grads.par_iter_mut(), rho_raw[..n].par_iter_mut())
+        (
+            grads.par_chunks_mut(MIN_LEN),
+            rho_raw[..n].par_chunks_mut(MIN_LEN),
+        )
             .into_par_iter()
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, (gr, rho_out))| {
-                let vi = vel[i];
-                let r = row(i);
-                let (act, wr, wz) = (&act[r.clone()], &wr[r.clone()], &wz[r]);
-                // dvr/dR, dvr/dZ, dvz/dR, dvz/dZ
-                let g4 = pair_sum(act.len(), |k| {
-                    let vj = vel[act[k] as usize];
-                    let dv = [vj[0] - vi[0], vj[1] - vi[1]];
-                    [wr[k] * dv[0], wz[k] * dv[0], wr[k] * dv[1], wz[k] * dv[1]]
-                });
-                *gr = g4;
-                let hoop = if axis(i) { g4[0] } else { vi[0] / pos[i][0] };
-                let div = g4[0] + g4[3] + hoop;
-                *rho_out = [self.rho[i] * (1.0 - dt * div)];
+            .for_each(|(c, (grads, rho_out))| {
+                let i0 = c * MIN_LEN;
+                // dU_R/dR, dU_R/dZ, dU_Z/dR, dU_Z/dZ
+                velocity_gradients(rows, vel, i0, grads);
+                for (k, (g, rho_out)) in grads.iter().zip(rho_out).enumerate() {
+                    let i = i0 + k;
+                    let hoop = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
+                    let div = g[0] + g[3] + hoop;
+                    *rho_out = [self.rho[i] * (1.0 - dt * div)];
+                }
             });
         fill_images(rho_raw, n, ghosts, |r| r);
 
@@ -623,51 +573,56 @@ impl TaylorSolver {
             self.p.specific_heat,
         );
         let (grads, rho_raw) = (&*grads, &*rho_raw);
-        upd.par_iter_mut()
+        upd.par_chunks_mut(MIN_LEN)
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, out)| {
-                let r = row(i);
-                let [rho] = smoothed(i, &act[r.clone()], &wk[r], rho_raw, alpha);
-                let g = grads[i];
-                let d_rr = g[0];
-                let d_zz = g[3];
-                let d_tt = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
-                // On the axis, symmetry gives dU_R/dZ = dU_Z/dR = 0: no shear
-                // and no spin (sigma_RZ is odd in R).
-                let (d_rz, omega) = if axis(i) {
-                    (0.0, 0.0)
-                } else {
-                    (0.5 * (g[1] + g[2]), 0.5 * (g[1] - g[2]))
-                };
-                let dvol = (d_rr + d_zz + d_tt) / 3.0;
-                let s = self.dev[i];
-                let trial = [
-                    s[0] + dt * (2.0 * omega * s[3] + 2.0 * mu * (d_rr - dvol)),
-                    s[1] + dt * (-2.0 * omega * s[3] + 2.0 * mu * (d_zz - dvol)),
-                    s[2] + dt * (2.0 * mu * (d_tt - dvol)),
-                    s[3] + dt * (omega * (s[1] - s[0]) + 2.0 * mu * d_rz),
-                ];
-                let rate = (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
-                let sy = jc.flow_stress(self.eps_p[i], rate, self.temp[i]);
-                let ret = radial_return(&trial, sy, mu);
-                let p_new = eos.pressure(rho);
-                // Stress power with the mid-step stress, per unit mass.
-                let p_old = self.pressure[i];
-                let sm = |k: usize, p: f64| 0.5 * (s[k] + ret.stress[k]) - p;
-                let pm = 0.5 * (p_old + p_new);
-                let power = sm(0, pm) * d_rr
-                    + sm(1, pm) * d_zz
-                    + sm(2, pm) * d_tt
-                    + 2.0 * 0.5 * (s[3] + ret.stress[3]) * d_rz;
-                *out = Update {
-                    dev: ret.stress,
-                    pressure: p_new,
-                    rho,
-                    plastic_strain: ret.plastic_strain,
-                    temp: ret.plastic_work / (rho * cap),
-                    energy: dt * power * self.mass[i] / rho,
-                };
+            .for_each(|(c, out)| {
+                let i0 = c * MIN_LEN;
+                let mut means = [[0.0]; MIN_LEN];
+                let means = &mut means[..out.len()];
+                shepard_means(rows, rho_raw, i0, means);
+                for (k, out) in out.iter_mut().enumerate() {
+                    let i = i0 + k;
+                    let [rho] = smooth(rho_raw[i], means[k], alpha);
+                    let g = grads[i];
+                    let d_rr = g[0];
+                    let d_zz = g[3];
+                    let d_tt = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
+                    // On the axis, symmetry gives dU_R/dZ = dU_Z/dR = 0: no shear
+                    // and no spin (sigma_RZ is odd in R).
+                    let (d_rz, omega) = if axis(i) {
+                        (0.0, 0.0)
+                    } else {
+                        (0.5 * (g[1] + g[2]), 0.5 * (g[1] - g[2]))
+                    };
+                    let dvol = (d_rr + d_zz + d_tt) / 3.0;
+                    let s = self.dev[i];
+                    let trial = [
+                        s[0] + dt * (2.0 * omega * s[3] + 2.0 * mu * (d_rr - dvol)),
+                        s[1] + dt * (-2.0 * omega * s[3] + 2.0 * mu * (d_zz - dvol)),
+                        s[2] + dt * (2.0 * mu * (d_tt - dvol)),
+                        s[3] + dt * (omega * (s[1] - s[0]) + 2.0 * mu * d_rz),
+                    ];
+                    let rate = (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
+                    let sy = jc.flow_stress(self.eps_p[i], rate, self.temp[i]);
+                    let ret = radial_return(&trial, sy, mu);
+                    let p_new = eos.pressure(rho);
+                    // Stress power with the mid-step stress, per unit mass.
+                    let p_old = self.pressure[i];
+                    let sm = |k: usize, p: f64| 0.5 * (s[k] + ret.stress[k]) - p;
+                    let pm = 0.5 * (p_old + p_new);
+                    let power = sm(0, pm) * d_rr
+                        + sm(1, pm) * d_zz
+                        + sm(2, pm) * d_tt
+                        + 2.0 * 0.5 * (s[3] + ret.stress[3]) * d_rz;
+                    *out = Update {
+                        dev: ret.stress,
+                        pressure: p_new,
+                        rho,
+                        plastic_strain: ret.plastic_strain,
+                        temp: ret.plastic_work / (rho * cap),
+                        energy: dt * power * self.mass[i] / rho,
+                    };
+                }
             });
         for (i, u) in upd.iter().enumerate() {
             self.dev[i] = u.dev;

@@ -1,0 +1,314 @@
+//! Arithmetic on lanes of [`W`] values, written as plain loops over
+//! fixed-size arrays that the compiler turns into vector instructions: the
+//! Gaussian of many pairs at once ([`exp`]), the moment matrices of [`W`]
+//! particles inverted together ([`invert`]), and sums over neighbours in
+//! [`W`] partial sums ([`gather`], [`total`]).
+//!
+//! Every lane operation is an IEEE add, multiply, divide, compare or select,
+//! never a fused multiply-add, and every sum runs in a fixed order, so the
+//! results are the same bit for bit whatever instruction set runs them (a
+//! test 7 run built for AVX-512, for AVX2 and for baseline x86-64 gave
+//! identical observables, BENCHMARKS.md).
+
+/// Number of lanes: eight doubles, one AVX-512 register.
+pub const W: usize = 8;
+
+/// A lane of [`W`] doubles.
+pub type Lanes = [f64; W];
+
+/// `1.5 * 2^52`: adding it rounds a double of magnitude below `2^51` to the
+/// nearest integer, which then sits in the low bits of the sum.
+const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
+
+/// `ln 2` split so that `k * LN2_HI` is exact for `|k| < 2^11`.
+const LN2_HI: f64 = 6.931_471_803_691_238e-1;
+const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+
+/// `1 / k!` for `k = 0..=13`, the Taylor coefficients of `exp` on the
+/// reduced interval `|r| <= ln(2) / 2`, where the truncation error is below
+/// `5e-18` relative.
+const INV_FACTORIAL: [f64; 14] = [
+    1.0,
+    1.0,
+    0.5,
+    1.0 / 6.0,
+    1.0 / 24.0,
+    1.0 / 120.0,
+    1.0 / 720.0,
+    1.0 / 5040.0,
+    1.0 / 40320.0,
+    1.0 / 362_880.0,
+    1.0 / 3_628_800.0,
+    1.0 / 39_916_800.0,
+    1.0 / 479_001_600.0,
+    1.0 / 6_227_020_800.0,
+];
+
+/// `exp(x)` of each lane, for `-700 <= x <= 700` (the callers pass
+/// `x = -|s|^2` with `|s| <= 2`). Within 2 ulp of the correctly rounded value
+/// (tested against the standard library), branch-free: `x = k ln 2 + r` with
+/// `k` the nearest integer to `x / ln 2`, a degree-13 Taylor polynomial of
+/// `exp(r)`, and `2^k` built in the exponent bits.
+#[inline(always)]
+pub fn exp(x: Lanes) -> Lanes {
+    let mut out = [0.0; W];
+    for l in 0..W {
+        let t = x[l] * std::f64::consts::LOG2_E + ROUND_MAGIC;
+        let k = t - ROUND_MAGIC;
+        let r = (x[l] - k * LN2_HI) - k * LN2_LO;
+        let mut p = INV_FACTORIAL[13];
+        for c in (0..13).rev() {
+            p = p * r + INV_FACTORIAL[c];
+        }
+        // The low bits of `t` hold `k` (two's complement over the magic).
+        let ki = t.to_bits().wrapping_sub(ROUND_MAGIC.to_bits());
+        let scale = f64::from_bits(ki.wrapping_add(1023) << 52);
+        out[l] = p * scale;
+    }
+    out
+}
+
+/// `if m { a } else { b }` lane by lane.
+#[inline(always)]
+pub fn select(m: [bool; W], a: Lanes, b: Lanes) -> Lanes {
+    std::array::from_fn(|l| if m[l] { a[l] } else { b[l] })
+}
+
+/// The `K` components of `f` at the [`W`] indices `idx`, one lane per
+/// component.
+#[inline(always)]
+pub fn gather<const K: usize>(f: &[[f64; K]], idx: &[u32; W]) -> [Lanes; K] {
+    let mut out = [[0.0; W]; K];
+    for l in 0..W {
+        let x = f[idx[l] as usize];
+        for k in 0..K {
+            out[k][l] = x[k];
+        }
+    }
+    out
+}
+
+/// The values of `f` at the [`W`] indices `idx`.
+#[inline(always)]
+pub fn gather1(f: &[f64], idx: &[u32; W]) -> Lanes {
+    idx.map(|j| f[j as usize])
+}
+
+/// A square matrix of lanes: lane `l` of every entry is matrix `l`.
+pub type LaneMatrix<const N: usize> = [[Lanes; N]; N];
+
+/// True when every lane of `m` holds.
+#[inline(always)]
+fn all(m: [bool; W]) -> bool {
+    m.iter().all(|&x| x)
+}
+
+/// Swaps `x` and `y` in the lanes where `m` holds.
+#[inline(always)]
+fn swap_where(m: [bool; W], x: &mut Lanes, y: &mut Lanes) {
+    let (a, b) = (*x, *y);
+    *x = select(m, b, a);
+    *y = select(m, a, b);
+}
+
+/// Inverts the [`W`] matrices held in the lanes of `a` (row-major) in place
+/// by Gauss-Jordan elimination with partial pivoting, each lane choosing its
+/// own pivots (the row interchanges are undone on the columns at the end).
+/// Returns the inverses and, per lane, whether a pivot vanished or was not
+/// finite (the inverse of such a lane is meaningless).
+#[inline(always)]
+pub fn invert<const N: usize>(a: LaneMatrix<N>) -> (LaneMatrix<N>, [bool; W]) {
+    let mut a = a;
+    let mut pivot_row = [[0.0; W]; N];
+    let mut singular = [false; W];
+    for k in 0..N {
+        // Pivot search: the first largest magnitude in the column.
+        let mut best = a[k][k];
+        let mut at = [k as f64; W];
+        for r in k + 1..N {
+            let x = a[r][k];
+            let m: [bool; W] = std::array::from_fn(|l| x[l].abs() > best[l].abs());
+            best = select(m, x, best);
+            at = select(m, [r as f64; W], at);
+        }
+        pivot_row[k] = at;
+        // Most batches keep the diagonal pivot in every lane.
+        if !all(at.map(|x| x == k as f64)) {
+            for r in k + 1..N {
+                let m: [bool; W] = at.map(|x| x == r as f64);
+                let (upper, lower) = a.split_at_mut(r);
+                for c in 0..N {
+                    swap_where(m, &mut upper[k][c], &mut lower[0][c]);
+                }
+            }
+        }
+        let mut d = [0.0; W];
+        for l in 0..W {
+            let bad = best[l] == 0.0 || !best[l].is_finite();
+            singular[l] |= bad;
+            // A failed lane goes on with a unit pivot; its result is unused.
+            d[l] = 1.0 / if bad { 1.0 } else { best[l] };
+        }
+        a[k][k] = [1.0; W];
+        for c in 0..N {
+            for l in 0..W {
+                a[k][c][l] *= d[l];
+            }
+        }
+        for r in 0..N {
+            if r == k {
+                continue;
+            }
+            let f = a[r][k];
+            a[r][k] = [0.0; W];
+            for c in 0..N {
+                for l in 0..W {
+                    a[r][c][l] -= f[l] * a[k][c][l];
+                }
+            }
+        }
+    }
+    // Undo the row interchanges on the columns, last first.
+    for k in (0..N).rev() {
+        let at = pivot_row[k];
+        if all(at.map(|x| x == k as f64)) {
+            continue;
+        }
+        for c in k + 1..N {
+            let m: [bool; W] = at.map(|x| x == c as f64);
+            for row in a.iter_mut() {
+                let (left, right) = row.split_at_mut(c);
+                swap_where(m, &mut left[k], &mut right[0]);
+            }
+        }
+    }
+    (a, singular)
+}
+
+/// The 1-norm (largest absolute column sum) of each lane's matrix.
+#[inline(always)]
+pub fn norm1<const N: usize>(m: &LaneMatrix<N>) -> Lanes {
+    let mut out: Lanes = [0.0; W];
+    for c in 0..N {
+        let mut s = [0.0; W];
+        for row in m {
+            for l in 0..W {
+                s[l] += row[c][l].abs();
+            }
+        }
+        for l in 0..W {
+            if s[l] > out[l] {
+                out[l] = s[l];
+            }
+        }
+    }
+    out
+}
+
+/// `sum_l x[l]` in a fixed pairwise order.
+#[inline(always)]
+pub fn total(x: Lanes) -> f64 {
+    let mut h = [0.0; W / 2];
+    for l in 0..W / 2 {
+        h[l] = x[l] + x[l + W / 2];
+    }
+    (h[0] + h[2]) + (h[1] + h[3])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rng(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn exp_is_within_two_ulp_of_the_standard_library() {
+        let mut next = rng(7);
+        let mut worst = 0.0f64;
+        let mut check = |x: Lanes| {
+            let e = exp(x);
+            for l in 0..W {
+                let want = x[l].exp();
+                let ulp = f64::from_bits(want.to_bits() + 1) - want;
+                worst = worst.max((e[l] - want).abs() / ulp);
+            }
+        };
+        // The kernel's range, densely, then the whole documented domain.
+        for _ in 0..20_000 {
+            check(std::array::from_fn(|_| -5.0 * next()));
+        }
+        for _ in 0..5_000 {
+            check(std::array::from_fn(|_| 1400.0 * next() - 700.0));
+        }
+        check([0.0, -0.0, 1.0, -1.0, -4.0, 700.0, -700.0, 1e-300]);
+        assert!(worst <= 2.0, "worst error {worst} ulp");
+        assert_eq!(exp([0.0; W]), [1.0; W]);
+    }
+
+    #[test]
+    fn lane_inverse_equals_the_scalar_gauss_jordan_lane_by_lane() {
+        let mut next = rng(11);
+        for _ in 0..100 {
+            let a: LaneMatrix<6> = std::array::from_fn(|_| {
+                std::array::from_fn(|_| std::array::from_fn(|_| next() - 0.5))
+            });
+            let (inv, singular) = invert(a);
+            assert_eq!(singular, [false; W]);
+            for l in 0..W {
+                let one: [[f64; 6]; 6] =
+                    std::array::from_fn(|r| std::array::from_fn(|c| a[r][c][l]));
+                let want = crate::msph::invert(one).unwrap();
+                let scale = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+                for r in 0..6 {
+                    for c in 0..6 {
+                        assert!(
+                            (inv[r][c][l] - want[r][c]).abs() <= 1e-12 * scale,
+                            "lane {l} ({r}, {c}): {} vs {}",
+                            inv[r][c][l],
+                            want[r][c]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn singular_lanes_are_flagged_and_do_not_spoil_the_others() {
+        let mut a: LaneMatrix<3> =
+            std::array::from_fn(|r| std::array::from_fn(|c| [if r == c { 2.0 } else { 0.5 }; W]));
+        // Lane 3: two equal rows. Lane 5: a NaN entry.
+        for c in 0..3 {
+            a[1][c][3] = a[0][c][3];
+        }
+        a[2][2][5] = f64::NAN;
+        let (inv, singular) = invert(a);
+        let flagged: Vec<usize> = (0..W).filter(|&l| singular[l]).collect();
+        assert_eq!(flagged, vec![3, 5]);
+        let m = [[2.0, 0.5, 0.5], [0.5, 2.0, 0.5], [0.5, 0.5, 2.0]];
+        let want = crate::msph::invert(m).unwrap();
+        for l in [0, 1, 2, 4, 6, 7] {
+            for r in 0..3 {
+                for c in 0..3 {
+                    assert!((inv[r][c][l] - want[r][c]).abs() < 1e-15);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn norm1_and_total() {
+        let m: LaneMatrix<2> = [[[1.0; W], [-2.0; W]], [[3.0; W], [0.5; W]]];
+        assert_eq!(norm1(&m), [4.0; W]);
+        let x: Lanes = std::array::from_fn(|l| l as f64);
+        assert_eq!(total(x), 28.0);
+    }
+}

@@ -1,0 +1,347 @@
+//! The pair pass of the axisymmetric solver, [`W`] particles at a time: each
+//! particle's neighbours in the support, its MSPH moment matrix, the
+//! [`W`] matrices inverted together in the lanes of one vector
+//! ([`crate::lanes::invert`]), then each pair's derivative and Shepard
+//! weights and the momentum equation.
+//!
+//! The lane arithmetic ([`crate::lanes`]) is plain IEEE arithmetic in a
+//! fixed order, so the results do not depend on the thread count or on the
+//! vector width the compiler picks.
+
+use super::boundary::Stress;
+use crate::kernel::SUPPORT;
+use crate::lanes::{self, Lanes, W};
+use crate::msph::{MAX_CONDITION, Neighbourhood, POWER_SUMS, moment_matrix_lanes};
+use multiversion::multiversion;
+/// Per-particle results of the pair pass.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct PairPass {
+    /// Neighbours in the support.
+    pub len: u32,
+    /// Condition number of a degenerate moment matrix, or zero.
+    pub condition: f64,
+    /// Smallest squared distance to another particle in the support.
+    pub min_d2: f64,
+    /// The same among particles not from the impact face (infinite for a
+    /// particle of the face).
+    pub min_d2_free: f64,
+}
+
+/// What the pair pass reads: the particles followed by their mirror images.
+pub(super) struct PairInputs<'a> {
+    /// Positions, volumes `m / rho`, stresses with boundary conditions.
+    pub pos: &'a [[f64; 2]],
+    pub vol: &'a [f64],
+    pub sbc: &'a [Stress],
+    /// Index ranges `[start, end)` of the particles that started on the
+    /// impact face and of their images.
+    pub face: [[u32; 2]; 2],
+    /// Candidate neighbours, padded rows of `stride`.
+    pub nbr: &'a [u32],
+    pub nbr_len: &'a [u32],
+    pub stride: usize,
+    /// Velocities `v^{n-1/2}` and densities of the real particles.
+    pub vel: &'a [[f64; 2]],
+    pub rho: &'a [f64],
+    /// Particles across the radius (axis particles are multiples of it).
+    pub nr: usize,
+    pub h: f64,
+    pub dt: f64,
+}
+
+/// What the pair pass writes for a batch of up to [`W`] particles: their
+/// padded rows of neighbours in the support and of weights, their
+/// [`PairPass`] records and their velocities `v^{n+1/2}`.
+pub(super) struct PairOutputs<'a> {
+    pub act: &'a mut [u32],
+    pub wr: &'a mut [f64],
+    pub wz: &'a mut [f64],
+    pub wk: &'a mut [f64],
+    pub part: &'a mut [PairPass],
+    pub vel: &'a mut [[f64; 2]],
+}
+
+/// One [`Neighbourhood`] per lane, reused from batch to batch.
+pub(super) struct Scratch {
+    hoods: Vec<Neighbourhood>,
+}
+
+impl Scratch {
+    /// Room for rows of `stride` candidates.
+    pub fn new(stride: usize) -> Self {
+        Scratch {
+            hoods: (0..W)
+                .map(|_| Neighbourhood::with_capacity(stride))
+                .collect(),
+        }
+    }
+}
+
+/// The stress-divergence sums of the momentum equation over the padded row
+/// `act` (padded slots have zero weight and a valid index): `sum_j g_j (s_j -
+/// s_i)` for (`g`, `s`) = (`wr`, RR), (`wr`, RZ), (`wz`, RZ), (`wz`, ZZ). Fixed
+/// order: lane partial sums, then [`lanes::total`].
+#[inline(always)]
+fn stress_divergence(act: &[u32], wr: &[f64], wz: &[f64], sbc: &[Stress], si: Stress) -> [f64; 4] {
+    let mut acc = [[0.0; W]; 4];
+    for c in (0..act.len()).step_by(W) {
+        let s = lanes::gather(sbc, act[c..c + W].try_into().expect("a whole lane"));
+        let (gr, gz) = (&wr[c..c + W], &wz[c..c + W]);
+        for l in 0..W {
+            acc[0][l] += gr[l] * (s[0][l] - si[0]);
+            acc[1][l] += gr[l] * (s[3][l] - si[3]);
+            acc[2][l] += gz[l] * (s[3][l] - si[3]);
+            acc[3][l] += gz[l] * (s[1][l] - si[1]);
+        }
+    }
+    acc.map(lanes::total)
+}
+
+/// The pair pass of the particles `i0 .. i0 + out.part.len()` (at most
+/// [`W`]). See the module documentation.
+#[multiversion(targets("x86_64+avx512f+avx512vl"))]
+pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch: &mut Scratch) {
+    let nb = out.part.len();
+    let stride = inp.stride;
+    let inv_h = 1.0 / inp.h;
+    let mut sums = [[0.0; W]; POWER_SUMS];
+    for p in 0..nb {
+        let i = i0 + p;
+        let xi = inp.pos[i];
+        let hood = &mut scratch.hoods[p];
+        hood.clear();
+        let act = &mut out.act[p * stride..(p + 1) * stride];
+        let on_face = |j: u32| inp.face.iter().any(|&[a, b]| a <= j && j < b);
+        let face_i = on_face(i as u32);
+        let (mut min_d2, mut min_d2_free) = ([f64::INFINITY; W], [f64::INFINITY; W]);
+        let cand = &inp.nbr[i * stride..(i + 1) * stride];
+        let n_cand = inp.nbr_len[i] as usize;
+        hood.reserve(n_cand);
+        for c in (0..n_cand).step_by(W) {
+            let idx: [u32; W] = cand[c..c + W].try_into().expect("a whole lane");
+            let [xr, xz] = lanes::gather(inp.pos, &idx);
+            let v = lanes::gather1(inp.vol, &idx);
+            let mut keep = [false; W];
+            let (mut sr, mut sz) = ([0.0; W], [0.0; W]);
+            for l in 0..W {
+                let (dr, dz) = (xr[l] - xi[0], xz[l] - xi[1]);
+                (sr[l], sz[l]) = (dr * inv_h, dz * inv_h);
+                keep[l] = sr[l] * sr[l] + sz[l] * sz[l] <= SUPPORT * SUPPORT && c + l < n_cand;
+                let d2 = dr * dr + dz * dz;
+                let other = keep[l] && idx[l] as usize != i;
+                let free = other && !face_i && !on_face(idx[l]);
+                // Plain compare-and-select: one vector instruction each.
+                if other && d2 < min_d2[l] {
+                    min_d2[l] = d2;
+                }
+                if free && d2 < min_d2_free[l] {
+                    min_d2_free[l] = d2;
+                }
+            }
+            let mut k = hood.len();
+            for l in 0..W {
+                act[k] = idx[l];
+                k += keep[l] as usize;
+            }
+            hood.push_lanes(keep, sr, sz, v);
+        }
+        let fold = |x: Lanes| x.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        let (min_d2, min_d2_free) = (fold(min_d2), fold(min_d2_free));
+        let len = hood.len();
+        // Padded slots: the particle itself, with zero weight.
+        for a in &mut act[len..hood.padded_len()] {
+            *a = i as u32;
+        }
+        out.part[p] = PairPass {
+            len: len as u32,
+            condition: 0.0,
+            min_d2,
+            min_d2_free,
+        };
+        for (k, x) in hood.power_sums().iter().enumerate() {
+            sums[k][p] = *x;
+        }
+    }
+    let mut b = moment_matrix_lanes(&sums);
+    // Identity in the unused lanes keeps their elimination harmless.
+    for p in nb..W {
+        for (r, row) in b.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                x[p] = if r == c { 1.0 } else { 0.0 };
+            }
+        }
+    }
+    let (inv, singular) = lanes::invert(b);
+    let (nb1, ni1) = (lanes::norm1(&b), lanes::norm1(&inv));
+    for p in 0..nb {
+        let i = i0 + p;
+        let cond = nb1[p] * ni1[p];
+        if singular[p] || !cond.is_finite() || cond > MAX_CONDITION {
+            out.part[p].condition = if singular[p] { f64::INFINITY } else { cond };
+            out.part[p].len = 0;
+            out.vel[p] = inp.vel[i];
+            continue;
+        }
+        let hood = &scratch.hoods[p];
+        let padded = hood.padded_len();
+        let row = p * stride..p * stride + padded;
+        let (wr, wz, wk) = (
+            &mut out.wr[row.clone()],
+            &mut out.wz[row.clone()],
+            &mut out.wk[row.clone()],
+        );
+        let rows: [[f64; 6]; 2] = [1, 2].map(|r| std::array::from_fn(|c| inv[r][c][p]));
+        let wsum = hood.weights_of(&rows, &[inv_h; 2], [&mut *wr, &mut *wz], wk);
+        // Shepard weights W_ij V_j / sum_j W_ij V_j (the kernel's
+        // normalisation cancels).
+        let inv_sum = 1.0 / wsum;
+        for w in wk.iter_mut() {
+            *w *= inv_sum;
+        }
+        // Momentum: v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
+        let si = inp.sbc[i];
+        let act = &out.act[row];
+        let [drr_r, drz_r, drz_z, dzz_z] = stress_divergence(act, wr, wz, inp.sbc, si);
+        let (v, rho, dt) = (inp.vel[i], inp.rho[i], inp.dt);
+        out.vel[p] = if i.is_multiple_of(inp.nr) {
+            [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho]
+        } else {
+            let r = inp.pos[i][0];
+            [
+                v[0] + dt * (drr_r + (si[0] - si[2]) / r + drz_z) / rho,
+                v[1] + dt * (drz_r + si[3] / r + dzz_z) / rho,
+            ]
+        };
+    }
+}
+
+/// The padded per-particle rows written by the pair pass, for the passes
+/// that follow it.
+#[derive(Clone, Copy)]
+pub(super) struct Rows<'a> {
+    pub act: &'a [u32],
+    pub wr: &'a [f64],
+    pub wz: &'a [f64],
+    pub wk: &'a [f64],
+    pub part: &'a [PairPass],
+    pub stride: usize,
+}
+
+impl Rows<'_> {
+    /// Slots of particle `i`: its neighbours in the support, padded to whole
+    /// lanes with zero-weight slots.
+    #[inline(always)]
+    fn range(&self, i: usize) -> std::ops::Range<usize> {
+        let start = i * self.stride;
+        start..start + (self.part[i].len as usize).next_multiple_of(W)
+    }
+}
+
+/// Shepard means `sum_j s_ij f_j` of the particles `i0 .. i0 + out.len()`.
+#[multiversion(targets("x86_64+avx512f+avx512vl"))]
+pub(super) fn shepard_means<const K: usize>(
+    rows: Rows,
+    f: &[[f64; K]],
+    i0: usize,
+    out: &mut [[f64; K]],
+) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let r = rows.range(i0 + k);
+        let (act, wk) = (&rows.act[r.clone()], &rows.wk[r]);
+        let mut acc = [[0.0; W]; K];
+        for c in (0..act.len()).step_by(W) {
+            let fj = lanes::gather(f, act[c..c + W].try_into().expect("a whole lane"));
+            for m in 0..K {
+                for l in 0..W {
+                    acc[m][l] += wk[c + l] * fj[m][l];
+                }
+            }
+        }
+        *o = acc.map(lanes::total);
+    }
+}
+
+/// Velocity gradients (dU_R/dR, dU_R/dZ, dU_Z/dR, dU_Z/dZ) of the particles
+/// `i0 .. i0 + out.len()`.
+#[multiversion(targets("x86_64+avx512f+avx512vl"))]
+pub(super) fn velocity_gradients(rows: Rows, vel: &[[f64; 2]], i0: usize, out: &mut [[f64; 4]]) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let i = i0 + k;
+        let vi = vel[i];
+        let r = rows.range(i);
+        let (act, wr, wz) = (&rows.act[r.clone()], &rows.wr[r.clone()], &rows.wz[r]);
+        let mut acc = [[0.0; W]; 4];
+        for c in (0..act.len()).step_by(W) {
+            let [vr, vz] = lanes::gather(vel, act[c..c + W].try_into().expect("a whole lane"));
+            for l in 0..W {
+                let (dr, dz) = (vr[l] - vi[0], vz[l] - vi[1]);
+                acc[0][l] += wr[c + l] * dr;
+                acc[1][l] += wz[c + l] * dr;
+                acc[2][l] += wr[c + l] * dz;
+                acc[3][l] += wz[c + l] * dz;
+            }
+        }
+        *o = acc.map(lanes::total);
+    }
+}
+
+/// Conservative smoothing, eq. (3.23): `f_i + alpha (mean - f_i)` with the
+/// Shepard mean of the neighbours; with `alpha = 0` the value is returned
+/// unchanged.
+#[inline]
+pub(super) fn smooth<const K: usize>(fi: [f64; K], mean: [f64; K], alpha: f64) -> [f64; K] {
+    if alpha == 0.0 {
+        return fi;
+    }
+    std::array::from_fn(|k| fi[k] + alpha * (mean[k] - fi[k]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smoothing_keeps_constants_and_damps_a_spike() {
+        // Twenty particles on a line, each with its (up to three) nearest
+        // neighbours at equal Shepard weights, in padded rows.
+        let n = 20;
+        let stride = W;
+        let (mut act, mut wk) = (vec![0u32; n * stride], vec![0.0; n * stride]);
+        let mut part = vec![PairPass::default(); n];
+        for i in 0..n {
+            let nb: Vec<usize> = (i.saturating_sub(1)..(i + 2).min(n)).collect();
+            for (k, &j) in nb.iter().enumerate() {
+                act[i * stride + k] = j as u32;
+                wk[i * stride + k] = 1.0 / nb.len() as f64;
+            }
+            for k in nb.len()..stride {
+                act[i * stride + k] = i as u32;
+            }
+            part[i].len = nb.len() as u32;
+        }
+        let zeros = vec![0.0; n * stride];
+        let rows = Rows {
+            act: &act,
+            wr: &zeros,
+            wz: &zeros,
+            wk: &wk,
+            part: &part,
+            stride,
+        };
+        let smooth_all = |f: &[[f64; 1]], alpha: f64| -> Vec<[f64; 1]> {
+            let mut means = vec![[0.0]; n];
+            shepard_means(rows, f, 0, &mut means);
+            (0..n).map(|i| smooth(f[i], means[i], alpha)).collect()
+        };
+        let c = vec![[3.0]; n];
+        for (a, b) in smooth_all(&c, 0.3).iter().zip(&c) {
+            assert!((a[0] - b[0]).abs() < 1e-14);
+        }
+        let mut spike = vec![[0.0]; n];
+        spike[10] = [3.0];
+        let out = smooth_all(&spike, 0.3);
+        assert!((out[10][0] - (3.0 + 0.3 * (1.0 - 3.0))).abs() < 1e-12);
+        assert!((out[9][0] - 0.3).abs() < 1e-12);
+        assert_eq!(smooth_all(&spike, 0.0), spike);
+    }
+}
