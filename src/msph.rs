@@ -328,6 +328,14 @@ impl Neighbourhood {
         self.len += k;
     }
 
+    /// The offset and weight buffers (`sr`, `sz`, `v`, each with room for
+    /// what [`Neighbourhood::reserve`] asked) and the neighbour count, for a
+    /// caller that appends neighbours with its own vector code. Entries
+    /// `0..len` must be set when `len` is raised.
+    pub(crate) fn buffers(&mut self) -> (&mut [f64], &mut [f64], &mut [f64], &mut usize) {
+        (&mut self.sr, &mut self.sz, &mut self.v, &mut self.len)
+    }
+
     /// Zero-weight lanes after the last neighbour up to a whole lane, and
     /// the Gaussians `exp(-|s|^2)` of every neighbour.
     #[inline(always)]

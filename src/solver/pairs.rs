@@ -13,6 +13,13 @@ use crate::kernel::SUPPORT;
 use crate::lanes::{self, Lanes, W};
 use crate::msph::{MAX_CONDITION, Neighbourhood, POWER_SUMS, moment_matrix_lanes};
 use multiversion::multiversion;
+use multiversion::target::match_target;
+
+// AVX-512 versions of parts of the pair pass, chosen at run time; the only
+// unsafe code outside the C and FMI layers (vector loads, gathers, stores).
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx512;
 /// Per-particle results of the pair pass.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct PairPass {
@@ -97,6 +104,67 @@ fn stress_divergence(act: &[u32], wr: &[f64], wz: &[f64], sbc: &[Stress], si: St
     acc.map(lanes::total)
 }
 
+/// Whether particle `j` is one of the impact-face particles or their images
+/// (the index ranges `face`).
+#[inline(always)]
+fn on_face(face: &[[u32; 2]; 2], j: u32) -> bool {
+    face.iter().any(|&[a, b]| a <= j && j < b)
+}
+
+/// Appends the candidates of particle `i` that lie in its support to `hood`
+/// (scaled offsets and volumes) and their indices to `act`, in candidate
+/// order, and returns the smallest squared distances to another particle in
+/// the support: over all of them, and over those not from the impact face
+/// (infinite when `face_i`, the particle itself is from the face).
+/// [`avx512::scan_candidates`] is the same with AVX-512 compress
+/// instructions, bit for bit.
+#[inline(always)]
+fn scan_candidates(
+    inp: &PairInputs,
+    i: usize,
+    face_i: bool,
+    hood: &mut Neighbourhood,
+    act: &mut [u32],
+) -> (f64, f64) {
+    let stride = inp.stride;
+    let xi = inp.pos[i];
+    let inv_h = 1.0 / inp.h;
+    let (mut min_d2, mut min_d2_free) = ([f64::INFINITY; W], [f64::INFINITY; W]);
+    let cand = &inp.nbr[i * stride..(i + 1) * stride];
+    let n_cand = inp.nbr_len[i] as usize;
+    hood.reserve(n_cand);
+    for c in (0..n_cand).step_by(W) {
+        let idx: [u32; W] = cand[c..c + W].try_into().expect("a whole lane");
+        let [xr, xz] = lanes::gather(inp.pos, &idx);
+        let v = lanes::gather1(inp.vol, &idx);
+        let mut keep = [false; W];
+        let (mut sr, mut sz) = ([0.0; W], [0.0; W]);
+        for l in 0..W {
+            let (dr, dz) = (xr[l] - xi[0], xz[l] - xi[1]);
+            (sr[l], sz[l]) = (dr * inv_h, dz * inv_h);
+            keep[l] = sr[l] * sr[l] + sz[l] * sz[l] <= SUPPORT * SUPPORT && c + l < n_cand;
+            let d2 = dr * dr + dz * dz;
+            let other = keep[l] && idx[l] as usize != i;
+            let free = other && !face_i && !on_face(&inp.face, idx[l]);
+            // Plain compare-and-select: one vector instruction each.
+            if other && d2 < min_d2[l] {
+                min_d2[l] = d2;
+            }
+            if free && d2 < min_d2_free[l] {
+                min_d2_free[l] = d2;
+            }
+        }
+        let mut k = hood.len();
+        for l in 0..W {
+            act[k] = idx[l];
+            k += keep[l] as usize;
+        }
+        hood.push_lanes(keep, sr, sz, v);
+    }
+    let fold = |x: Lanes| x.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    (fold(min_d2), fold(min_d2_free))
+}
+
 /// The pair pass of the particles `i0 .. i0 + out.part.len()` (at most
 /// [`W`]). See the module documentation.
 #[multiversion(targets("x86_64+avx512f+avx512vl"))]
@@ -107,46 +175,14 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
     let mut sums = [[0.0; W]; POWER_SUMS];
     for p in 0..nb {
         let i = i0 + p;
-        let xi = inp.pos[i];
         let hood = &mut scratch.hoods[p];
         hood.clear();
         let act = &mut out.act[p * stride..(p + 1) * stride];
-        let on_face = |j: u32| inp.face.iter().any(|&[a, b]| a <= j && j < b);
-        let face_i = on_face(i as u32);
-        let (mut min_d2, mut min_d2_free) = ([f64::INFINITY; W], [f64::INFINITY; W]);
-        let cand = &inp.nbr[i * stride..(i + 1) * stride];
-        let n_cand = inp.nbr_len[i] as usize;
-        hood.reserve(n_cand);
-        for c in (0..n_cand).step_by(W) {
-            let idx: [u32; W] = cand[c..c + W].try_into().expect("a whole lane");
-            let [xr, xz] = lanes::gather(inp.pos, &idx);
-            let v = lanes::gather1(inp.vol, &idx);
-            let mut keep = [false; W];
-            let (mut sr, mut sz) = ([0.0; W], [0.0; W]);
-            for l in 0..W {
-                let (dr, dz) = (xr[l] - xi[0], xz[l] - xi[1]);
-                (sr[l], sz[l]) = (dr * inv_h, dz * inv_h);
-                keep[l] = sr[l] * sr[l] + sz[l] * sz[l] <= SUPPORT * SUPPORT && c + l < n_cand;
-                let d2 = dr * dr + dz * dz;
-                let other = keep[l] && idx[l] as usize != i;
-                let free = other && !face_i && !on_face(idx[l]);
-                // Plain compare-and-select: one vector instruction each.
-                if other && d2 < min_d2[l] {
-                    min_d2[l] = d2;
-                }
-                if free && d2 < min_d2_free[l] {
-                    min_d2_free[l] = d2;
-                }
-            }
-            let mut k = hood.len();
-            for l in 0..W {
-                act[k] = idx[l];
-                k += keep[l] as usize;
-            }
-            hood.push_lanes(keep, sr, sz, v);
-        }
-        let fold = |x: Lanes| x.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-        let (min_d2, min_d2_free) = (fold(min_d2), fold(min_d2_free));
+        let face_i = on_face(&inp.face, i as u32);
+        let (min_d2, min_d2_free) = match_target! {
+            "x86_64+avx512f+avx512vl" => avx512::scan_candidates(inp, i, face_i, hood, act),
+            _ => scan_candidates(inp, i, face_i, hood, act),
+        };
         let len = hood.len();
         // Padded slots: the particle itself, with zero weight.
         for a in &mut act[len..hood.padded_len()] {
@@ -343,5 +379,96 @@ mod tests {
         assert!((out[10][0] - (3.0 + 0.3 * (1.0 - 3.0))).abs() < 1e-12);
         assert!((out[9][0] - 0.3).abs() < 1e-12);
         assert_eq!(smooth_all(&spike, 0.0), spike);
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod avx512_tests {
+    use super::*;
+    use crate::neighbors::cell_list_first;
+
+    /// The AVX-512 candidate scan gives the portable scan's neighbourhoods,
+    /// rows and minimum distances bit for bit, on a jittered lattice whose
+    /// first row plays the impact face (so both minima are exercised).
+    #[test]
+    #[allow(unsafe_code)]
+    fn avx512_scan_equals_portable_scan() {
+        if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
+            eprintln!("no AVX-512 on this machine: nothing to compare");
+            return;
+        }
+        let (nr, nz, h) = (9, 14, 1.3);
+        let mut seed = 7u64;
+        let mut jitter = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.6
+        };
+        let pos: Vec<[f64; 2]> = (0..nr * nz)
+            .map(|k| [(k % nr) as f64 + jitter(), (k / nr) as f64 + jitter()])
+            .collect();
+        let n = pos.len();
+        let vol: Vec<f64> = (0..n).map(|k| 1.0 + 0.01 * k as f64).collect();
+        let nl = cell_list_first(&pos, n, (SUPPORT + 0.3) * h);
+        let stride = (0..n)
+            .map(|i| nl.of(i).len())
+            .max()
+            .unwrap()
+            .next_multiple_of(W);
+        let mut nbr = vec![0u32; n * stride];
+        let mut nbr_len = vec![0u32; n];
+        for i in 0..n {
+            for (k, &j) in nl.of(i).iter().enumerate() {
+                nbr[i * stride + k] = j as u32;
+            }
+            nbr_len[i] = nl.of(i).len() as u32;
+        }
+        let zeros = vec![[0.0; 4]; n];
+        let inp = PairInputs {
+            pos: &pos,
+            vol: &vol,
+            sbc: &zeros,
+            face: [[0, nr as u32], [n as u32, n as u32]],
+            nbr: &nbr,
+            nbr_len: &nbr_len,
+            stride,
+            vel: &[],
+            rho: &[],
+            nr,
+            h,
+            dt: 0.0,
+        };
+        let (mut faces, mut kept, mut candidates) = (0, 0, 0);
+        for i in 0..n {
+            let face_i = on_face(&inp.face, i as u32);
+            faces += face_i as usize;
+            let (mut a, mut b) = (
+                Neighbourhood::with_capacity(stride),
+                Neighbourhood::with_capacity(stride),
+            );
+            let (mut act_a, mut act_b) = (vec![0u32; stride], vec![0u32; stride]);
+            let ma = scan_candidates(&inp, i, face_i, &mut a, &mut act_a);
+            // SAFETY: the CPU has AVX-512F and VL (checked above).
+            let mb = unsafe { avx512::scan_candidates(&inp, i, face_i, &mut b, &mut act_b) };
+            assert_eq!(ma.0.to_bits(), mb.0.to_bits(), "particle {i}");
+            assert_eq!(ma.1.to_bits(), mb.1.to_bits(), "particle {i}");
+            assert!(ma.0 > 0.0 && ma.0.is_finite());
+            assert_eq!(ma.1.is_infinite(), face_i);
+            let len = a.len();
+            assert_eq!(len, b.len());
+            assert!(
+                len >= 4 && len <= nbr_len[i] as usize,
+                "particle {i}: {len}"
+            );
+            (kept, candidates) = (kept + len, candidates + nbr_len[i] as usize);
+            assert_eq!(act_a[..len], act_b[..len]);
+            let (ra, za, va, _) = a.buffers();
+            let (rb, zb, vb, _) = b.buffers();
+            assert_eq!(ra[..len], rb[..len]);
+            assert_eq!(za[..len], zb[..len]);
+            assert_eq!(va[..len], vb[..len]);
+        }
+        assert_eq!(faces, nr);
+        // The skin holds candidates outside the support: some were dropped.
+        assert!(kept < candidates * 9 / 10, "{kept} of {candidates}");
     }
 }

@@ -1,0 +1,110 @@
+//! AVX-512 versions of parts of the pair pass, called from the AVX-512 clone
+//! of [`super::pair_batch`] only. Each gives the same result bit for bit as
+//! the portable code it replaces (the same IEEE operations in the same order;
+//! compaction and minima are exact); a test runs both on the same input.
+//!
+//! The vector loads, gathers and stores take raw pointers. Every gather
+//! index is checked against the length of the slice it reads, and every
+//! store against the room of the slice it writes, before the access.
+
+use super::{Neighbourhood, PairInputs};
+use crate::kernel::SUPPORT;
+use crate::lanes::W;
+use std::arch::x86_64::*;
+
+/// `(1 << k) - 1`: the low `k` of [`W`] lanes.
+#[inline(always)]
+fn low_lanes(k: usize) -> u8 {
+    (((1u32 << k) - 1) & 0xff) as u8
+}
+
+/// [`super::scan_candidates`] with AVX-512: the [`W`] candidates of a lane
+/// are gathered, tested against the support and compressed into the
+/// neighbourhood and the row `act` with `vcompresspd` / `vpcompressd`
+/// instead of one scalar store per candidate.
+#[target_feature(enable = "avx512f,avx512vl")]
+pub(super) fn scan_candidates(
+    inp: &PairInputs,
+    i: usize,
+    face_i: bool,
+    hood: &mut Neighbourhood,
+    act: &mut [u32],
+) -> (f64, f64) {
+    let stride = inp.stride;
+    let cand = &inp.nbr[i * stride..(i + 1) * stride];
+    let n_cand = inp.nbr_len[i] as usize;
+    assert!(n_cand <= stride && stride.is_multiple_of(W) && act.len() >= n_cand);
+    hood.reserve(n_cand);
+    let (out_r, out_z, out_v, len) = hood.buffers();
+    assert!(out_r.len() >= n_cand && out_z.len() >= n_cand && out_v.len() >= n_cand);
+    // Every particle's position (two doubles) and volume can be gathered.
+    let reach = inp.pos.len().min(inp.vol.len());
+    assert!(reach < (i32::MAX / 2) as usize);
+    let reach = _mm256_set1_epi32(reach as i32);
+    let pos = inp.pos.as_ptr().cast::<f64>();
+    let inv_h = _mm512_set1_pd(1.0 / inp.h);
+    let (xi, zi) = (_mm512_set1_pd(inp.pos[i][0]), _mm512_set1_pd(inp.pos[i][1]));
+    let support2 = _mm512_set1_pd(SUPPORT * SUPPORT);
+    let me = _mm256_set1_epi32(i as i32);
+    let face = inp
+        .face
+        .map(|[a, b]| [a, b].map(|x| _mm256_set1_epi32(x as i32)));
+    let mut min_d2 = _mm512_set1_pd(f64::INFINITY);
+    let mut min_free = min_d2;
+    let mut k = *len;
+    for c in (0..n_cand).step_by(W) {
+        let valid = low_lanes((n_cand - c).min(W));
+        // SAFETY: `c + W <= stride = cand.len()` (stride is whole lanes).
+        let idx = unsafe { _mm256_loadu_si256(cand[c..c + W].as_ptr().cast()) };
+        assert_eq!(
+            _mm256_cmpge_epu32_mask(idx, reach),
+            0,
+            "candidate out of range"
+        );
+        let idx2 = _mm256_add_epi32(idx, idx);
+        // SAFETY: every index is below the lengths of `pos` and `vol`
+        // (checked above), so each gathered double lies inside them.
+        let (xr, xz, v) = unsafe {
+            (
+                _mm512_i32gather_pd::<8>(idx2, pos),
+                _mm512_i32gather_pd::<8>(idx2, pos.add(1)),
+                _mm512_i32gather_pd::<8>(idx, inp.vol.as_ptr()),
+            )
+        };
+        let (dr, dz) = (_mm512_sub_pd(xr, xi), _mm512_sub_pd(xz, zi));
+        let (sr, sz) = (_mm512_mul_pd(dr, inv_h), _mm512_mul_pd(dz, inv_h));
+        let q2 = _mm512_add_pd(_mm512_mul_pd(sr, sr), _mm512_mul_pd(sz, sz));
+        let keep = _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(valid, q2, support2);
+        let d2 = _mm512_add_pd(_mm512_mul_pd(dr, dr), _mm512_mul_pd(dz, dz));
+        let other = keep & _mm256_cmpneq_epi32_mask(idx, me);
+        let closer = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(other, d2, min_d2);
+        min_d2 = _mm512_mask_blend_pd(closer, min_d2, d2);
+        if !face_i {
+            let in_range = |[a, b]: [__m256i; 2]| {
+                _mm256_cmpge_epu32_mask(idx, a) & _mm256_cmplt_epu32_mask(idx, b)
+            };
+            let free = other & !(in_range(face[0]) | in_range(face[1]));
+            let closer = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(free, d2, min_free);
+            min_free = _mm512_mask_blend_pd(closer, min_free, d2);
+        }
+        let n = keep.count_ones() as usize;
+        let room = low_lanes(n);
+        assert!(k + n <= n_cand);
+        // SAFETY: `k + n <= n_cand` and every output holds at least `n_cand`
+        // entries (asserted above); the masked stores write `n` of them.
+        unsafe {
+            let at = |x: &mut [f64]| x[k..].as_mut_ptr();
+            _mm512_mask_storeu_pd(at(out_r), room, _mm512_maskz_compress_pd(keep, sr));
+            _mm512_mask_storeu_pd(at(out_z), room, _mm512_maskz_compress_pd(keep, sz));
+            _mm512_mask_storeu_pd(at(out_v), room, _mm512_maskz_compress_pd(keep, v));
+            _mm256_mask_storeu_epi32(
+                act[k..].as_mut_ptr().cast(),
+                room,
+                _mm256_maskz_compress_epi32(keep, idx),
+            );
+        }
+        k += n;
+    }
+    *len = k;
+    (_mm512_reduce_min_pd(min_d2), _mm512_reduce_min_pd(min_free))
+}
