@@ -48,7 +48,7 @@ const INV_FACTORIAL: [f64; 14] = [
 /// `x = -|s|^2` with `|s| <= 2`). Within 2 ulp of the correctly rounded value
 /// (tested against the standard library), branch-free: `x = k ln 2 + r` with
 /// `k` the nearest integer to `x / ln 2`, a degree-13 Taylor polynomial of
-/// `exp(r)`, and `2^k` built in the exponent bits.
+/// `exp(r)` (Estrin's scheme), and `2^k` built in the exponent bits.
 #[inline(always)]
 pub fn exp(x: Lanes) -> Lanes {
     let mut out = [0.0; W];
@@ -56,10 +56,13 @@ pub fn exp(x: Lanes) -> Lanes {
         let t = x[l] * std::f64::consts::LOG2_E + ROUND_MAGIC;
         let k = t - ROUND_MAGIC;
         let r = (x[l] - k * LN2_HI) - k * LN2_LO;
-        let mut p = INV_FACTORIAL[13];
-        for c in (0..13).rev() {
-            p = p * r + INV_FACTORIAL[c];
-        }
+        // Estrin's scheme: eight operations deep instead of Horner's 26.
+        let c = &INV_FACTORIAL;
+        let (r2, pair) = (r * r, |k: usize| c[k] + c[k + 1] * r);
+        let r4 = r2 * r2;
+        let lo = (pair(0) + pair(2) * r2) + (pair(4) + pair(6) * r2) * r4;
+        let hi = (pair(8) + pair(10) * r2) + pair(12) * r4;
+        let p = lo + hi * (r4 * r4);
         // The low bits of `t` hold `k` (two's complement over the magic).
         let ki = t.to_bits().wrapping_sub(ROUND_MAGIC.to_bits());
         let scale = f64::from_bits(ki.wrapping_add(1023) << 52);
