@@ -110,15 +110,52 @@ pub const SKIN: f64 = 0.3;
 /// Smallest number of particles a thread takes at a time.
 const MIN_LEN: usize = 64;
 
-/// Per-particle result of the constitutive update.
+/// What the pair pass found in a batch of [`W`] particles.
+#[derive(Debug, Clone, Copy)]
+struct BatchTally {
+    /// First particle with a degenerate moment matrix, and its condition.
+    singular: Option<(usize, f64)>,
+    /// Smallest squared distances between neighbours: all pairs, and pairs
+    /// without a particle of the impact face.
+    min_d2: f64,
+    min_d2_free: f64,
+    /// Kinetic energy removed by holding particles on the anvil.
+    held: f64,
+}
+
+impl Default for BatchTally {
+    fn default() -> Self {
+        BatchTally {
+            singular: None,
+            min_d2: f64::INFINITY,
+            min_d2_free: f64::INFINITY,
+            held: 0.0,
+        }
+    }
+}
+
+/// The sums of a chunk of [`MIN_LEN`] particles at the end of a step, added
+/// chunk by chunk in index order afterwards (so the totals do not depend on
+/// the thread count).
 #[derive(Debug, Clone, Copy, Default)]
-struct Update {
-    dev: Stress,
-    pressure: f64,
-    rho: f64,
-    plastic_strain: f64,
-    temp: f64,
-    energy: f64,
+struct Tally {
+    /// Internal energy added by the stress power.
+    internal: f64,
+    /// Kinetic energy, and axial momentum `sum m U_Z`, at the end.
+    kinetic: f64,
+    momentum: f64,
+    mass: f64,
+    /// Kinetic energy removed by particles reaching the anvil.
+    contact_lost: f64,
+    /// Largest `c + |v|` (for the time step).
+    worst_speed: f64,
+    /// Whether a particle touches the anvil.
+    touching: bool,
+    /// First particle through the anvil or the axis: (particle, boundary,
+    /// position).
+    through: Option<(usize, &'static str, f64)>,
+    /// First particle with a non-finite field: (particle, field).
+    non_finite: Option<(usize, &'static str)>,
 }
 
 /// Buffers reused from step to step (no allocation in the time loop but when
@@ -154,7 +191,11 @@ struct Workspace {
     wk: Vec<f64>,
     part: Vec<PairPass>,
     grads: Vec<[f64; 4]>,
-    upd: Vec<Update>,
+    /// Per batch of the pair pass, per chunk of the smoothing pass (kinetic
+    /// energy before and after) and per chunk of the update pass.
+    batches: Vec<BatchTally>,
+    smoothing: Vec<[f64; 2]>,
+    tallies: Vec<Tally>,
 }
 
 /// Writes the image values `f[n + k] = mirror(f[ghosts[k]])`.
@@ -165,12 +206,41 @@ fn fill_images<T: Copy>(f: &mut [T], n: usize, ghosts: &[u32], mirror: impl Fn(T
     }
 }
 
+/// Kinetic energy of a particle of mass `m` and velocity `v`.
+#[inline]
+fn kinetic1(v: [f64; 2], m: f64) -> f64 {
+    0.5 * m * (v[0] * v[0] + v[1] * v[1])
+}
+
 /// Kinetic energy of particles of masses `m` and velocities `v`.
 fn kinetic(v: &[[f64; 2]], m: &[f64]) -> f64 {
-    v.iter()
-        .zip(m)
-        .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
-        .sum()
+    v.iter().zip(m).map(|(v, m)| kinetic1(*v, *m)).sum()
+}
+
+/// The speed that bounds the time step at a particle: the longitudinal wave
+/// speed `sqrt(modulus / rho)` plus the particle speed.
+#[inline]
+fn wave_and_flow_speed(modulus: f64, rho: f64, v: [f64; 2]) -> f64 {
+    (modulus / rho).sqrt() + (v[0] * v[0] + v[1] * v[1]).sqrt()
+}
+
+/// The first non-finite field of a particle, in the order position,
+/// velocity, density, deviatoric stress, temperature.
+fn non_finite(x: [f64; 2], v: [f64; 2], rho: f64, dev: Stress, temp: f64) -> Option<&'static str> {
+    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+    if !finite(&x) {
+        Some("position")
+    } else if !finite(&v) {
+        Some("velocity")
+    } else if !rho.is_finite() {
+        Some("density")
+    } else if !finite(&dev) {
+        Some("deviatoric stress")
+    } else if !temp.is_finite() {
+        Some("temperature")
+    } else {
+        None
+    }
 }
 
 impl TaylorSolver {
@@ -316,7 +386,7 @@ impl TaylorSolver {
             .rho
             .iter()
             .zip(&self.vel)
-            .map(|(rho, v)| (m / rho).sqrt() + (v[0] * v[0] + v[1] * v[1]).sqrt())
+            .map(|(rho, v)| wave_and_flow_speed(m, *rho, *v))
             .fold(0.0, f64::max);
         COURANT * self.h / worst
     }
@@ -372,7 +442,9 @@ impl TaylorSolver {
         ws.rho.resize(m, [0.0]);
         ws.part.resize(n, PairPass::default());
         ws.grads.resize(n, [0.0; 4]);
-        ws.upd.resize(n, Update::default());
+        ws.batches.resize(n.div_ceil(W), BatchTally::default());
+        ws.smoothing.resize(n.div_ceil(MIN_LEN), [0.0; 2]);
+        ws.tallies.resize(n.div_ceil(MIN_LEN), Tally::default());
     }
 
     /// Whether a particle moved more than half the skin since the lists were
@@ -430,7 +502,9 @@ impl TaylorSolver {
             wk,
             part,
             grads,
-            upd,
+            batches,
+            smoothing,
+            tallies,
             ..
         } = ws;
         let stride = (*stride).max(1);
@@ -446,7 +520,8 @@ impl TaylorSolver {
         // 1-2. Per particle: the MSPH moment matrix over the neighbours in
         // the support, the derivative and Shepard weights of each pair, and
         // the momentum equation v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho,
-        // W particles at a time (src/solver/pairs.rs).
+        // W particles at a time (src/solver/pairs.rs); then U_Z = 0 on the
+        // particles touching the anvil.
         let inputs = PairInputs {
             pos,
             vol,
@@ -462,6 +537,7 @@ impl TaylorSolver {
             dt,
         };
         let batch = W * stride;
+        let (mass, contact) = (&self.mass, &self.contact);
         (
             act.par_chunks_mut(batch),
             wr.par_chunks_mut(batch),
@@ -469,49 +545,66 @@ impl TaylorSolver {
             wk.par_chunks_mut(batch),
             part.par_chunks_mut(W),
             vel[..n].par_chunks_mut(W),
+            batches.par_iter_mut(),
         )
             .into_par_iter()
             .enumerate()
             .with_min_len(MIN_LEN / W)
             .for_each_init(
                 || Scratch::new(stride),
-                |scratch, (b, (act, wr, wz, wk, part, vel))| {
+                |scratch, (b, (act, wr, wz, wk, part, vel, tally))| {
+                    let i0 = b * W;
                     let out = PairOutputs {
                         act,
                         wr,
                         wz,
                         wk,
-                        part,
-                        vel,
+                        part: &mut *part,
+                        vel: &mut *vel,
                     };
-                    pair_batch(&inputs, b * W, out, scratch);
+                    pair_batch(&inputs, i0, out, scratch);
+                    let mut t = BatchTally::default();
+                    for (k, (p, v)) in part.iter().zip(vel.iter_mut()).enumerate() {
+                        let i = i0 + k;
+                        if p.condition != 0.0 && t.singular.is_none() {
+                            t.singular = Some((i, p.condition));
+                        }
+                        t.min_d2 = t.min_d2.min(p.min_d2);
+                        t.min_d2_free = t.min_d2_free.min(p.min_d2_free);
+                        if contact[i] {
+                            t.held += 0.5 * mass[i] * v[1] * v[1];
+                            v[1] = 0.0;
+                        }
+                    }
+                    *tally = t;
                 },
             );
-        if let Some((i, p)) = part.iter().enumerate().find(|(_, p)| p.condition != 0.0) {
+        let mut a = BatchTally::default();
+        for t in batches.iter() {
+            a.singular = a.singular.or(t.singular);
+            a.min_d2 = a.min_d2.min(t.min_d2);
+            a.min_d2_free = a.min_d2_free.min(t.min_d2_free);
+            a.held += t.held;
+        }
+        if let Some((particle, condition)) = a.singular {
             return Err(Error::SingularMomentMatrix {
-                particle: i,
+                particle,
                 time: self.time,
-                condition: p.condition,
+                condition,
             });
         }
-        let min_d2 = part.iter().map(|p| p.min_d2).fold(f64::INFINITY, f64::min);
-        let min_d2_free = part
-            .iter()
-            .map(|p| p.min_d2_free)
-            .fold(f64::INFINITY, f64::min);
         let d0 = self.r0 / (self.nr - 1) as f64;
-        self.min_spacing = self.min_spacing.min(min_d2.sqrt() / d0);
-        if min_d2_free.sqrt() / d0 < SPACING_COLLAPSE_BOUND {
+        self.min_spacing = self.min_spacing.min(a.min_d2.sqrt() / d0);
+        if a.min_d2_free.sqrt() / d0 < SPACING_COLLAPSE_BOUND {
             return Err(Error::SpacingCollapse {
-                ratio: min_d2_free.sqrt() / d0,
+                ratio: a.min_d2_free.sqrt() / d0,
                 bound: SPACING_COLLAPSE_BOUND,
                 time: self.time,
             });
         }
-        self.contact_dissipation += self.hold_on_anvil(&mut vel[..n]);
+        self.contact_dissipation += a.held;
 
         // 3. Conservative smoothing of the velocity.
-        let ke_before = kinetic(&vel[..n], &self.mass);
         fill_images(vel, n, ghosts, |v| [-v[0], v[1]]);
         let rows = Rows {
             act,
@@ -523,25 +616,31 @@ impl TaylorSolver {
         };
         {
             let vel = &*vel;
-            vel_s[..n]
-                .par_chunks_mut(MIN_LEN)
+            (vel_s[..n].par_chunks_mut(MIN_LEN), smoothing.par_iter_mut())
+                .into_par_iter()
                 .enumerate()
-                .for_each(|(c, out)| {
+                .for_each(|(c, (out, ke))| {
                     let i0 = c * MIN_LEN;
                     shepard_means(rows, vel, i0, out);
+                    *ke = [0.0; 2];
                     for (k, v) in out.iter_mut().enumerate() {
                         let i = i0 + k;
                         *v = smooth(vel[i], *v, alpha);
                         if axis(i) {
                             v[0] = 0.0;
                         }
-                        if self.contact[i] {
+                        if contact[i] {
                             v[1] = 0.0;
                         }
+                        ke[0] += kinetic1(vel[i], mass[i]);
+                        ke[1] += kinetic1(*v, mass[i]);
                     }
                 });
         }
-        self.smoothing_dissipation += ke_before - kinetic(&vel_s[..n], &self.mass);
+        let ke = smoothing
+            .iter()
+            .fold([0.0; 2], |a, k| [a[0] + k[0], a[1] + k[1]]);
+        self.smoothing_dissipation += ke[0] - ke[1];
 
         // 4. Velocity gradients and continuity.
         fill_images(vel_s, n, ghosts, |v| [-v[0], v[1]]);
@@ -565,87 +664,167 @@ impl TaylorSolver {
             });
         fill_images(rho_raw, n, ghosts, |r| r);
 
-        // 5. Conservative smoothing of the density, constitutive update.
+        // 5-6. Per particle: conservative smoothing of the density, the
+        // constitutive update, positions x^{n+1} = x^n + dt v^{n+1/2}, anvil
+        // contact, the generic stress boundary condition, and the sums of the
+        // step, MIN_LEN particles at a time.
         let (jc, eos, mu, cap) = (
             self.jc,
             self.eos,
             self.p.shear_modulus,
             self.p.specific_heat,
         );
+        let modulus = self.p.bulk_modulus + 4.0 / 3.0 * self.p.shear_modulus;
         let (grads, rho_raw) = (&*grads, &*rho_raw);
-        upd.par_chunks_mut(MIN_LEN)
+        let (h, mass) = (self.h, &self.mass);
+        (
+            (
+                self.dev.par_chunks_mut(MIN_LEN),
+                self.pressure.par_chunks_mut(MIN_LEN),
+                self.eps_p.par_chunks_mut(MIN_LEN),
+                self.temp.par_chunks_mut(MIN_LEN),
+                self.rho.par_chunks_mut(MIN_LEN),
+            ),
+            (
+                self.pos.par_chunks_mut(MIN_LEN),
+                self.vel.par_chunks_mut(MIN_LEN),
+                self.contact.par_chunks_mut(MIN_LEN),
+                self.stress_bc.par_chunks_mut(MIN_LEN),
+                tallies.par_iter_mut(),
+            ),
+        )
+            .into_par_iter()
             .enumerate()
-            .for_each(|(c, out)| {
-                let i0 = c * MIN_LEN;
-                let mut means = [[0.0]; MIN_LEN];
-                let means = &mut means[..out.len()];
-                shepard_means(rows, rho_raw, i0, means);
-                for (k, out) in out.iter_mut().enumerate() {
-                    let i = i0 + k;
-                    let [rho] = smooth(rho_raw[i], means[k], alpha);
-                    let g = grads[i];
-                    let d_rr = g[0];
-                    let d_zz = g[3];
-                    let d_tt = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
-                    // On the axis, symmetry gives dU_R/dZ = dU_Z/dR = 0: no shear
-                    // and no spin (sigma_RZ is odd in R).
-                    let (d_rz, omega) = if axis(i) {
-                        (0.0, 0.0)
-                    } else {
-                        (0.5 * (g[1] + g[2]), 0.5 * (g[1] - g[2]))
-                    };
-                    let dvol = (d_rr + d_zz + d_tt) / 3.0;
-                    let s = self.dev[i];
-                    let trial = [
-                        s[0] + dt * (2.0 * omega * s[3] + 2.0 * mu * (d_rr - dvol)),
-                        s[1] + dt * (-2.0 * omega * s[3] + 2.0 * mu * (d_zz - dvol)),
-                        s[2] + dt * (2.0 * mu * (d_tt - dvol)),
-                        s[3] + dt * (omega * (s[1] - s[0]) + 2.0 * mu * d_rz),
-                    ];
-                    let rate = (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
-                    let sy = jc.flow_stress(self.eps_p[i], rate, self.temp[i]);
-                    let ret = radial_return(&trial, sy, mu);
-                    let p_new = eos.pressure(rho);
-                    // Stress power with the mid-step stress, per unit mass.
-                    let p_old = self.pressure[i];
-                    let sm = |k: usize, p: f64| 0.5 * (s[k] + ret.stress[k]) - p;
-                    let pm = 0.5 * (p_old + p_new);
-                    let power = sm(0, pm) * d_rr
-                        + sm(1, pm) * d_zz
-                        + sm(2, pm) * d_tt
-                        + 2.0 * 0.5 * (s[3] + ret.stress[3]) * d_rz;
-                    *out = Update {
-                        dev: ret.stress,
-                        pressure: p_new,
-                        rho,
-                        plastic_strain: ret.plastic_strain,
-                        temp: ret.plastic_work / (rho * cap),
-                        energy: dt * power * self.mass[i] / rho,
-                    };
-                }
-            });
-        for (i, u) in upd.iter().enumerate() {
-            self.dev[i] = u.dev;
-            self.pressure[i] = u.pressure;
-            self.eps_p[i] += u.plastic_strain;
-            self.temp[i] += u.temp;
-            self.rho[i] = u.rho;
-            self.internal_energy += u.energy;
-        }
+            .for_each(
+                |(c, ((dev, pressure, eps_p, temp, rho), (x, v, touch, sbc, tally)))| {
+                    let i0 = c * MIN_LEN;
+                    let mut means = [[0.0]; MIN_LEN];
+                    let means = &mut means[..dev.len()];
+                    shepard_means(rows, rho_raw, i0, means);
+                    let mut t = Tally::default();
+                    for k in 0..dev.len() {
+                        let i = i0 + k;
+                        let [rho_new] = smooth(rho_raw[i], means[k], alpha);
+                        let g = grads[i];
+                        let d_rr = g[0];
+                        let d_zz = g[3];
+                        let d_tt = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
+                        // On the axis, symmetry gives dU_R/dZ = dU_Z/dR = 0: no
+                        // shear and no spin (sigma_RZ is odd in R).
+                        let (d_rz, omega) = if axis(i) {
+                            (0.0, 0.0)
+                        } else {
+                            (0.5 * (g[1] + g[2]), 0.5 * (g[1] - g[2]))
+                        };
+                        let dvol = (d_rr + d_zz + d_tt) / 3.0;
+                        let s = dev[k];
+                        let trial = [
+                            s[0] + dt * (2.0 * omega * s[3] + 2.0 * mu * (d_rr - dvol)),
+                            s[1] + dt * (-2.0 * omega * s[3] + 2.0 * mu * (d_zz - dvol)),
+                            s[2] + dt * (2.0 * mu * (d_tt - dvol)),
+                            s[3] + dt * (omega * (s[1] - s[0]) + 2.0 * mu * d_rz),
+                        ];
+                        let rate =
+                            (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
+                        let sy = jc.flow_stress(eps_p[k], rate, temp[k]);
+                        let ret = radial_return(&trial, sy, mu);
+                        let p_new = eos.pressure(rho_new);
+                        // Stress power with the mid-step stress, per unit mass.
+                        let p_old = pressure[k];
+                        let sm = |k: usize, p: f64| 0.5 * (s[k] + ret.stress[k]) - p;
+                        let pm = 0.5 * (p_old + p_new);
+                        let power = sm(0, pm) * d_rr
+                            + sm(1, pm) * d_zz
+                            + sm(2, pm) * d_tt
+                            + 2.0 * 0.5 * (s[3] + ret.stress[3]) * d_rz;
+                        dev[k] = ret.stress;
+                        pressure[k] = p_new;
+                        eps_p[k] += ret.plastic_strain;
+                        temp[k] += ret.plastic_work / (rho_new * cap);
+                        rho[k] = rho_new;
+                        t.internal += dt * power * mass[i] / rho_new;
 
-        // 6. Positions, anvil contact.
-        for (x, v) in self.pos.iter_mut().zip(&vel[..n]) {
-            x[0] += dt * v[0];
-            x[1] += dt * v[1];
+                        // Positions and anvil contact.
+                        let mut vi = vel[i];
+                        let mut xi = [x[k][0] + dt * vi[0], x[k][1] + dt * vi[1]];
+                        if touch[k] {
+                            // Released when the normal stress turns tensile.
+                            if dev[k][1] - pressure[k] > 0.0 {
+                                touch[k] = false;
+                            }
+                        } else if xi[1] < 0.0 {
+                            if xi[1] < -0.5 * h && t.through.is_none() {
+                                t.through = Some((i, "anvil", xi[1]));
+                            }
+                            xi[1] = 0.0;
+                            t.contact_lost += 0.5 * mass[i] * vi[1] * vi[1];
+                            vi[1] = 0.0;
+                            touch[k] = true;
+                        }
+                        if !axis(i) && xi[0] <= 0.0 && t.through.is_none() {
+                            t.through = Some((i, "axis", xi[0]));
+                        }
+                        x[k] = xi;
+                        v[k] = vi;
+                        if t.non_finite.is_none() {
+                            t.non_finite = non_finite(xi, vi, rho_new, dev[k], temp[k])
+                                .map(|field| (i, field));
+                        }
+                        let p = pressure[k];
+                        let d = dev[k];
+                        sbc[k] = [d[0] - p, d[1] - p, d[2] - p, d[3]];
+
+                        // The sums of the step.
+                        t.kinetic += kinetic1(vi, mass[i]);
+                        t.momentum += mass[i] * vi[1];
+                        t.mass += mass[i];
+                        t.touching |= touch[k];
+                        t.worst_speed =
+                            t.worst_speed.max(wave_and_flow_speed(modulus, rho_new, vi));
+                    }
+                    *tally = t;
+                },
+            );
+        let mut t = Tally::default();
+        for c in tallies.iter() {
+            t.internal += c.internal;
+            t.kinetic += c.kinetic;
+            t.momentum += c.momentum;
+            t.mass += c.mass;
+            t.contact_lost += c.contact_lost;
+            t.worst_speed = t.worst_speed.max(c.worst_speed);
+            t.touching |= c.touching;
+            t.through = t.through.or(c.through);
+            t.non_finite = t.non_finite.or(c.non_finite);
         }
-        self.vel.copy_from_slice(&vel[..n]);
+        self.internal_energy += t.internal;
+        self.contact_dissipation += t.contact_lost;
         self.time += dt;
         self.steps += 1;
-        self.update_contact()?;
-        self.check_finite()?;
-        self.apply_stress_bc();
+        if let Some((particle, boundary, position)) = t.through {
+            return Err(Error::ThroughBoundary {
+                particle,
+                boundary,
+                time: self.time,
+                position,
+            });
+        }
+        if let Some((field, particle)) = t.non_finite.map(|(i, f)| (f, i)) {
+            return Err(Error::NonFinite {
+                field,
+                particle,
+                time: self.time,
+            });
+        }
+        self.apply_surface_stress_bc();
 
-        let e = self.energy_error();
+        let e = (t.kinetic
+            + self.internal_energy
+            + self.smoothing_dissipation
+            + self.contact_dissipation
+            - self.initial_energy)
+            .abs()
+            / self.initial_energy;
         if e > ENERGY_ERROR_BOUND {
             return Err(Error::EnergyDrift {
                 error: e,
@@ -653,96 +832,21 @@ impl TaylorSolver {
                 time: self.time,
             });
         }
-        self.dt = self.stable_dt();
+        self.dt = COURANT * self.h / t.worst_speed;
         check_time_step(self.dt, self.dt0, self.time)?;
-        self.update_at_rest();
-        Ok(())
-    }
-
-    /// Holds particles touching the anvil at `U_Z = 0` and returns the kinetic
-    /// energy that removes.
-    fn hold_on_anvil(&self, vel: &mut [[f64; 2]]) -> f64 {
-        let mut lost = 0.0;
-        for i in 0..vel.len() {
-            if self.contact[i] {
-                lost += 0.5 * self.mass[i] * vel[i][1] * vel[i][1];
-                vel[i][1] = 0.0;
-            }
-        }
-        lost
-    }
-
-    fn update_contact(&mut self) -> Result<()> {
-        for i in 0..self.particles() {
-            let z = self.pos[i][1];
-            if self.contact[i] {
-                // Released when the normal stress turns tensile.
-                if self.dev[i][1] - self.pressure[i] > 0.0 {
-                    self.contact[i] = false;
-                }
-            } else if z < 0.0 {
-                if z < -0.5 * self.h {
-                    return Err(Error::ThroughBoundary {
-                        particle: i,
-                        boundary: "anvil",
-                        time: self.time,
-                        position: z,
-                    });
-                }
-                self.pos[i][1] = 0.0;
-                self.contact_dissipation += 0.5 * self.mass[i] * self.vel[i][1].powi(2);
-                self.vel[i][1] = 0.0;
-                self.contact[i] = true;
-            }
-            if !i.is_multiple_of(self.nr) && self.pos[i][0] <= 0.0 {
-                return Err(Error::ThroughBoundary {
-                    particle: i,
-                    boundary: "axis",
-                    time: self.time,
-                    position: self.pos[i][0],
-                });
-            }
+        // The rod is at rest once its momentum toward the anvil is spent: the
+        // centre of mass no longer moves toward the anvil.
+        if -t.momentum / t.mass <= 0.0 && !t.touching {
+            self.at_rest = true;
         }
         Ok(())
     }
 
-    fn check_finite(&self) -> Result<()> {
-        let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
-        let bad = (0..self.particles()).find_map(|i| {
-            if !finite(&self.pos[i]) {
-                Some("position")
-            } else if !finite(&self.vel[i]) {
-                Some("velocity")
-            } else if !self.rho[i].is_finite() {
-                Some("density")
-            } else if !finite(&self.dev[i]) {
-                Some("deviatoric stress")
-            } else if !self.temp[i].is_finite() {
-                Some("temperature")
-            } else {
-                None
-            }
-            .map(|field| (field, i))
-        });
-        match bad {
-            Some((field, particle)) => Err(Error::NonFinite {
-                field,
-                particle,
-                time: self.time,
-            }),
-            None => Ok(()),
-        }
-    }
-
-    /// Stress used by the momentum equation: the constitutive stress with the
-    /// traction-free and smooth-contact conditions applied on the surfaces.
-    fn apply_stress_bc(&mut self) {
+    /// Stress used by the momentum equation: the traction-free and
+    /// smooth-contact conditions applied on the surfaces to the constitutive
+    /// stress `dev - p I` (which the update pass writes for every particle).
+    fn apply_surface_stress_bc(&mut self) {
         let n = self.particles();
-        for i in 0..n {
-            let p = self.pressure[i];
-            let d = self.dev[i];
-            self.stress_bc[i] = [d[0] - p, d[1] - p, d[2] - p, d[3]];
-        }
         let (nr, nz) = (self.nr, self.nz);
         for (k, &i) in self.mantle.particles.iter().enumerate() {
             let s = &self.stress_bc[i];
@@ -804,14 +908,6 @@ impl TaylorSolver {
             m += mi;
         }
         mv / m
-    }
-
-    fn update_at_rest(&mut self) {
-        // The rod is at rest once its momentum toward the anvil is spent: the
-        // centre of mass no longer moves toward the anvil.
-        if self.centre_of_mass_speed() <= 0.0 && !self.contact.iter().any(|&c| c) {
-            self.at_rest = true;
-        }
     }
 
     /// Current values of [`TAYLOR_OBSERVABLES`], in that order.
