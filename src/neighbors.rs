@@ -71,70 +71,17 @@ pub fn cell_list(points: &[[f64; 2]], radius: f64) -> NeighborList {
 /// first `rows` points: the others are mirror images that are neighbours but
 /// need no derivatives of their own.
 pub fn cell_list_first(points: &[[f64; 2]], rows: usize, radius: f64) -> NeighborList {
-    let n = points.len();
-    if n == 0 {
+    let Some(cells) = Cells::new(points, radius) else {
         return NeighborList {
             offsets: vec![0],
             indices: vec![],
         };
-    }
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in points {
-        for d in 0..2 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
-    let cell = radius.max(f64::MIN_POSITIVE);
-    let dims = [
-        (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1),
-        (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1),
-    ];
-    let cell_of = |p: &[f64; 2]| -> [usize; 2] {
-        [
-            (((p[0] - lo[0]) / cell) as usize).min(dims[0] - 1),
-            (((p[1] - lo[1]) / cell) as usize).min(dims[1] - 1),
-        ]
     };
-    // Counting sort of particles into cells: particles of a cell are stored in
-    // ascending index order.
-    let ncell = dims[0] * dims[1];
-    let mut start = vec![0usize; ncell + 1];
-    let cells: Vec<usize> = points
-        .iter()
-        .map(|p| {
-            let c = cell_of(p);
-            c[1] * dims[0] + c[0]
-        })
-        .collect();
-    for &c in &cells {
-        start[c + 1] += 1;
-    }
-    for c in 0..ncell {
-        start[c + 1] += start[c];
-    }
-    let mut fill = start.clone();
-    let mut sorted = vec![0usize; n];
-    for (i, &c) in cells.iter().enumerate() {
-        sorted[fill[c]] = i;
-        fill[c] += 1;
-    }
-    let r2 = radius * radius;
     let lists: Vec<Vec<usize>> = points[..rows]
         .par_iter()
         .map(|p| {
-            let c = cell_of(p);
             let mut row = Vec::with_capacity(32);
-            for cy in c[1].saturating_sub(1)..=(c[1] + 1).min(dims[1] - 1) {
-                for cx in c[0].saturating_sub(1)..=(c[0] + 1).min(dims[0] - 1) {
-                    let id = cy * dims[0] + cx;
-                    for &j in &sorted[start[id]..start[id + 1]] {
-                        if dist2(p, &points[j]) <= r2 {
-                            row.push(j);
-                        }
-                    }
-                }
-            }
+            cells.visit(p, |j| row.push(j));
             row.sort_unstable();
             row
         })
@@ -148,6 +95,149 @@ pub fn cell_list_first(points: &[[f64; 2]], rows: usize, radius: f64) -> Neighbo
         offsets.push(indices.len());
     }
     NeighborList { offsets, indices }
+}
+
+/// The neighbour lists of [`cell_list_first`] written straight into rows of
+/// a fixed length: the neighbours of point `i` are
+/// `rows[i * stride..][..len[i]]`, ascending, and `stride` is the longest
+/// list rounded up to a multiple of `align`. The buffers are reused; a first
+/// try uses `stride_hint` (the stride of the previous call) and is redone
+/// with the true stride only when a list does not fit.
+pub fn padded_rows(
+    points: &[[f64; 2]],
+    first: usize,
+    radius: f64,
+    align: usize,
+    stride_hint: usize,
+    rows: &mut Vec<u32>,
+    len: &mut Vec<u32>,
+) -> usize {
+    let align = align.max(1);
+    len.clear();
+    len.resize(first, 0);
+    let Some(cells) = Cells::new(points, radius) else {
+        rows.clear();
+        return align;
+    };
+    let mut stride = stride_hint.max(align).next_multiple_of(align);
+    loop {
+        rows.clear();
+        rows.resize(first * stride, 0);
+        rows.par_chunks_mut(stride)
+            .zip(len.par_iter_mut())
+            .zip(&points[..first])
+            .with_min_len(64)
+            .for_each(|((row, len), p)| {
+                let mut k = 0;
+                cells.visit(p, |j| {
+                    if k < row.len() {
+                        row[k] = j as u32;
+                    }
+                    k += 1;
+                });
+                if k <= row.len() {
+                    row[..k].sort_unstable();
+                }
+                *len = k as u32;
+            });
+        let longest = len.iter().copied().max().unwrap_or(0) as usize;
+        if longest <= stride {
+            // Shrink a stride the lists have outgrown by a whole lane or more.
+            if longest.next_multiple_of(align) + align <= stride {
+                stride = longest.next_multiple_of(align).max(align);
+                continue;
+            }
+            return stride;
+        }
+        stride = longest.next_multiple_of(align);
+    }
+}
+
+/// A uniform grid of cells of side `radius` over a point set, with the
+/// points of each cell in ascending index order.
+struct Cells<'a> {
+    points: &'a [[f64; 2]],
+    lo: [f64; 2],
+    cell: f64,
+    dims: [usize; 2],
+    start: Vec<usize>,
+    sorted: Vec<usize>,
+    r2: f64,
+}
+
+impl<'a> Cells<'a> {
+    /// The grid, or `None` for no points.
+    fn new(points: &'a [[f64; 2]], radius: f64) -> Option<Self> {
+        if points.is_empty() {
+            return None;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in points {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        let cell = radius.max(f64::MIN_POSITIVE);
+        let dims = [
+            (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1),
+            (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1),
+        ];
+        let mut grid = Cells {
+            points,
+            lo,
+            cell,
+            dims,
+            start: vec![0; dims[0] * dims[1] + 1],
+            sorted: vec![0; points.len()],
+            r2: radius * radius,
+        };
+        // Counting sort of the points into cells, ascending within a cell.
+        let cells: Vec<usize> = points
+            .iter()
+            .map(|p| {
+                let c = grid.cell_of(p);
+                c[1] * dims[0] + c[0]
+            })
+            .collect();
+        for &c in &cells {
+            grid.start[c + 1] += 1;
+        }
+        for c in 0..dims[0] * dims[1] {
+            grid.start[c + 1] += grid.start[c];
+        }
+        let mut fill = grid.start.clone();
+        for (i, &c) in cells.iter().enumerate() {
+            grid.sorted[fill[c]] = i;
+            fill[c] += 1;
+        }
+        Some(grid)
+    }
+
+    fn cell_of(&self, p: &[f64; 2]) -> [usize; 2] {
+        [
+            (((p[0] - self.lo[0]) / self.cell) as usize).min(self.dims[0] - 1),
+            (((p[1] - self.lo[1]) / self.cell) as usize).min(self.dims[1] - 1),
+        ]
+    }
+
+    /// Calls `f(j)` for every point `j` within the radius of `p`, cell by
+    /// cell (not in index order).
+    #[inline]
+    fn visit(&self, p: &[f64; 2], mut f: impl FnMut(usize)) {
+        let c = self.cell_of(p);
+        let dims = self.dims;
+        for cy in c[1].saturating_sub(1)..=(c[1] + 1).min(dims[1] - 1) {
+            for cx in c[0].saturating_sub(1)..=(c[0] + 1).min(dims[0] - 1) {
+                let id = cy * dims[0] + cx;
+                for &j in &self.sorted[self.start[id]..self.start[id + 1]] {
+                    if dist2(p, &self.points[j]) <= self.r2 {
+                        f(j);
+                    }
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -200,5 +290,25 @@ mod tests {
         let nl = cell_list(&p, 0.035);
         assert_eq!(nl, naive(&p, 0.035));
         assert_eq!(nl.of(50), &[47, 48, 49, 50, 51, 52, 53]);
+    }
+
+    #[test]
+    fn padded_rows_equal_the_cell_list_rows() {
+        let p = points(900, 5);
+        let want = cell_list_first(&p, 600, 0.3);
+        let (mut rows, mut len) = (Vec::new(), Vec::new());
+        // Too short a hint, too long a hint, and the right one.
+        for hint in [1, 200, 0] {
+            let stride = padded_rows(&p, 600, 0.3, 8, hint, &mut rows, &mut len);
+            let longest = (0..600).map(|i| want.of(i).len()).max().unwrap();
+            assert_eq!(stride, longest.next_multiple_of(8), "hint {hint}");
+            for i in 0..600 {
+                let got: Vec<usize> = rows[i * stride..][..len[i] as usize]
+                    .iter()
+                    .map(|&j| j as usize)
+                    .collect();
+                assert_eq!(got, want.of(i), "hint {hint}, point {i}");
+            }
+        }
     }
 }

@@ -34,7 +34,7 @@ use crate::kernel::SUPPORT;
 use crate::lanes::W;
 use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
-use crate::neighbors::cell_list_first;
+use crate::neighbors::padded_rows;
 use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
 use crate::scene::taylor::TaylorParams;
 use rayon::prelude::*;
@@ -407,24 +407,16 @@ impl TaylorSolver {
         ws.pos.resize(m, [0.0; 2]);
         ws.pos[..n].copy_from_slice(&self.pos);
         fill_images(&mut ws.pos, n, &ws.ghosts, |x| [-x[0], x[1]]);
-        let nl = cell_list_first(&ws.pos, n, reach);
-        // Rows padded to whole SIMD lanes.
-        let stride = (0..n)
-            .map(|i| nl.of(i).len())
-            .max()
-            .unwrap_or(0)
-            .next_multiple_of(W);
-        ws.stride = stride;
-        ws.nbr.clear();
-        ws.nbr.resize(n * stride, 0);
-        ws.nbr_len.clear();
-        for i in 0..n {
-            let row = nl.of(i);
-            for (slot, &j) in ws.nbr[i * stride..].iter_mut().zip(row) {
-                *slot = j as u32;
-            }
-            ws.nbr_len.push(row.len() as u32);
-        }
+        ws.stride = padded_rows(
+            &ws.pos,
+            n,
+            reach,
+            W,
+            ws.stride,
+            &mut ws.nbr,
+            &mut ws.nbr_len,
+        );
+        let stride = ws.stride;
         ws.built_at.clear();
         ws.built_at.extend_from_slice(&self.pos);
         // Whole batches of W rows.
