@@ -31,26 +31,55 @@ pub struct JohnsonCook {
 
 impl JohnsonCook {
     /// Flow stress for effective plastic strain `eps_p`, effective strain
-    /// rate `rate` and temperature `temp`. Never negative, never NaN for
-    /// finite non-negative inputs.
+    /// rate `rate` and temperature `temp`: the product of
+    /// [`JohnsonCook::hardening`], [`JohnsonCook::rate_factor`] and
+    /// [`JohnsonCook::thermal`]. Never negative, never NaN for finite
+    /// non-negative inputs.
     #[inline]
     pub fn flow_stress(&self, eps_p: f64, rate: f64, temp: f64) -> f64 {
-        let hardening = if eps_p > 0.0 {
+        self.strength(self.hardening(eps_p), rate, self.thermal(temp))
+    }
+
+    /// The flow stress from the hardening and thermal factors (which a
+    /// caller may keep from step to step while `eps_p` and `temp` stay put).
+    #[inline]
+    pub fn strength(&self, hardening: f64, rate: f64, thermal: f64) -> f64 {
+        (hardening * self.rate_factor(rate) * thermal).max(0.0)
+    }
+
+    /// Strain hardening `A + B eps_p^n`.
+    #[inline]
+    pub fn hardening(&self, eps_p: f64) -> f64 {
+        if eps_p > 0.0 {
             self.a + self.b * eps_p.powf(self.n)
         } else {
             self.a
-        };
+        }
+    }
+
+    /// Rate factor `1 + C ln(max(rate / rate_0, 1))`.
+    #[inline]
+    pub fn rate_factor(&self, rate: f64) -> f64 {
         let ratio = (rate / self.ref_strain_rate).max(1.0);
-        let rate_term = 1.0 + self.c * ratio.ln();
+        if ratio == 1.0 {
+            // ln 1 = 0 exactly: spare the logarithm.
+            1.0
+        } else {
+            1.0 + self.c * ratio.ln()
+        }
+    }
+
+    /// Thermal softening `1 - T*^m`, with `T*` clamped to `[0, 1]`.
+    #[inline]
+    pub fn thermal(&self, temp: f64) -> f64 {
         let t_star = ((temp - self.room_temperature)
             / (self.melt_temperature - self.room_temperature))
             .clamp(0.0, 1.0);
-        let thermal = if t_star > 0.0 {
+        if t_star > 0.0 {
             1.0 - t_star.powf(self.m)
         } else {
             1.0
-        };
-        (hardening * rate_term * thermal).max(0.0)
+        }
     }
 }
 

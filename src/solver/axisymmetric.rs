@@ -196,6 +196,32 @@ struct Workspace {
     batches: Vec<BatchTally>,
     smoothing: Vec<[f64; 2]>,
     tallies: Vec<Tally>,
+    /// Johnson-Cook hardening and thermal factors of each particle with the
+    /// plastic strain and temperature they were computed for: reused while
+    /// both stay the same (a particle that does not yield), which spares two
+    /// `powf` and gives the same bits.
+    strength: Vec<Strength>,
+}
+
+/// A particle's Johnson-Cook factors and the state they belong to.
+#[derive(Debug, Clone, Copy)]
+struct Strength {
+    eps_p: f64,
+    temp: f64,
+    hardening: f64,
+    thermal: f64,
+}
+
+impl Default for Strength {
+    /// Matches no state (NaN equals nothing).
+    fn default() -> Self {
+        Strength {
+            eps_p: f64::NAN,
+            temp: f64::NAN,
+            hardening: 0.0,
+            thermal: 0.0,
+        }
+    }
 }
 
 /// Writes the image values `f[n + k] = mirror(f[ghosts[k]])`.
@@ -437,6 +463,7 @@ impl TaylorSolver {
         ws.batches.resize(n.div_ceil(W), BatchTally::default());
         ws.smoothing.resize(n.div_ceil(MIN_LEN), [0.0; 2]);
         ws.tallies.resize(n.div_ceil(MIN_LEN), Tally::default());
+        ws.strength.resize(n, Strength::default());
     }
 
     /// Whether a particle moved more than half the skin since the lists were
@@ -497,6 +524,7 @@ impl TaylorSolver {
             batches,
             smoothing,
             tallies,
+            strength,
             ..
         } = ws;
         let stride = (*stride).max(1);
@@ -676,6 +704,7 @@ impl TaylorSolver {
                 self.eps_p.par_chunks_mut(MIN_LEN),
                 self.temp.par_chunks_mut(MIN_LEN),
                 self.rho.par_chunks_mut(MIN_LEN),
+                strength.par_chunks_mut(MIN_LEN),
             ),
             (
                 self.pos.par_chunks_mut(MIN_LEN),
@@ -688,7 +717,7 @@ impl TaylorSolver {
             .into_par_iter()
             .enumerate()
             .for_each(
-                |(c, ((dev, pressure, eps_p, temp, rho), (x, v, touch, sbc, tally)))| {
+                |(c, ((dev, pressure, eps_p, temp, rho, memo), (x, v, touch, sbc, tally)))| {
                     let i0 = c * MIN_LEN;
                     let mut means = [[0.0]; MIN_LEN];
                     let means = &mut means[..dev.len()];
@@ -718,7 +747,16 @@ impl TaylorSolver {
                         ];
                         let rate =
                             (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
-                        let sy = jc.flow_stress(eps_p[k], rate, temp[k]);
+                        let f = &mut memo[k];
+                        if f.eps_p != eps_p[k] || f.temp != temp[k] {
+                            *f = Strength {
+                                eps_p: eps_p[k],
+                                temp: temp[k],
+                                hardening: jc.hardening(eps_p[k]),
+                                thermal: jc.thermal(temp[k]),
+                            };
+                        }
+                        let sy = jc.strength(f.hardening, rate, f.thermal);
                         let ret = radial_return(&trial, sy, mu);
                         let p_new = eos.pressure(rho_new);
                         // Stress power with the mid-step stress, per unit mass.
