@@ -8,7 +8,7 @@
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use meshless_impact::kernel::kernel2;
 use meshless_impact::msph::{Neighbourhood, Row2};
-use meshless_impact::neighbors::{cell_list, naive};
+use meshless_impact::neighbors::{cell_list, naive, padded_rows};
 use meshless_impact::{Scene, Simulation};
 use std::hint::black_box;
 
@@ -77,6 +77,23 @@ fn neighbours(c: &mut Criterion) {
     let reach = 2.3 * 1.5 * spacing;
     c.bench_function("cell list, test 7 (3820 points)", |b| {
         b.iter(|| cell_list(black_box(&p), reach))
+    });
+    // What the solver runs at a rebuild: the same lists straight into padded
+    // rows, reusing the buffers and the stride of the previous rebuild.
+    let (mut rows, mut len) = (Vec::new(), Vec::new());
+    let stride = padded_rows(&p, p.len(), reach, 8, 0, &mut rows, &mut len);
+    c.bench_function("padded rows, test 7 (3820 points)", |b| {
+        b.iter(|| {
+            padded_rows(
+                black_box(&p),
+                p.len(),
+                reach,
+                8,
+                stride,
+                &mut rows,
+                &mut len,
+            )
+        })
     });
     let mut g = c.benchmark_group("oracle");
     g.sample_size(10);
