@@ -141,15 +141,12 @@ pub fn padded_rows(
                 *len = k as u32;
             });
         let longest = len.iter().copied().max().unwrap_or(0) as usize;
-        if longest <= stride {
-            // Shrink a stride the lists have outgrown by a whole lane or more.
-            if longest.next_multiple_of(align) + align <= stride {
-                stride = longest.next_multiple_of(align).max(align);
-                continue;
-            }
+        let fit = longest.next_multiple_of(align).max(align);
+        if fit == stride {
             return stride;
         }
-        stride = longest.next_multiple_of(align);
+        // Too short a stride, or one longer than the lists need.
+        stride = fit;
     }
 }
 
@@ -297,6 +294,9 @@ mod tests {
         let p = points(900, 5);
         let want = cell_list_first(&p, 600, 0.3);
         let (mut rows, mut len) = (Vec::new(), Vec::new());
+        // No rows at all.
+        assert_eq!(padded_rows(&p, 0, 0.3, 8, 64, &mut rows, &mut len), 8);
+        assert!(rows.is_empty() && len.is_empty());
         // Too short a hint, too long a hint, and the right one.
         for hint in [1, 200, 0] {
             let stride = padded_rows(&p, 600, 0.3, 8, hint, &mut rows, &mut len);
