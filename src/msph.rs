@@ -178,41 +178,33 @@ pub const POWER_SUMS: usize = 21;
 /// Theta_c(s_j)`) from its power sums (see [`Neighbourhood::power_sums`]).
 #[inline(always)]
 pub fn moment_matrix(sums: &[f64; POWER_SUMS]) -> [[f64; 6]; 6] {
-    let (m, n) = sums.split_at(15);
-    let mut b = [[0.0; 6]; 6];
-    for (c, &(pc, qc, tc)) in THETA.iter().enumerate() {
-        for (a, terms) in PHI.iter().enumerate() {
-            let mut x = 0.0;
-            for &(p, q, k) in terms.iter() {
-                x += k * tc * m[monomial(p + pc, q + qc)];
-            }
-            if a == 0 {
-                x -= EXP_M4 * tc * n[monomial(pc, qc)];
-            }
-            b[a][c] = x;
-        }
-    }
-    b
+    moment_matrix_of(&sums.map(|x| [x])).map(|row| row.map(|[x]| x))
 }
 
 /// [`moment_matrix`] of [`W`] particles at once, lane `l` of the power sums
 /// giving lane `l` of the matrix (the same operations in the same order).
 #[inline(always)]
 pub fn moment_matrix_lanes(sums: &[Lanes; POWER_SUMS]) -> crate::lanes::LaneMatrix<6> {
+    moment_matrix_of(sums)
+}
+
+/// The moment matrices of `L` particles, one per lane.
+#[inline(always)]
+fn moment_matrix_of<const L: usize>(sums: &[[f64; L]; POWER_SUMS]) -> [[[f64; L]; 6]; 6] {
     let (m, n) = sums.split_at(15);
-    let mut b = [[[0.0; W]; 6]; 6];
+    let mut b = [[[0.0; L]; 6]; 6];
     for (c, &(pc, qc, tc)) in THETA.iter().enumerate() {
         for (a, terms) in PHI.iter().enumerate() {
-            let mut x = [0.0; W];
+            let mut x = [0.0; L];
             for &(p, q, k) in terms.iter() {
                 let mk = &m[monomial(p + pc, q + qc)];
-                for l in 0..W {
+                for l in 0..L {
                     x[l] += k * tc * mk[l];
                 }
             }
             if a == 0 {
                 let nk = &n[monomial(pc, qc)];
-                for l in 0..W {
+                for l in 0..L {
                     x[l] -= EXP_M4 * tc * nk[l];
                 }
             }
@@ -294,22 +286,16 @@ impl Neighbourhood {
     /// must lie in the support, with weight `v = m_j / rho_j`.
     #[inline]
     pub fn push(&mut self, sr: f64, sz: f64, v: f64) {
-        self.push_if(true, sr, sz, v);
-    }
-
-    /// Adds the neighbour as [`Neighbourhood::push`] does when `keep` holds,
-    /// and otherwise leaves the neighbourhood as it was, without a branch.
-    #[inline(always)]
-    pub fn push_if(&mut self, keep: bool, sr: f64, sz: f64, v: f64) {
         self.reserve(self.len + 1);
         let k = self.len;
         self.sr[k] = sr;
         self.sz[k] = sz;
         self.v[k] = v;
-        self.len = k + keep as usize;
+        self.len = k + 1;
     }
 
-    /// [`Neighbourhood::push_if`] for a lane of candidates, in lane order.
+    /// Adds the candidates of a lane where `keep` holds, in lane order,
+    /// without a branch.
     #[inline(always)]
     pub fn push_lanes(&mut self, keep: [bool; W], sr: Lanes, sz: Lanes, v: Lanes) {
         self.reserve(self.len + W);

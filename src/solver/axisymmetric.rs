@@ -25,7 +25,7 @@
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
 use super::pairs::{
-    PairInputs, PairOutputs, PairPass, Rows, Scratch, pair_batch, shepard_means, smooth,
+    PairInputs, PairOutputs, PairPass, Rows, ScratchPool, pair_batch, shepard_means, smooth,
     velocity_gradients,
 };
 use super::{COURANT, check_time_step};
@@ -201,6 +201,8 @@ struct Workspace {
     /// both stay the same (a particle that does not yield), which spares two
     /// `powf` and gives the same bits.
     strength: Vec<Strength>,
+    /// Neighbourhoods of the pair pass, one set per thread.
+    scratch: ScratchPool,
 }
 
 /// A particle's Johnson-Cook factors and the state they belong to.
@@ -525,8 +527,10 @@ impl TaylorSolver {
             smoothing,
             tallies,
             strength,
+            scratch,
             ..
         } = ws;
+        scratch.fit();
         let stride = (*stride).max(1);
         pos[..n].copy_from_slice(&self.pos);
         fill_images(pos, n, ghosts, |x| [-x[0], x[1]]);
@@ -571,7 +575,7 @@ impl TaylorSolver {
             .enumerate()
             .with_min_len(MIN_LEN / W)
             .for_each_init(
-                || Scratch::new(stride),
+                || scratch.get(),
                 |scratch, (b, (act, wr, wz, wk, part, vel, tally))| {
                     let i0 = b * W;
                     let out = PairOutputs {
@@ -848,13 +852,7 @@ impl TaylorSolver {
         }
         self.apply_surface_stress_bc();
 
-        let e = (t.kinetic
-            + self.internal_energy
-            + self.smoothing_dissipation
-            + self.contact_dissipation
-            - self.initial_energy)
-            .abs()
-            / self.initial_energy;
+        let e = self.energy_error_with(t.kinetic);
         if e > ENERGY_ERROR_BOUND {
             return Err(Error::EnergyDrift {
                 error: e,
@@ -921,10 +919,13 @@ impl TaylorSolver {
     }
 
     fn energy_error(&self) -> f64 {
-        (self.kinetic_energy()
-            + self.internal_energy
-            + self.smoothing_dissipation
-            + self.contact_dissipation
+        self.energy_error_with(self.kinetic_energy())
+    }
+
+    /// The energy error with the kinetic energy given (the update pass sums
+    /// it in chunks).
+    fn energy_error_with(&self, kinetic: f64) -> f64 {
+        (kinetic + self.internal_energy + self.smoothing_dissipation + self.contact_dissipation
             - self.initial_energy)
             .abs()
             / self.initial_energy

@@ -14,6 +14,7 @@ use crate::lanes::{self, Lanes, W};
 use crate::msph::{MAX_CONDITION, Neighbourhood, POWER_SUMS, moment_matrix_lanes};
 use multiversion::multiversion;
 use multiversion::target::match_target;
+use std::sync::{Mutex, MutexGuard};
 
 // AVX-512 versions of parts of the pair pass, chosen at run time; the only
 // unsafe code outside the C and FMI layers (vector loads, gathers, stores).
@@ -68,18 +69,70 @@ pub(super) struct PairOutputs<'a> {
     pub vel: &'a mut [[f64; 2]],
 }
 
-/// One [`Neighbourhood`] per lane, reused from batch to batch.
+/// One [`Neighbourhood`] per lane, reused from batch to batch (they grow to
+/// the longest candidate row once and keep their room). Aligned to whole
+/// cache-line pairs so the scratch of two threads never shares a line.
+#[derive(Debug, Default)]
+#[repr(align(128))]
 pub(super) struct Scratch {
-    hoods: Vec<Neighbourhood>,
+    hoods: [Neighbourhood; W],
 }
 
-impl Scratch {
-    /// Room for rows of `stride` candidates.
-    pub fn new(stride: usize) -> Self {
-        Scratch {
-            hoods: (0..W)
-                .map(|_| Neighbourhood::with_capacity(stride))
-                .collect(),
+/// One [`Scratch`] per thread of the pool, kept from step to step so the
+/// pair pass allocates nothing. A copy starts empty (scratch holds no state).
+#[derive(Debug, Default)]
+pub(super) struct ScratchPool {
+    slots: Vec<Mutex<Scratch>>,
+}
+
+impl Clone for ScratchPool {
+    fn clone(&self) -> Self {
+        ScratchPool::default()
+    }
+}
+
+/// A thread's scratch: its slot of the pool, or a fresh one when the slot
+/// is missing or taken (which the pair pass does not cause: a thread holds
+/// its slot only while it runs its share of batches, without nested
+/// parallel work).
+pub(super) enum ScratchRef<'a> {
+    Kept(MutexGuard<'a, Scratch>),
+    Fresh(Box<Scratch>),
+}
+
+impl ScratchPool {
+    /// Makes a slot for every thread of the current pool.
+    pub fn fit(&mut self) {
+        let n = rayon::current_num_threads();
+        if self.slots.len() < n {
+            self.slots.resize_with(n, Mutex::default);
+        }
+    }
+
+    /// The calling thread's scratch.
+    pub fn get(&self) -> ScratchRef<'_> {
+        rayon::current_thread_index()
+            .and_then(|t| self.slots.get(t))
+            .and_then(|slot| slot.try_lock().ok())
+            .map_or_else(|| ScratchRef::Fresh(Box::default()), ScratchRef::Kept)
+    }
+}
+
+impl std::ops::Deref for ScratchRef<'_> {
+    type Target = Scratch;
+    fn deref(&self) -> &Scratch {
+        match self {
+            ScratchRef::Kept(g) => g,
+            ScratchRef::Fresh(s) => s,
+        }
+    }
+}
+
+impl std::ops::DerefMut for ScratchRef<'_> {
+    fn deref_mut(&mut self) -> &mut Scratch {
+        match self {
+            ScratchRef::Kept(g) => g,
+            ScratchRef::Fresh(s) => s,
         }
     }
 }
