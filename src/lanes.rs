@@ -188,6 +188,121 @@ pub fn invert<const N: usize>(a: LaneMatrix<N>) -> (LaneMatrix<N>, [bool; W]) {
     (a, singular)
 }
 
+/// `x` in every lane.
+#[inline(always)]
+pub fn splat(x: f64) -> Lanes {
+    [x; W]
+}
+
+/// `a + b` lane by lane.
+#[inline(always)]
+pub fn add(a: Lanes, b: Lanes) -> Lanes {
+    std::array::from_fn(|l| a[l] + b[l])
+}
+
+/// `a - b` lane by lane.
+#[inline(always)]
+pub fn sub(a: Lanes, b: Lanes) -> Lanes {
+    std::array::from_fn(|l| a[l] - b[l])
+}
+
+/// `a * b` lane by lane.
+#[inline(always)]
+pub fn mul(a: Lanes, b: Lanes) -> Lanes {
+    std::array::from_fn(|l| a[l] * b[l])
+}
+
+/// Runs `$body` once for each listed value, with `$v` a constant of that
+/// value, so that the loops inside have constant bounds and unroll.
+macro_rules! unroll {
+    ($v:ident in [$($n:literal),*] $body:block) => {
+        $({
+            #[allow(non_upper_case_globals)]
+            const $v: usize = $n;
+            $body
+        })*
+    };
+}
+pub(crate) use unroll;
+
+/// `d` where it exceeds `floor`, else 1; and whether it did not (including a
+/// NaN).
+#[inline(always)]
+fn pivot_above(d: Lanes, floor: Lanes) -> (Lanes, [bool; W]) {
+    let ok: [bool; W] = std::array::from_fn(|l| d[l] > floor[l]);
+    (select(ok, d, [1.0; W]), ok.map(|x| !x))
+}
+
+/// Inverts the [`W`] symmetric positive definite 6×6 matrices held in the
+/// lanes of `g` (only the lower triangle, `g[r][c]` with `r >= c`, is read) by
+/// an `L D L^T` factorisation without pivoting, then `G^-1 = L^-T D^-1 L^-1`.
+/// No lane needs a row interchange, so the elimination has no branch.
+///
+/// Returns the (full, symmetric) inverses and, per lane, whether a pivot
+/// `D_j` failed to exceed `min_pivot` times its diagonal entry `G_jj`: the
+/// matrix is then not positive definite, too close to singular for this
+/// elimination to be accurate, or holds a NaN, and the inverse of that lane
+/// is meaningless (a failed lane goes on with a unit pivot).
+#[inline(always)]
+// The unrolled loops have empty ranges for the first constant.
+#[allow(clippy::reversed_empty_ranges)]
+pub fn invert_spd6(g: &LaneMatrix<6>, min_pivot: f64) -> (LaneMatrix<6>, [bool; W]) {
+    const N: usize = 6;
+    // l[i][j] (i > j): the unit lower factor; ld[i][j] = l[i][j] d_j.
+    let mut l = [[[0.0; W]; N]; N];
+    let mut ld = [[[0.0; W]; N]; N];
+    let mut dinv = [[0.0; W]; N];
+    let mut singular = [false; W];
+    unroll!(j in [0, 1, 2, 3, 4, 5] {
+        let mut d = g[j][j];
+        for k in 0..j {
+            d = sub(d, mul(l[j][k], ld[j][k]));
+        }
+        let (d, bad) = pivot_above(d, mul(splat(min_pivot), g[j][j]));
+        for x in 0..W {
+            singular[x] |= bad[x];
+            dinv[j][x] = 1.0 / d[x];
+        }
+        for i in j + 1..N {
+            let mut t = g[i][j];
+            for k in 0..j {
+                t = sub(t, mul(l[i][k], ld[j][k]));
+            }
+            ld[i][j] = t;
+            l[i][j] = mul(t, dinv[j]);
+        }
+    });
+    // y = L^-1 (unit lower triangular), column by column.
+    let mut y = [[[0.0; W]; N]; N];
+    unroll!(j in [0, 1, 2, 3, 4, 5] {
+        y[j][j] = [1.0; W];
+        for i in j + 1..N {
+            let mut t = l[i][j];
+            for k in j + 1..i {
+                t = add(t, mul(l[i][k], y[k][j]));
+            }
+            y[i][j] = sub([0.0; W], t);
+        }
+    });
+    // G^-1[i][j] = sum_{k >= i} (y[k][i] / d_k) y[k][j] for i >= j.
+    let mut inv = [[[0.0; W]; N]; N];
+    unroll!(i in [0, 1, 2, 3, 4, 5] {
+        let mut yd = [[0.0; W]; N];
+        for k in i..N {
+            yd[k] = mul(y[k][i], dinv[k]);
+        }
+        for j in 0..=i {
+            let mut s = mul(yd[i], y[i][j]);
+            for k in i + 1..N {
+                s = add(s, mul(yd[k], y[k][j]));
+            }
+            inv[i][j] = s;
+            inv[j][i] = s;
+        }
+    });
+    (inv, singular)
+}
+
 /// The 1-norm (largest absolute column sum) of each lane's matrix.
 #[inline(always)]
 pub fn norm1<const N: usize>(m: &LaneMatrix<N>) -> Lanes {
@@ -302,6 +417,74 @@ mod tests {
             for r in 0..3 {
                 for c in 0..3 {
                     assert!((inv[r][c][l] - want[r][c]).abs() < 1e-15);
+                }
+            }
+        }
+    }
+
+    /// Random symmetric positive definite matrices `M M^T + I / 2`, one per
+    /// lane: the inverse equals nalgebra's, lane by lane.
+    #[test]
+    fn spd_inverse_equals_nalgebra_lane_by_lane() {
+        let mut next = rng(11);
+        for _ in 0..100 {
+            let m: [[Lanes; 6]; 6] = std::array::from_fn(|_| {
+                std::array::from_fn(|_| std::array::from_fn(|_| next() - 0.5))
+            });
+            let g: LaneMatrix<6> = std::array::from_fn(|r| {
+                std::array::from_fn(|c| {
+                    std::array::from_fn(|l| {
+                        (0..6).map(|k| m[r][k][l] * m[c][k][l]).sum::<f64>()
+                            + if r == c { 0.5 } else { 0.0 }
+                    })
+                })
+            });
+            let (inv, singular) = invert_spd6(&g, 1e-6);
+            assert_eq!(singular, [false; W]);
+            for l in 0..W {
+                let want = nalgebra::Matrix6::from_fn(|r, c| g[r][c][l])
+                    .try_inverse()
+                    .unwrap();
+                let scale = want.amax();
+                for r in 0..6 {
+                    for c in 0..6 {
+                        assert!(
+                            (inv[r][c][l] - want[(r, c)]).abs() <= 1e-12 * scale,
+                            "lane {l} ({r}, {c}): {} vs {}",
+                            inv[r][c][l],
+                            want[(r, c)]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn non_positive_definite_lanes_are_flagged_and_do_not_spoil_the_others() {
+        let mut g: LaneMatrix<6> =
+            std::array::from_fn(|r| std::array::from_fn(|c| [if r == c { 2.0 } else { 0.5 }; W]));
+        // Lane 3: two equal rows (singular). Lane 5: a NaN entry. Lane 6: a
+        // negative eigenvalue (its third pivot is 0.1 - 0.2). Lane 7: nearly
+        // singular (its third pivot is 1e-7 of the diagonal entry).
+        for c in 0..6 {
+            g[1][c][3] = g[0][c][3];
+            g[c][1][3] = g[c][0][3];
+        }
+        g[1][1][3] = g[0][0][3];
+        g[4][2][5] = f64::NAN;
+        g[2][2][6] = 0.1;
+        g[2][2][7] = 0.2 + 2e-8;
+        let (inv, singular) = invert_spd6(&g, 1e-6);
+        let flagged: Vec<usize> = (0..W).filter(|&l| singular[l]).collect();
+        assert_eq!(flagged, vec![3, 5, 6, 7]);
+        let want = nalgebra::Matrix6::from_fn(|r, c| if r == c { 2.0 } else { 0.5 })
+            .try_inverse()
+            .unwrap();
+        for l in [0, 1, 2, 4] {
+            for r in 0..6 {
+                for c in 0..6 {
+                    assert!((inv[r][c][l] - want[(r, c)]).abs() < 1e-14);
                 }
             }
         }

@@ -190,13 +190,17 @@ pub fn moment_matrix_lanes(sums: &[Lanes; POWER_SUMS]) -> crate::lanes::LaneMatr
 
 /// The moment matrices of `L` particles, one per lane.
 #[inline(always)]
+// The unrolled loops have empty ranges for the first constant.
+#[allow(clippy::reversed_empty_ranges)]
 fn moment_matrix_of<const L: usize>(sums: &[[f64; L]; POWER_SUMS]) -> [[[f64; L]; 6]; 6] {
     let (m, n) = sums.split_at(15);
     let mut b = [[[0.0; L]; 6]; 6];
-    for (c, &(pc, qc, tc)) in THETA.iter().enumerate() {
-        for (a, terms) in PHI.iter().enumerate() {
+    // Unrolled, so that every index below is a constant.
+    crate::lanes::unroll!(c in [0, 1, 2, 3, 4, 5] {
+        let (pc, qc, tc) = THETA[c];
+        crate::lanes::unroll!(a in [0, 1, 2, 3, 4, 5] {
             let mut x = [0.0; L];
-            for &(p, q, k) in terms.iter() {
+            for &(p, q, k) in PHI[a].iter() {
                 let mk = &m[monomial(p + pc, q + qc)];
                 for l in 0..L {
                     x[l] += k * tc * mk[l];
@@ -209,9 +213,90 @@ fn moment_matrix_of<const L: usize>(sums: &[[f64; L]; POWER_SUMS]) -> [[[f64; L]
                 }
             }
             b[a][c] = x;
-        }
-    }
+        });
+    });
     b
+}
+
+/// Smallest pivot of the `L D L^T` elimination of the Gram matrix, relative
+/// to its diagonal entry, that [`inverse_moments_lanes`] accepts: below it
+/// the Gram matrix is too close to singular for the factored inverse to be
+/// as accurate as a pivoting elimination of `B` itself.
+pub const MIN_GRAM_PIVOT: f64 = 1e-6;
+
+/// The inverses of the moment matrices of [`W`] particles from their power
+/// sums (lane `l` of each sum for particle `l`), without pivoting.
+///
+/// With `Phi_a = exp(-|s|^2) sum_c P[a][c] Theta_c - exp(-4) [a = 0]` (see
+/// [`PHI`] and [`THETA`]; `P` is lower triangular with the diagonal (1, 2, 2,
+/// 8, 8, 4) and -2 in column 0 of rows 3 and 4), the moment matrix factors as
+/// `B = P G - exp(-4) e_0 u^T` with the Gram matrix `G = sum_j V_j
+/// exp(-|s_j|^2) Theta(s_j) Theta(s_j)^T` (symmetric, positive definite for a
+/// neighbourhood that supports a quadratic fit) and `u = sum_j V_j
+/// Theta(s_j)`. So `B^-1` is `A^-1 = G^-1 P^-1` ([`crate::lanes::invert_spd6`])
+/// corrected by the Sherman-Morrison formula for the rank-one term.
+///
+/// Returns the inverses and, per lane, whether this route does not apply:
+/// a pivot of `G` at or below [`MIN_GRAM_PIVOT`] of its diagonal entry, or a
+/// Sherman-Morrison denominator below 1/2 (or NaN). `B` may still be
+/// invertible then (it can be even when `G` is singular), so such a lane
+/// must be inverted by an elimination of `B` with pivoting
+/// ([`crate::lanes::invert`]); its result here is meaningless.
+pub fn inverse_moments_lanes(
+    sums: &[Lanes; POWER_SUMS],
+) -> (crate::lanes::LaneMatrix<6>, [bool; W]) {
+    use crate::lanes::{add, mul, splat, unroll};
+    let (m, n) = sums.split_at(15);
+    // Plain loops, not array::from_fn: a closure the compiler leaves out of
+    // line would lose the caller's instruction set.
+    let mut g = [[[0.0; W]; 6]; 6];
+    unroll!(c in [0, 1, 2, 3, 4, 5] {
+        for d in 0..=c {
+            let ((pc, qc, tc), (pd, qd, td)) = (THETA[c], THETA[d]);
+            g[c][d] = mul(splat(tc * td), m[monomial(pc + pd, qc + qd)]);
+        }
+    });
+    let (ginv, mut elsewhere) = crate::lanes::invert_spd6(&g, MIN_GRAM_PIVOT);
+    // A^-1 = G^-1 P^-1, column by column of P^-1.
+    let mut a = [[[0.0; W]; 6]; 6];
+    unroll!(i in [0, 1, 2, 3, 4, 5] {
+        let r = &ginv[i];
+        a[i][0] = add(r[0], mul(splat(0.25), add(r[3], r[4])));
+        a[i][1] = mul(splat(0.5), r[1]);
+        a[i][2] = mul(splat(0.5), r[2]);
+        a[i][3] = mul(splat(0.125), r[3]);
+        a[i][4] = mul(splat(0.125), r[4]);
+        a[i][5] = mul(splat(0.25), r[5]);
+    });
+    // Sherman-Morrison: B^-1 = A^-1 + (A^-1 e_0)(w^T A^-1) / (1 - w^T A^-1 e_0)
+    // with w = exp(-4) u.
+    let mut w = [[0.0; W]; 6];
+    for c in 0..6 {
+        let (pc, qc, tc) = THETA[c];
+        w[c] = mul(splat(EXP_M4 * tc), n[monomial(pc, qc)]);
+    }
+    let mut b = [[0.0; W]; 6];
+    unroll!(j in [0, 1, 2, 3, 4, 5] {
+        b[j] = mul(w[0], a[0][j]);
+        for i in 1..6 {
+            b[j] = add(b[j], mul(w[i], a[i][j]));
+        }
+    });
+    let mut scale = [0.0; W];
+    for l in 0..W {
+        let gamma = 1.0 - b[0][l];
+        // Typically about 0.95: exp(-4) u is small against G.
+        let bad = gamma.is_nan() || gamma.abs() < 0.5;
+        elsewhere[l] |= bad;
+        scale[l] = 1.0 / if bad { 1.0 } else { gamma };
+    }
+    unroll!(i in [0, 1, 2, 3, 4, 5] {
+        let c0 = mul(a[i][0], scale);
+        for j in 0..6 {
+            a[i][j] = add(a[i][j], mul(c0, b[j]));
+        }
+    });
+    (a, elsewhere)
 }
 
 /// The neighbours of one particle in structure-of-arrays form (scaled
@@ -770,6 +855,89 @@ mod tests {
                 assert_eq!(kern[k], 0.0);
             }
         }
+    }
+
+    /// The lane inverse from the Gram factorisation equals the scalar
+    /// Gauss-Jordan inverse with pivoting of the assembled moment matrix, on
+    /// every particle of the jittered cloud (edge and axis particles
+    /// included), eight at a time. Lanes it cannot serve are flagged without
+    /// spoiling the others: a collinear neighbourhood, a NaN, and five
+    /// neighbours, whose Gram matrix is singular while `B` is not.
+    #[test]
+    fn lane_inverse_of_the_moments_equals_gauss_jordan() {
+        let (p, v, h) = cloud();
+        let nl = cell_list(&p, 2.0 * h);
+        let mut sums: Vec<[f64; POWER_SUMS]> = (0..p.len())
+            .map(|i| {
+                let mut hood = Neighbourhood::with_capacity(8);
+                for &j in nl.of(i) {
+                    let (sr, sz) = ((p[j][0] - p[i][0]) / h, (p[j][1] - p[i][1]) / h);
+                    if sr * sr + sz * sz <= SUPPORT * SUPPORT {
+                        hood.push(sr, sz, v[j]);
+                    }
+                }
+                hood.power_sums()
+            })
+            .collect();
+        // Particle 150: ten neighbours on a line. 151: a NaN sum. 152: five.
+        let mut line = Neighbourhood::with_capacity(8);
+        for k in -5..5 {
+            line.push(0.3 * k as f64, 0.0, 1.0);
+        }
+        sums.push(line.power_sums());
+        let mut nan = sums[40];
+        nan[7] = f64::NAN;
+        sums.push(nan);
+        let mut five = Neighbourhood::with_capacity(8);
+        for (r, z) in [
+            (0.0, 0.0),
+            (0.7, 0.1),
+            (-0.2, 0.8),
+            (-0.9, -0.3),
+            (0.4, -1.1),
+        ] {
+            five.push(r, z, 1.0);
+        }
+        sums.push(five.power_sums());
+        assert!(invert(moment_matrix(&sums[152])).is_some());
+        let (mut checked, mut worst) = (0, 0.0f64);
+        for (batch, chunk) in sums.chunks(W).enumerate() {
+            let lanes: [Lanes; POWER_SUMS] = std::array::from_fn(|k| {
+                std::array::from_fn(|l| chunk.get(l).map_or(0.0, |s| s[k]))
+            });
+            let (inv, elsewhere) = inverse_moments_lanes(&lanes);
+            let norm_b = crate::lanes::norm1(&moment_matrix_lanes(&lanes));
+            for (l, s) in chunk.iter().enumerate() {
+                let i = batch * W + l;
+                let b = moment_matrix(s);
+                if i >= p.len() {
+                    assert!(elsewhere[l], "lane {l}");
+                    continue;
+                }
+                assert!(!elsewhere[l], "particle {i}");
+                let want = invert(b).unwrap();
+                assert_eq!(norm_b[l], norm1(&b));
+                let scale = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+                for r in 0..6 {
+                    for c in 0..6 {
+                        let d = (inv[r][c][l] - want[r][c]).abs() / scale;
+                        worst = worst.max(d);
+                        assert!(
+                            d <= 1e-12,
+                            "particle {i} ({r}, {c}): {} vs {}",
+                            inv[r][c][l],
+                            want[r][c]
+                        );
+                    }
+                }
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, p.len());
+        assert!(
+            worst > 0.0,
+            "two different algorithms agree to the last bit?"
+        );
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! The pair pass of the axisymmetric solver, [`W`] particles at a time: each
 //! particle's neighbours in the support, its MSPH moment matrix, the
 //! [`W`] matrices inverted together in the lanes of one vector
-//! ([`crate::lanes::invert`]), then each pair's derivative and Shepard
+//! ([`crate::msph::inverse_moments_lanes`], or [`crate::lanes::invert`] for a
+//! near-degenerate neighbourhood), then each pair's derivative and Shepard
 //! weights and the momentum equation.
 //!
 //! The lane arithmetic ([`crate::lanes`]) is plain IEEE arithmetic in a
@@ -11,7 +12,9 @@
 use super::boundary::Stress;
 use crate::kernel::SUPPORT;
 use crate::lanes::{self, Lanes, W};
-use crate::msph::{MAX_CONDITION, Neighbourhood, POWER_SUMS, moment_matrix_lanes};
+use crate::msph::{
+    MAX_CONDITION, Neighbourhood, POWER_SUMS, inverse_moments_lanes, moment_matrix_lanes,
+};
 use multiversion::multiversion;
 use multiversion::target::match_target;
 use std::sync::{Mutex, MutexGuard};
@@ -251,16 +254,32 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
             sums[k][p] = *x;
         }
     }
-    let mut b = moment_matrix_lanes(&sums);
-    // Identity in the unused lanes keeps their elimination harmless.
-    for p in nb..W {
-        for (r, row) in b.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                x[p] = if r == c { 1.0 } else { 0.0 };
+    let b = moment_matrix_lanes(&sums);
+    // The Gram route without pivoting; unused lanes (zero sums) are not read.
+    let (mut inv, elsewhere) = inverse_moments_lanes(&sums);
+    let mut singular = [false; W];
+    if elsewhere[..nb].iter().any(|&x| x) {
+        // Rare (a neighbourhood near degenerate): Gauss-Jordan elimination
+        // of B with pivoting for the lanes the Gram route cannot serve,
+        // with the identity in the unused lanes.
+        let mut bb = b;
+        for p in nb..W {
+            for (r, row) in bb.iter_mut().enumerate() {
+                for (c, x) in row.iter_mut().enumerate() {
+                    x[p] = if r == c { 1.0 } else { 0.0 };
+                }
             }
         }
+        let (gj, gj_singular) = lanes::invert(bb);
+        for p in (0..nb).filter(|&p| elsewhere[p]) {
+            for (row, gj_row) in inv.iter_mut().zip(&gj) {
+                for (x, y) in row.iter_mut().zip(gj_row) {
+                    x[p] = y[p];
+                }
+            }
+            singular[p] = gj_singular[p];
+        }
     }
-    let (inv, singular) = lanes::invert(b);
     let (nb1, ni1) = (lanes::norm1(&b), lanes::norm1(&inv));
     for p in 0..nb {
         let i = i0 + p;
