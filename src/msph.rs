@@ -242,6 +242,9 @@ pub const MIN_GRAM_PIVOT: f64 = 1e-6;
 /// invertible then (it can be even when `G` is singular), so such a lane
 /// must be inverted by an elimination of `B` with pivoting
 /// ([`crate::lanes::invert`]); its result here is meaningless.
+#[inline(always)]
+// The unrolled loops have empty ranges for the first constant.
+#[allow(clippy::reversed_empty_ranges)]
 pub fn inverse_moments_lanes(
     sums: &[Lanes; POWER_SUMS],
 ) -> (crate::lanes::LaneMatrix<6>, [bool; W]) {
