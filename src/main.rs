@@ -170,39 +170,45 @@ fn run(a: RunArgs) -> Result<(), Error> {
     let mut vtk_error = None;
     // Snapshots need the state between steps, so the loop is written out here.
     let mut status = Ok(());
-    while !sim.finished() {
-        if let Err(e) = sim.step() {
-            status = Err(e);
-            break;
-        }
-        while next_vtk < vtk_times.len() && sim.time() >= vtk_times[next_vtk] {
-            if let Err(e) = write_vtk(&sim, &mut vtk_count) {
-                vtk_error = Some(e);
+    // The whole loop runs on a worker of the thread pool, so a step does not
+    // wake a worker from this thread and wait to be woken in turn.
+    rayon::scope(|_| {
+        while !sim.finished() {
+            if let Err(e) = sim.step() {
+                status = Err(e);
+                break;
             }
-            next_vtk += 1;
-        }
-        if show_bar
-            && start.elapsed() > Duration::from_secs(1)
-            && last_draw.elapsed() > Duration::from_millis(100)
-        {
-            let b = bar.get_or_insert_with(|| {
-                let b = ProgressBar::new(1000);
-                b.set_style(
-                    ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {msg}")
+            while next_vtk < vtk_times.len() && sim.time() >= vtk_times[next_vtk] {
+                if let Err(e) = write_vtk(&sim, &mut vtk_count) {
+                    vtk_error = Some(e);
+                }
+                next_vtk += 1;
+            }
+            if show_bar
+                && start.elapsed() > Duration::from_secs(1)
+                && last_draw.elapsed() > Duration::from_millis(100)
+            {
+                let b = bar.get_or_insert_with(|| {
+                    let b = ProgressBar::new(1000);
+                    b.set_style(
+                        ProgressStyle::with_template(
+                            "{spinner} [{elapsed_precise}] {bar:30} {msg}",
+                        )
                         .expect("valid template"),
-                );
-                b
-            });
-            b.set_position(((sim.time() / end_time) * 1000.0) as u64);
-            b.set_message(format!(
-                "t = {}, {} steps, {} particles",
-                fmt_duration(sim.time()),
-                sim.steps(),
-                sim.particles()
-            ));
-            last_draw = Instant::now();
+                    );
+                    b
+                });
+                b.set_position(((sim.time() / end_time) * 1000.0) as u64);
+                b.set_message(format!(
+                    "t = {}, {} steps, {} particles",
+                    fmt_duration(sim.time()),
+                    sim.steps(),
+                    sim.particles()
+                ));
+                last_draw = Instant::now();
+            }
         }
-    }
+    });
     if let Some(b) = bar {
         b.finish_and_clear();
     }

@@ -197,9 +197,13 @@ impl Simulation {
     /// The last step is not shortened, so the time may pass `t` by less than
     /// one step; results therefore do not depend on how a run is divided.
     pub fn advance_to(&mut self, t: f64) -> Result<()> {
-        while self.time() < t && !self.finished() {
-            self.step()?;
-        }
+        // On a worker of the thread pool: see `Simulation::run`.
+        rayon::scope(|_| {
+            while self.time() < t && !self.finished() {
+                self.step()?;
+            }
+            Ok(())
+        })?;
         match &self.error {
             Some(e) => Err(e.clone()),
             None => Ok(()),
@@ -220,7 +224,10 @@ impl Simulation {
 
     /// Runs to the end condition.
     pub fn run(&mut self) -> Result<()> {
-        self.run_with(|_| true)
+        // The whole loop runs on a worker of the thread pool, so a step does
+        // not wake a worker from the calling thread and wait to be woken in
+        // turn (test 7 on one thread: 8% of the run time).
+        rayon::scope(|_| self.run_with(|_| true))
     }
 
     /// Runs to the end condition, calling `progress` after every step; the
