@@ -434,6 +434,13 @@ impl Neighbourhood {
     /// result does not depend on the thread or the instruction set.
     #[inline(always)]
     pub fn power_sums(&mut self) -> [f64; POWER_SUMS] {
+        self.power_partials().map(crate::lanes::total)
+    }
+
+    /// The [`W`] lane partial sums of each power sum (see
+    /// [`Neighbourhood::power_sums`], which totals them).
+    #[inline(always)]
+    pub fn power_partials(&mut self) -> [Lanes; POWER_SUMS] {
         let padded = self.gaussians();
         let mut acc = [[0.0; W]; POWER_SUMS];
         for c in (0..padded).step_by(W) {
@@ -472,7 +479,7 @@ impl Neighbourhood {
                 }
             }
         }
-        acc.map(crate::lanes::total)
+        acc
     }
 
     /// Assembles the moment matrix (see [`Neighbourhood::power_sums`]).

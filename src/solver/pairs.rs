@@ -228,7 +228,7 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
     let nb = out.part.len();
     let stride = inp.stride;
     let inv_h = 1.0 / inp.h;
-    let mut sums = [[0.0; W]; POWER_SUMS];
+    let mut partials = [[[0.0; W]; POWER_SUMS]; W];
     for p in 0..nb {
         let i = i0 + p;
         let hood = &mut scratch.hoods[p];
@@ -250,10 +250,11 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
             min_d2,
             min_d2_free,
         };
-        for (k, x) in hood.power_sums().iter().enumerate() {
-            sums[k][p] = *x;
-        }
+        partials[p] = hood.power_partials();
     }
+    // Each power sum of the eight particles at once (unused lanes zero).
+    let sums: [Lanes; POWER_SUMS] =
+        std::array::from_fn(|k| lanes::totals(&std::array::from_fn(|p| partials[p][k])));
     let b = moment_matrix_lanes(&sums);
     // The Gram route without pivoting; unused lanes (zero sums) are not read.
     let (mut inv, elsewhere) = inverse_moments_lanes(&sums);
