@@ -288,7 +288,8 @@ pub fn inverse_moments_lanes(
     let mut scale = [0.0; W];
     for l in 0..W {
         let gamma = 1.0 - b[0][l];
-        // Typically about 0.95: exp(-4) u is small against G.
+        // w = exp(-4) u is small next to the Gram terms, so gamma stays near
+        // 1; far from it the correction would amplify rounding errors.
         let bad = gamma.is_nan() || gamma.abs() < 0.5;
         elsewhere[l] |= bad;
         scale[l] = 1.0 / if bad { 1.0 } else { gamma };

@@ -253,8 +253,15 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         partials[p] = hood.power_partials();
     }
     // Each power sum of the eight particles at once (unused lanes zero).
-    let sums: [Lanes; POWER_SUMS] =
-        std::array::from_fn(|k| lanes::totals(&std::array::from_fn(|p| partials[p][k])));
+    // Plain loops: a closure left out of line would lose the instruction set.
+    let mut sums = [[0.0; W]; POWER_SUMS];
+    for (k, s) in sums.iter_mut().enumerate() {
+        let mut of_k = [[0.0; W]; W];
+        for (x, part) in of_k.iter_mut().zip(&partials) {
+            *x = part[k];
+        }
+        *s = lanes::totals(&of_k);
+    }
     let b = moment_matrix_lanes(&sums);
     // The Gram route without pivoting; unused lanes (zero sums) are not read.
     let (mut inv, elsewhere) = inverse_moments_lanes(&sums);
