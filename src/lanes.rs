@@ -329,37 +329,34 @@ pub fn norm1<const N: usize>(m: &LaneMatrix<N>) -> Lanes {
 /// of eight separate ones.
 #[inline(always)]
 pub fn totals(x: &[Lanes; W]) -> Lanes {
+    // Plain loops, no closures: a closure left out of line would lose the
+    // caller's instruction set.
     // Level 1: h[l] = x[l] + x[l + 4], two arrays per vector.
-    let h = |a: &Lanes, b: &Lanes| -> Lanes {
-        std::array::from_fn(|l| {
-            if l < 4 {
-                a[l] + a[l + 4]
-            } else {
-                b[l - 4] + b[l]
-            }
-        })
-    };
+    let mut h = [[0.0; W]; 4];
+    for (j, hj) in h.iter_mut().enumerate() {
+        let (a, b) = (&x[2 * j], &x[2 * j + 1]);
+        for l in 0..4 {
+            hj[l] = a[l] + a[l + 4];
+            hj[l + 4] = b[l] + b[l + 4];
+        }
+    }
     // Level 2: (h0 + h2, h1 + h3) of each array, four per vector.
-    let q = |a: &Lanes, b: &Lanes| -> Lanes {
-        std::array::from_fn(|l| {
-            let (s, m) = (if l < 4 { a } else { b }, (l % 4) / 2 * 4 + l % 2);
-            s[m] + s[m + 2]
-        })
-    };
+    let mut q = [[0.0; W]; 2];
+    for (j, qj) in q.iter_mut().enumerate() {
+        let (a, b) = (&h[2 * j], &h[2 * j + 1]);
+        for l in 0..4 {
+            let m = l / 2 * 4 + l % 2;
+            qj[l] = a[m] + a[m + 2];
+            qj[l + 4] = b[m] + b[m + 2];
+        }
+    }
     // Level 3: (h0 + h2) + (h1 + h3), all eight.
-    let f = |a: &Lanes, b: &Lanes| -> Lanes {
-        std::array::from_fn(|l| {
-            let (s, m) = (if l < 4 { a } else { b }, 2 * (l % 4));
-            s[m] + s[m + 1]
-        })
-    };
-    let (h01, h23, h45, h67) = (
-        h(&x[0], &x[1]),
-        h(&x[2], &x[3]),
-        h(&x[4], &x[5]),
-        h(&x[6], &x[7]),
-    );
-    f(&q(&h01, &h23), &q(&h45, &h67))
+    let mut out = [0.0; W];
+    for l in 0..4 {
+        out[l] = q[0][2 * l] + q[0][2 * l + 1];
+        out[l + 4] = q[1][2 * l] + q[1][2 * l + 1];
+    }
+    out
 }
 
 /// `sum_l x[l]` in a fixed pairwise order.

@@ -79,6 +79,8 @@ pub(super) struct PairOutputs<'a> {
 #[repr(align(128))]
 pub(super) struct Scratch {
     hoods: [Neighbourhood; W],
+    /// Lane partial sums of the power sums of each particle of a batch.
+    partials: [[Lanes; POWER_SUMS]; W],
 }
 
 /// One [`Scratch`] per thread of the pool, kept from step to step so the
@@ -228,7 +230,6 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
     let nb = out.part.len();
     let stride = inp.stride;
     let inv_h = 1.0 / inp.h;
-    let mut partials = [[[0.0; W]; POWER_SUMS]; W];
     for p in 0..nb {
         let i = i0 + p;
         let hood = &mut scratch.hoods[p];
@@ -250,14 +251,19 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
             min_d2,
             min_d2_free,
         };
-        partials[p] = hood.power_partials();
+        scratch.partials[p] = hood.power_partials();
+    }
+    // Kept in the scratch, not zeroed per batch: only the unused lanes are.
+    let partials = &mut scratch.partials;
+    for part in &mut partials[nb..] {
+        *part = [[0.0; W]; POWER_SUMS];
     }
     // Each power sum of the eight particles at once (unused lanes zero).
     // Plain loops: a closure left out of line would lose the instruction set.
     let mut sums = [[0.0; W]; POWER_SUMS];
     for (k, s) in sums.iter_mut().enumerate() {
         let mut of_k = [[0.0; W]; W];
-        for (x, part) in of_k.iter_mut().zip(&partials) {
+        for (x, part) in of_k.iter_mut().zip(partials.iter()) {
             *x = part[k];
         }
         *s = lanes::totals(&of_k);
