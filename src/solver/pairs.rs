@@ -223,6 +223,23 @@ fn scan_candidates(
     (fold(min_d2), fold(min_d2_free))
 }
 
+/// [`lanes::totals`] of the power sums of a batch: lane `p` of sum `k` is
+/// the total of `partials[p][k]`. [`avx512::power_totals`] is the same with
+/// AVX-512 block shuffles, bit for bit.
+#[inline(always)]
+fn power_totals(partials: &[[Lanes; POWER_SUMS]; W]) -> [Lanes; POWER_SUMS] {
+    let mut sums = [[0.0; W]; POWER_SUMS];
+    // Plain loops: a closure left out of line would lose the instruction set.
+    for (k, s) in sums.iter_mut().enumerate() {
+        let mut of_k = [[0.0; W]; W];
+        for (x, part) in of_k.iter_mut().zip(partials.iter()) {
+            *x = part[k];
+        }
+        *s = lanes::totals(&of_k);
+    }
+    sums
+}
+
 /// The pair pass of the particles `i0 .. i0 + out.part.len()` (at most
 /// [`W`]). See the module documentation.
 #[multiversion(targets("x86_64+avx512f+avx512vl"))]
@@ -259,15 +276,10 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         *part = [[0.0; W]; POWER_SUMS];
     }
     // Each power sum of the eight particles at once (unused lanes zero).
-    // Plain loops: a closure left out of line would lose the instruction set.
-    let mut sums = [[0.0; W]; POWER_SUMS];
-    for (k, s) in sums.iter_mut().enumerate() {
-        let mut of_k = [[0.0; W]; W];
-        for (x, part) in of_k.iter_mut().zip(partials.iter()) {
-            *x = part[k];
-        }
-        *s = lanes::totals(&of_k);
-    }
+    let sums = match_target! {
+        "x86_64+avx512f+avx512vl" => avx512::power_totals(partials),
+        _ => power_totals(partials),
+    };
     let b = moment_matrix_lanes(&sums);
     // The Gram route without pivoting; unused lanes (zero sums) are not read.
     let (mut inv, elsewhere) = inverse_moments_lanes(&sums);
@@ -323,7 +335,10 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         // Momentum: v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
         let si = inp.sbc[i];
         let act = &out.act[row];
-        let [drr_r, drz_r, drz_z, dzz_z] = stress_divergence(act, wr, wz, inp.sbc, si);
+        let [drr_r, drz_r, drz_z, dzz_z] = match_target! {
+            "x86_64+avx512f+avx512vl" => avx512::stress_divergence(act, wr, wz, inp.sbc, si),
+            _ => stress_divergence(act, wr, wz, inp.sbc, si),
+        };
         let (v, rho, dt) = (inp.vel[i], inp.rho[i], inp.dt);
         out.vel[p] = if i.is_multiple_of(inp.nr) {
             [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho]
@@ -472,6 +487,59 @@ mod tests {
 mod avx512_tests {
     use super::*;
     use crate::neighbors::cell_list_first;
+
+    /// A pseudo-random number in [-0.5, 0.5) times a power of ten from
+    /// 1e-6 to 1e6, so that sums round.
+    fn spread(seed: &mut u64) -> f64 {
+        let mut next = || {
+            *seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (*seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (next() - 0.5) * 10f64.powi((next() * 12.0) as i32 - 6)
+    }
+
+    /// The AVX-512 batched totals of the power sums and stress divergence
+    /// equal the portable ones bit for bit.
+    #[test]
+    #[allow(unsafe_code)]
+    fn avx512_sums_equal_portable_sums() {
+        if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
+            eprintln!("no AVX-512 on this machine: nothing to compare");
+            return;
+        }
+        let mut seed = 11u64;
+        for _ in 0..200 {
+            let mut partials = [[[0.0; W]; POWER_SUMS]; W];
+            for x in partials.iter_mut().flatten().flatten() {
+                *x = spread(&mut seed);
+            }
+            let a = power_totals(&partials);
+            // SAFETY: the CPU has AVX-512F and VL (checked above).
+            let b = unsafe { avx512::power_totals(&partials) };
+            for (ra, rb) in a.iter().zip(&b) {
+                for (x, y) in ra.iter().zip(rb) {
+                    assert_eq!(x.to_bits(), y.to_bits());
+                }
+            }
+        }
+        let sbc: Vec<Stress> = (0..97)
+            .map(|_| std::array::from_fn(|_| spread(&mut seed)))
+            .collect();
+        for len in [W, 2 * W, 5 * W] {
+            for _ in 0..50 {
+                let act: Vec<u32> = (0..len)
+                    .map(|_| (spread(&mut seed).abs() * 1e6) as u32 % sbc.len() as u32)
+                    .collect();
+                let wr: Vec<f64> = (0..len).map(|_| spread(&mut seed)).collect();
+                let wz: Vec<f64> = (0..len).map(|_| spread(&mut seed)).collect();
+                let si = sbc[act[0] as usize];
+                let a = stress_divergence(&act, &wr, &wz, &sbc, si);
+                // SAFETY: as above.
+                let b = unsafe { avx512::stress_divergence(&act, &wr, &wz, &sbc, si) };
+                assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{len} slots");
+            }
+        }
+    }
 
     /// The AVX-512 candidate scan gives the portable scan's neighbourhoods,
     /// rows and minimum distances bit for bit, on a jittered lattice whose

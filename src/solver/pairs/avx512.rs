@@ -7,9 +7,10 @@
 //! index is checked against the length of the slice it reads, and every
 //! store against the room of the slice it writes, before the access.
 
-use super::{Neighbourhood, PairInputs};
+use super::{Neighbourhood, PairInputs, Stress};
 use crate::kernel::SUPPORT;
-use crate::lanes::W;
+use crate::lanes::{Lanes, W};
+use crate::msph::POWER_SUMS;
 use std::arch::x86_64::*;
 
 /// `(1 << k) - 1`: the low `k` of [`W`] lanes.
@@ -107,4 +108,115 @@ pub(super) fn scan_candidates(
     }
     *len = k;
     (_mm512_reduce_min_pd(min_d2), _mm512_reduce_min_pd(min_free))
+}
+
+/// [`crate::lanes::totals`] of the power sums of a batch: lane `p` of sum
+/// `k` is the total of `partials[p][k]`. The same additions in the same
+/// order, with whole-register block shuffles (the portable loops compile to
+/// two-lane pieces here, several times as many instructions).
+#[target_feature(enable = "avx512f,avx512vl")]
+pub(super) fn power_totals(partials: &[[Lanes; POWER_SUMS]; W]) -> [Lanes; POWER_SUMS] {
+    let mut out = [[0.0; W]; POWER_SUMS];
+    let even = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
+    let odd = _mm512_set_epi64(15, 13, 11, 9, 7, 5, 3, 1);
+    // Plain loops, no closures (a closure left out of line would lose the
+    // instruction set).
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut x = [_mm512_setzero_pd(); W];
+        for (xp, part) in x.iter_mut().zip(partials) {
+            // SAFETY: a lane array is W = 8 doubles, one whole register.
+            *xp = unsafe { _mm512_loadu_pd(part[k].as_ptr()) };
+        }
+        // Level 1: x[l] + x[l + 4] of two arrays per register.
+        let mut h = [_mm512_setzero_pd(); 4];
+        for (j, hj) in h.iter_mut().enumerate() {
+            let (a, b) = (x[2 * j], x[2 * j + 1]);
+            *hj = _mm512_add_pd(
+                _mm512_shuffle_f64x2::<0x44>(a, b),
+                _mm512_shuffle_f64x2::<0xEE>(a, b),
+            );
+        }
+        // Level 2: pairs two apart, four arrays per register.
+        let mut q = [_mm512_setzero_pd(); 2];
+        for (j, qj) in q.iter_mut().enumerate() {
+            let (a, b) = (h[2 * j], h[2 * j + 1]);
+            *qj = _mm512_add_pd(
+                _mm512_shuffle_f64x2::<0x88>(a, b),
+                _mm512_shuffle_f64x2::<0xDD>(a, b),
+            );
+        }
+        // Level 3: neighbouring pairs, all eight.
+        let t = _mm512_add_pd(
+            _mm512_permutex2var_pd(q[0], even, q[1]),
+            _mm512_permutex2var_pd(q[0], odd, q[1]),
+        );
+        // SAFETY: `o` is W = 8 doubles.
+        unsafe { _mm512_storeu_pd(o.as_mut_ptr(), t) };
+    }
+    out
+}
+
+/// [`super::stress_divergence`] with AVX-512: the stresses of the [`W`]
+/// neighbours of a lane are loaded row by row and transposed with block
+/// shuffles instead of being assembled two doubles at a time. The same
+/// operations in the same order, bit for bit.
+#[target_feature(enable = "avx512f,avx512vl")]
+pub(super) fn stress_divergence(
+    act: &[u32],
+    wr: &[f64],
+    wz: &[f64],
+    sbc: &[Stress],
+    si: Stress,
+) -> [f64; 4] {
+    let n = act.len();
+    assert!(n.is_multiple_of(W) && wr.len() >= n && wz.len() >= n);
+    assert!(sbc.len() < (i32::MAX as usize));
+    let reach = _mm256_set1_epi32(sbc.len() as i32);
+    let base = sbc.as_ptr().cast::<f64>();
+    let (s0, s1, s3) = (
+        _mm512_set1_pd(si[0]),
+        _mm512_set1_pd(si[1]),
+        _mm512_set1_pd(si[3]),
+    );
+    let mut acc = [_mm512_setzero_pd(); 4];
+    for c in (0..n).step_by(W) {
+        // SAFETY: `c + W <= n = act.len()`.
+        let idx = unsafe { _mm256_loadu_si256(act[c..c + W].as_ptr().cast()) };
+        assert_eq!(
+            _mm256_cmpge_epu32_mask(idx, reach),
+            0,
+            "neighbour out of range"
+        );
+        // SAFETY: every index is below `sbc.len()` (checked above), so each
+        // row of four doubles lies inside `sbc`.
+        let row = |l: usize| unsafe { _mm256_loadu_pd(base.add(4 * act[c + l] as usize)) };
+        let pair = |l: usize| _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(row(l)), row(l + 2));
+        let (a0, a1, a2, a3) = (pair(0), pair(1), pair(4), pair(5));
+        let (t0, t1) = (_mm512_unpacklo_pd(a0, a1), _mm512_unpackhi_pd(a0, a1));
+        let (t2, t3) = (_mm512_unpacklo_pd(a2, a3), _mm512_unpackhi_pd(a2, a3));
+        // Components RR, ZZ and RZ of the eight neighbours.
+        let rr = _mm512_shuffle_f64x2::<0x88>(t0, t2);
+        let zz = _mm512_shuffle_f64x2::<0x88>(t1, t3);
+        let rz = _mm512_shuffle_f64x2::<0xDD>(t1, t3);
+        // SAFETY: `c + W <= n <= wr.len(), wz.len()`.
+        let (gr, gz) = unsafe {
+            (
+                _mm512_loadu_pd(wr[c..].as_ptr()),
+                _mm512_loadu_pd(wz[c..].as_ptr()),
+            )
+        };
+        let drz = _mm512_sub_pd(rz, s3);
+        acc[0] = _mm512_add_pd(acc[0], _mm512_mul_pd(gr, _mm512_sub_pd(rr, s0)));
+        acc[1] = _mm512_add_pd(acc[1], _mm512_mul_pd(gr, drz));
+        acc[2] = _mm512_add_pd(acc[2], _mm512_mul_pd(gz, drz));
+        acc[3] = _mm512_add_pd(acc[3], _mm512_mul_pd(gz, _mm512_sub_pd(zz, s1)));
+    }
+    let mut out = [0.0; 4];
+    for (o, a) in out.iter_mut().zip(acc) {
+        let mut x = [0.0; W];
+        // SAFETY: `x` is W = 8 doubles.
+        unsafe { _mm512_storeu_pd(x.as_mut_ptr(), a) };
+        *o = crate::lanes::total(x);
+    }
+    out
 }
