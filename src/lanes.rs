@@ -4,11 +4,12 @@
 //! particles inverted together ([`invert`]), and sums over neighbours in
 //! [`W`] partial sums ([`gather`], [`total`]).
 //!
-//! Every lane operation is an IEEE add, multiply, divide, compare or select,
-//! never a fused multiply-add, and every sum runs in a fixed order, so the
-//! results are the same bit for bit whatever instruction set runs them (a
-//! test 7 run built for AVX-512, for AVX2 and for baseline x86-64 gave
-//! identical observables, BENCHMARKS.md).
+//! Every lane operation is an IEEE add, multiply, fused multiply-add
+//! ([`mul_add`]), divide, compare or select, each correctly rounded, and
+//! every sum runs in a fixed order, so the results are the same bit for bit
+//! whatever instruction set runs them (BENCHMARKS.md). A clone without
+//! hardware FMA computes the fused operation in software: the same bits,
+//! slower.
 
 /// Number of lanes: eight doubles, one AVX-512 register.
 pub const W: usize = 8;
@@ -58,11 +59,13 @@ pub fn exp(x: Lanes) -> Lanes {
         let r = (x[l] - k * LN2_HI) - k * LN2_LO;
         // Estrin's scheme: eight operations deep instead of Horner's 26.
         let c = &INV_FACTORIAL;
-        let (r2, pair) = (r * r, |k: usize| c[k] + c[k + 1] * r);
+        let (r2, pair) = (r * r, |k: usize| c[k + 1].mul_add(r, c[k]));
         let r4 = r2 * r2;
-        let lo = (pair(0) + pair(2) * r2) + (pair(4) + pair(6) * r2) * r4;
-        let hi = (pair(8) + pair(10) * r2) + pair(12) * r4;
-        let p = lo + hi * (r4 * r4);
+        let lo = pair(6)
+            .mul_add(r2, pair(4))
+            .mul_add(r4, pair(2).mul_add(r2, pair(0)));
+        let hi = pair(12).mul_add(r4, pair(10).mul_add(r2, pair(8)));
+        let p = hi.mul_add(r4 * r4, lo);
         // The low bits of `t` hold `k` (two's complement over the magic).
         let ki = t.to_bits().wrapping_sub(ROUND_MAGIC.to_bits());
         let scale = f64::from_bits(ki.wrapping_add(1023) << 52);
@@ -212,6 +215,20 @@ pub fn mul(a: Lanes, b: Lanes) -> Lanes {
     std::array::from_fn(|l| a[l] * b[l])
 }
 
+/// `a * b + c` lane by lane with a single rounding (a fused multiply-add,
+/// an exactly specified IEEE operation: the same bits on every instruction
+/// set, in hardware where the clone has FMA, in software otherwise).
+#[inline(always)]
+pub fn mul_add(a: Lanes, b: Lanes, c: Lanes) -> Lanes {
+    std::array::from_fn(|l| a[l].mul_add(b[l], c[l]))
+}
+
+/// `c - a * b` lane by lane with a single rounding.
+#[inline(always)]
+pub fn neg_mul_add(a: Lanes, b: Lanes, c: Lanes) -> Lanes {
+    std::array::from_fn(|l| (-a[l]).mul_add(b[l], c[l]))
+}
+
 /// Runs `$body` once for each listed value, with `$v` a constant of that
 /// value, so that the loops inside have constant bounds and unroll.
 macro_rules! unroll {
@@ -256,7 +273,7 @@ pub fn invert_spd6(g: &LaneMatrix<6>, min_pivot: f64) -> (LaneMatrix<6>, [bool; 
     unroll!(j in [0, 1, 2, 3, 4, 5] {
         let mut d = g[j][j];
         for k in 0..j {
-            d = sub(d, mul(l[j][k], ld[j][k]));
+            d = neg_mul_add(l[j][k], ld[j][k], d);
         }
         let (d, bad) = pivot_above(d, mul(splat(min_pivot), g[j][j]));
         for x in 0..W {
@@ -266,7 +283,7 @@ pub fn invert_spd6(g: &LaneMatrix<6>, min_pivot: f64) -> (LaneMatrix<6>, [bool; 
         for i in j + 1..N {
             let mut t = g[i][j];
             for k in 0..j {
-                t = sub(t, mul(l[i][k], ld[j][k]));
+                t = neg_mul_add(l[i][k], ld[j][k], t);
             }
             ld[i][j] = t;
             l[i][j] = mul(t, dinv[j]);
@@ -279,7 +296,7 @@ pub fn invert_spd6(g: &LaneMatrix<6>, min_pivot: f64) -> (LaneMatrix<6>, [bool; 
         for i in j + 1..N {
             let mut t = l[i][j];
             for k in j + 1..i {
-                t = add(t, mul(l[i][k], y[k][j]));
+                t = mul_add(l[i][k], y[k][j], t);
             }
             y[i][j] = sub([0.0; W], t);
         }
@@ -294,7 +311,7 @@ pub fn invert_spd6(g: &LaneMatrix<6>, min_pivot: f64) -> (LaneMatrix<6>, [bool; 
         for j in 0..=i {
             let mut s = mul(yd[i], y[i][j]);
             for k in i + 1..N {
-                s = add(s, mul(yd[k], y[k][j]));
+                s = mul_add(yd[k], y[k][j], s);
             }
             inv[i][j] = s;
             inv[j][i] = s;

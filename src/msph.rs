@@ -248,7 +248,7 @@ pub const MIN_GRAM_PIVOT: f64 = 1e-6;
 pub fn inverse_moments_lanes(
     sums: &[Lanes; POWER_SUMS],
 ) -> (crate::lanes::LaneMatrix<6>, [bool; W]) {
-    use crate::lanes::{add, mul, splat, unroll};
+    use crate::lanes::{add, mul, mul_add, splat, unroll};
     let (m, n) = sums.split_at(15);
     // Plain loops, not array::from_fn: a closure the compiler leaves out of
     // line would lose the caller's instruction set.
@@ -282,7 +282,7 @@ pub fn inverse_moments_lanes(
     unroll!(j in [0, 1, 2, 3, 4, 5] {
         b[j] = mul(w[0], a[0][j]);
         for i in 1..6 {
-            b[j] = add(b[j], mul(w[i], a[i][j]));
+            b[j] = mul_add(w[i], a[i][j], b[j]);
         }
     });
     let mut scale = [0.0; W];
@@ -297,7 +297,7 @@ pub fn inverse_moments_lanes(
     unroll!(i in [0, 1, 2, 3, 4, 5] {
         let c0 = mul(a[i][0], scale);
         for j in 0..6 {
-            a[i][j] = add(a[i][j], mul(c0, b[j]));
+            a[i][j] = mul_add(c0, b[j], a[i][j]);
         }
     });
     (a, elsewhere)
@@ -473,10 +473,10 @@ impl Neighbourhood {
                     z2 * z2,
                 ];
                 for k in 0..15 {
-                    acc[k][l] += ev * mons[k];
+                    acc[k][l] = ev.mul_add(mons[k], acc[k][l]);
                 }
                 for k in 0..6 {
-                    acc[15 + k][l] += v[l] * mons[k];
+                    acc[15 + k][l] = v[l].mul_add(mons[k], acc[15 + k][l]);
                 }
             }
         }
@@ -539,7 +539,7 @@ impl Neighbourhood {
                 for k in 0..K {
                     let mut s = rows[k][0] * phi[0];
                     for a in 1..6 {
-                        s += rows[k][a] * phi[a];
+                        s = rows[k][a].mul_add(phi[a], s);
                     }
                     w[k][l] = s * v[l] * scale[k];
                 }

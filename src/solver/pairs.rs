@@ -145,7 +145,7 @@ impl std::ops::DerefMut for ScratchRef<'_> {
 /// The stress-divergence sums of the momentum equation over the padded row
 /// `act` (padded slots have zero weight and a valid index): `sum_j g_j (s_j -
 /// s_i)` for (`g`, `s`) = (`wr`, RR), (`wr`, RZ), (`wz`, RZ), (`wz`, ZZ). Fixed
-/// order: lane partial sums, then [`lanes::total`].
+/// order: lane partial sums (fused multiply-adds), then [`lanes::total`].
 #[inline(always)]
 fn stress_divergence(act: &[u32], wr: &[f64], wz: &[f64], sbc: &[Stress], si: Stress) -> [f64; 4] {
     let mut acc = [[0.0; W]; 4];
@@ -153,10 +153,10 @@ fn stress_divergence(act: &[u32], wr: &[f64], wz: &[f64], sbc: &[Stress], si: St
         let s = lanes::gather(sbc, act[c..c + W].try_into().expect("a whole lane"));
         let (gr, gz) = (&wr[c..c + W], &wz[c..c + W]);
         for l in 0..W {
-            acc[0][l] += gr[l] * (s[0][l] - si[0]);
-            acc[1][l] += gr[l] * (s[3][l] - si[3]);
-            acc[2][l] += gz[l] * (s[3][l] - si[3]);
-            acc[3][l] += gz[l] * (s[1][l] - si[1]);
+            acc[0][l] = gr[l].mul_add(s[0][l] - si[0], acc[0][l]);
+            acc[1][l] = gr[l].mul_add(s[3][l] - si[3], acc[1][l]);
+            acc[2][l] = gz[l].mul_add(s[3][l] - si[3], acc[2][l]);
+            acc[3][l] = gz[l].mul_add(s[1][l] - si[1], acc[3][l]);
         }
     }
     acc.map(lanes::total)
@@ -242,7 +242,7 @@ fn power_totals(partials: &[[Lanes; POWER_SUMS]; W]) -> [Lanes; POWER_SUMS] {
 
 /// The pair pass of the particles `i0 .. i0 + out.part.len()` (at most
 /// [`W`]). See the module documentation.
-#[multiversion(targets("x86_64+avx512f+avx512vl"))]
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
 pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch: &mut Scratch) {
     let nb = out.part.len();
     let stride = inp.stride;
@@ -375,7 +375,7 @@ impl Rows<'_> {
 }
 
 /// Shepard means `sum_j s_ij f_j` of the particles `i0 .. i0 + out.len()`.
-#[multiversion(targets("x86_64+avx512f+avx512vl"))]
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
 pub(super) fn shepard_means<const K: usize>(
     rows: Rows,
     f: &[[f64; K]],
@@ -400,7 +400,7 @@ pub(super) fn shepard_means<const K: usize>(
 
 /// Velocity gradients (dU_R/dR, dU_R/dZ, dU_Z/dR, dU_Z/dZ) of the particles
 /// `i0 .. i0 + out.len()`.
-#[multiversion(targets("x86_64+avx512f+avx512vl"))]
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
 pub(super) fn velocity_gradients(rows: Rows, vel: &[[f64; 2]], i0: usize, out: &mut [[f64; 4]]) {
     for (k, o) in out.iter_mut().enumerate() {
         let i = i0 + k;

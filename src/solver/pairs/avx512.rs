@@ -206,10 +206,10 @@ pub(super) fn stress_divergence(
             )
         };
         let drz = _mm512_sub_pd(rz, s3);
-        acc[0] = _mm512_add_pd(acc[0], _mm512_mul_pd(gr, _mm512_sub_pd(rr, s0)));
-        acc[1] = _mm512_add_pd(acc[1], _mm512_mul_pd(gr, drz));
-        acc[2] = _mm512_add_pd(acc[2], _mm512_mul_pd(gz, drz));
-        acc[3] = _mm512_add_pd(acc[3], _mm512_mul_pd(gz, _mm512_sub_pd(zz, s1)));
+        acc[0] = _mm512_fmadd_pd(gr, _mm512_sub_pd(rr, s0), acc[0]);
+        acc[1] = _mm512_fmadd_pd(gr, drz, acc[1]);
+        acc[2] = _mm512_fmadd_pd(gz, drz, acc[2]);
+        acc[3] = _mm512_fmadd_pd(gz, _mm512_sub_pd(zz, s1), acc[3]);
     }
     let mut out = [0.0; 4];
     for (o, a) in out.iter_mut().zip(acc) {
