@@ -13,6 +13,7 @@
 
 use crate::kernel::{EXP_M4, SUPPORT};
 use crate::lanes::{Lanes, W};
+use multiversion::multiversion;
 
 /// Largest 1-norm condition number of a scaled moment matrix that is accepted.
 /// Beyond it the particle arrangement cannot support a second-order
@@ -433,9 +434,8 @@ impl Neighbourhood {
     /// the moment matrix (for [`moment_matrix`]). Each sum runs in a fixed
     /// order ([`W`] lane partial sums, then [`crate::lanes::total`]), so the
     /// result does not depend on the thread or the instruction set.
-    #[inline(always)]
     pub fn power_sums(&mut self) -> [f64; POWER_SUMS] {
-        self.power_partials().map(crate::lanes::total)
+        power_sums_of(self)
     }
 
     /// The [`W`] lane partial sums of each power sum (see
@@ -501,7 +501,7 @@ impl Neighbourhood {
         out: [&mut [f64]; K],
         kernel: &mut [f64],
     ) {
-        self.weights_of(&rows.rows, &rows.scale, out, kernel);
+        weights_with(self, rows, out, kernel);
     }
 
     /// [`Neighbourhood::weights`] for rows of the inverse moment matrix
@@ -553,6 +553,30 @@ impl Neighbourhood {
         }
         crate::lanes::total(sum)
     }
+}
+
+/// [`Neighbourhood::power_sums`], compiled for the instruction sets with
+/// fused multiply-adds and chosen at run time (the baseline compiles them
+/// in software: the same bits, several times slower).
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+fn power_sums_of(hood: &mut Neighbourhood) -> [f64; POWER_SUMS] {
+    let partials = hood.power_partials();
+    let mut out = [0.0; POWER_SUMS];
+    for (o, p) in out.iter_mut().zip(partials) {
+        *o = crate::lanes::total(p);
+    }
+    out
+}
+
+/// [`Neighbourhood::weights`], chosen at run time like [`power_sums_of`].
+#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+fn weights_with<const K: usize>(
+    hood: &Neighbourhood,
+    rows: &Msph2Rows<K>,
+    out: [&mut [f64]; K],
+    kernel: &mut [f64],
+) {
+    hood.weights_of(&rows.rows, &rows.scale, out, kernel);
 }
 
 /// Selected rows of the inverse of the scaled 2-D moment matrix of particle
