@@ -452,10 +452,15 @@ mod tests {
         }
     }
 
+    /// 2 on the diagonal and 0.5 elsewhere in every lane: well conditioned,
+    /// for tests that spoil some lanes.
+    fn dominant<const N: usize>() -> LaneMatrix<N> {
+        std::array::from_fn(|r| std::array::from_fn(|c| [if r == c { 2.0 } else { 0.5 }; W]))
+    }
+
     #[test]
     fn singular_lanes_are_flagged_and_do_not_spoil_the_others() {
-        let mut a: LaneMatrix<3> =
-            std::array::from_fn(|r| std::array::from_fn(|c| [if r == c { 2.0 } else { 0.5 }; W]));
+        let mut a: LaneMatrix<3> = dominant();
         // Lane 3: two equal rows. Lane 5: a NaN entry.
         for c in 0..3 {
             a[1][c][3] = a[0][c][3];
@@ -515,8 +520,7 @@ mod tests {
 
     #[test]
     fn non_positive_definite_lanes_are_flagged_and_do_not_spoil_the_others() {
-        let mut g: LaneMatrix<6> =
-            std::array::from_fn(|r| std::array::from_fn(|c| [if r == c { 2.0 } else { 0.5 }; W]));
+        let mut g: LaneMatrix<6> = dominant();
         // Lane 3: two equal rows (singular). Lane 5: a NaN entry. Lane 6: a
         // negative eigenvalue (its third pivot is 0.1 - 0.2). Lane 7: nearly
         // singular (its third pivot is 1e-7 of the diagonal entry).

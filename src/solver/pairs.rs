@@ -488,14 +488,26 @@ mod avx512_tests {
     use super::*;
     use crate::neighbors::cell_list_first;
 
+    /// A pseudo-random number in [0, 1) from a linear congruential step.
+    fn uniform(seed: &mut u64) -> f64 {
+        *seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
     /// A pseudo-random number in [-0.5, 0.5) times a power of ten from
     /// 1e-6 to 1e6, so that sums round.
     fn spread(seed: &mut u64) -> f64 {
-        let mut next = || {
-            *seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            (*seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        (next() - 0.5) * 10f64.powi((next() * 12.0) as i32 - 6)
+        let x = uniform(seed) - 0.5;
+        x * 10f64.powi((uniform(seed) * 12.0) as i32 - 6)
+    }
+
+    /// Whether this CPU runs the AVX-512 code (said on stderr when not).
+    fn avx512_here() -> bool {
+        let here = is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl");
+        if !here {
+            eprintln!("no AVX-512 on this machine: nothing to compare");
+        }
+        here
     }
 
     /// The AVX-512 batched totals of the power sums and stress divergence
@@ -503,8 +515,7 @@ mod avx512_tests {
     #[test]
     #[allow(unsafe_code)]
     fn avx512_sums_equal_portable_sums() {
-        if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
-            eprintln!("no AVX-512 on this machine: nothing to compare");
+        if !avx512_here() {
             return;
         }
         let mut seed = 11u64;
@@ -547,16 +558,12 @@ mod avx512_tests {
     #[test]
     #[allow(unsafe_code)]
     fn avx512_scan_equals_portable_scan() {
-        if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
-            eprintln!("no AVX-512 on this machine: nothing to compare");
+        if !avx512_here() {
             return;
         }
         let (nr, nz, h) = (9, 14, 1.3);
         let mut seed = 7u64;
-        let mut jitter = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.6
-        };
+        let mut jitter = || (uniform(&mut seed) - 0.5) * 0.6;
         let pos: Vec<[f64; 2]> = (0..nr * nz)
             .map(|k| [(k % nr) as f64 + jitter(), (k / nr) as f64 + jitter()])
             .collect();
