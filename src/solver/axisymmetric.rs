@@ -28,6 +28,7 @@ use super::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, pair_batch, shepard_means, smooth,
     velocity_gradients,
 };
+use super::team::{Chunks, Team};
 use super::{COURANT, check_time_step};
 use crate::error::{Error, Result};
 use crate::kernel::SUPPORT;
@@ -37,7 +38,6 @@ use crate::material::johnson_cook::{JohnsonCook, radial_return};
 use crate::neighbors::padded_rows;
 use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
 use crate::scene::taylor::TaylorParams;
-use rayon::prelude::*;
 
 /// Radial strain below which the rod counts as undeformed (0.2 %).
 pub const UNDEFORMED_STRAIN: f64 = 0.002;
@@ -485,15 +485,23 @@ impl TaylorSolver {
     /// Advances one step.
     pub fn step(&mut self) -> Result<()> {
         let mut ws = std::mem::take(&mut self.ws);
-        // The whole step runs on one worker of the thread pool, so its
-        // parallel passes are shared with the other workers without handing
-        // each one over from the calling thread.
-        let result = rayon::scope(|_| self.step_in(&mut ws));
+        // The whole step runs on one worker of the thread pool, which leads
+        // a team of the others through its parallel passes
+        // (src/solver/team.rs).
+        let result = rayon::scope(|_| {
+            let team = Team::new();
+            rayon::in_place_scope(|s| self.step_in(&mut ws, &team, s))
+        });
         self.ws = ws;
         result
     }
 
-    fn step_in(&mut self, ws: &mut Workspace) -> Result<()> {
+    fn step_in<'s>(
+        &mut self,
+        ws: &mut Workspace,
+        team: &'s Team,
+        scope: &rayon::Scope<'s>,
+    ) -> Result<()> {
         let n = self.particles();
         let dt = self.dt;
         let alpha = self.p.smoothing_coefficient;
@@ -505,6 +513,10 @@ impl TaylorSolver {
         if self.needs_rebuild(ws) {
             self.rebuild_neighbours(ws);
         }
+        // After the rebuild (its own parallel loops), so that no follower
+        // waits on this thread meanwhile.
+        team.spawn_followers(scope);
+        let _finish = team.finish_on_drop();
         let Workspace {
             ghosts,
             stride,
@@ -560,24 +572,31 @@ impl TaylorSolver {
             h: self.h,
             dt,
         };
-        let batch = W * stride;
         let (mass, contact) = (&self.mass, &self.contact);
-        (
-            act.par_chunks_mut(batch),
-            wr.par_chunks_mut(batch),
-            wz.par_chunks_mut(batch),
-            wk.par_chunks_mut(batch),
-            part.par_chunks_mut(W),
-            vel[..n].par_chunks_mut(W),
-            batches.par_iter_mut(),
-        )
-            .into_par_iter()
-            .enumerate()
-            .with_min_len(MIN_LEN / W)
-            .for_each_init(
-                || scratch.get(),
-                |scratch, (b, (act, wr, wz, wk, part, vel, tally))| {
-                    let i0 = b * W;
+        {
+            let rows = MIN_LEN * stride;
+            let parts = (
+                Chunks::new(act, rows),
+                Chunks::new(wr, rows),
+                Chunks::new(wz, rows),
+                Chunks::new(wk, rows),
+                Chunks::new(part, MIN_LEN),
+                Chunks::new(&mut vel[..n], MIN_LEN),
+                Chunks::new(batches, MIN_LEN / W),
+            );
+            team.run_parts(&parts, |c, (act, wr, wz, wk, part, vel, tallies)| {
+                let mut scratch = scratch.get();
+                let batch = W * stride;
+                for (b, (((((act, wr), wz), wk), (part, vel)), tally)) in act
+                    .chunks_mut(batch)
+                    .zip(wr.chunks_mut(batch))
+                    .zip(wz.chunks_mut(batch))
+                    .zip(wk.chunks_mut(batch))
+                    .zip(part.chunks_mut(W).zip(vel.chunks_mut(W)))
+                    .zip(tallies)
+                    .enumerate()
+                {
+                    let i0 = c * MIN_LEN + b * W;
                     let out = PairOutputs {
                         act,
                         wr,
@@ -586,7 +605,7 @@ impl TaylorSolver {
                         part: &mut *part,
                         vel: &mut *vel,
                     };
-                    pair_batch(&inputs, i0, out, scratch);
+                    pair_batch(&inputs, i0, out, &mut scratch);
                     let mut t = BatchTally::default();
                     for (k, (p, v)) in part.iter().zip(vel.iter_mut()).enumerate() {
                         let i = i0 + k;
@@ -601,8 +620,9 @@ impl TaylorSolver {
                         }
                     }
                     *tally = t;
-                },
-            );
+                }
+            });
+        }
         let mut a = BatchTally::default();
         for t in batches.iter() {
             a.singular = a.singular.or(t.singular);
@@ -640,26 +660,28 @@ impl TaylorSolver {
         };
         {
             let vel = &*vel;
-            (vel_s[..n].par_chunks_mut(MIN_LEN), smoothing.par_iter_mut())
-                .into_par_iter()
-                .enumerate()
-                .for_each(|(c, (out, ke))| {
-                    let i0 = c * MIN_LEN;
-                    shepard_means(rows, vel, i0, out);
-                    *ke = [0.0; 2];
-                    for (k, v) in out.iter_mut().enumerate() {
-                        let i = i0 + k;
-                        *v = smooth(vel[i], *v, alpha);
-                        if axis(i) {
-                            v[0] = 0.0;
-                        }
-                        if contact[i] {
-                            v[1] = 0.0;
-                        }
-                        ke[0] += kinetic1(vel[i], mass[i]);
-                        ke[1] += kinetic1(*v, mass[i]);
+            let parts = (
+                Chunks::new(&mut vel_s[..n], MIN_LEN),
+                Chunks::new(smoothing, 1),
+            );
+            team.run_parts(&parts, |c, (out, ke)| {
+                let ke = &mut ke[0];
+                let i0 = c * MIN_LEN;
+                shepard_means(rows, vel, i0, out);
+                *ke = [0.0; 2];
+                for (k, v) in out.iter_mut().enumerate() {
+                    let i = i0 + k;
+                    *v = smooth(vel[i], *v, alpha);
+                    if axis(i) {
+                        v[0] = 0.0;
                     }
-                });
+                    if contact[i] {
+                        v[1] = 0.0;
+                    }
+                    ke[0] += kinetic1(vel[i], mass[i]);
+                    ke[1] += kinetic1(*v, mass[i]);
+                }
+            });
         }
         let ke = smoothing
             .iter()
@@ -669,13 +691,12 @@ impl TaylorSolver {
         // 4. Velocity gradients and continuity.
         fill_images(vel_s, n, ghosts, |v| [-v[0], v[1]]);
         let vel = &*vel_s;
-        (
-            grads.par_chunks_mut(MIN_LEN),
-            rho_raw[..n].par_chunks_mut(MIN_LEN),
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(c, (grads, rho_out))| {
+        {
+            let parts = (
+                Chunks::new(grads, MIN_LEN),
+                Chunks::new(&mut rho_raw[..n], MIN_LEN),
+            );
+            team.run_parts(&parts, |c, (grads, rho_out)| {
                 let i0 = c * MIN_LEN;
                 // dU_R/dR, dU_R/dZ, dU_Z/dR, dU_Z/dZ
                 velocity_gradients(rows, vel, i0, grads);
@@ -686,6 +707,7 @@ impl TaylorSolver {
                     *rho_out = [self.rho[i] * (1.0 - dt * div)];
                 }
             });
+        }
         fill_images(rho_raw, n, ghosts, |r| r);
 
         // 5-6. Per particle: conservative smoothing of the density, the
@@ -701,27 +723,28 @@ impl TaylorSolver {
         let modulus = self.p.bulk_modulus + 4.0 / 3.0 * self.p.shear_modulus;
         let (grads, rho_raw) = (&*grads, &*rho_raw);
         let (h, mass) = (self.h, &self.mass);
-        (
-            (
-                self.dev.par_chunks_mut(MIN_LEN),
-                self.pressure.par_chunks_mut(MIN_LEN),
-                self.eps_p.par_chunks_mut(MIN_LEN),
-                self.temp.par_chunks_mut(MIN_LEN),
-                self.rho.par_chunks_mut(MIN_LEN),
-                strength.par_chunks_mut(MIN_LEN),
-            ),
-            (
-                self.pos.par_chunks_mut(MIN_LEN),
-                self.vel.par_chunks_mut(MIN_LEN),
-                self.contact.par_chunks_mut(MIN_LEN),
-                self.stress_bc.par_chunks_mut(MIN_LEN),
-                tallies.par_iter_mut(),
-            ),
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(
-                |(c, ((dev, pressure, eps_p, temp, rho, memo), (x, v, touch, sbc, tally)))| {
+        {
+            let parts = (
+                (
+                    Chunks::new(&mut self.dev, MIN_LEN),
+                    Chunks::new(&mut self.pressure, MIN_LEN),
+                    Chunks::new(&mut self.eps_p, MIN_LEN),
+                    Chunks::new(&mut self.temp, MIN_LEN),
+                    Chunks::new(&mut self.rho, MIN_LEN),
+                    Chunks::new(strength, MIN_LEN),
+                ),
+                (
+                    Chunks::new(&mut self.pos, MIN_LEN),
+                    Chunks::new(&mut self.vel, MIN_LEN),
+                    Chunks::new(&mut self.contact, MIN_LEN),
+                    Chunks::new(&mut self.stress_bc, MIN_LEN),
+                    Chunks::new(tallies, 1),
+                ),
+            );
+            team.run_parts(
+                &parts,
+                |c, ((dev, pressure, eps_p, temp, rho, memo), (x, v, touch, sbc, tally))| {
+                    let tally = &mut tally[0];
                     let i0 = c * MIN_LEN;
                     let mut means = [[0.0]; MIN_LEN];
                     let means = &mut means[..dev.len()];
@@ -819,6 +842,7 @@ impl TaylorSolver {
                     *tally = t;
                 },
             );
+        }
         let mut t = Tally::default();
         for c in tallies.iter() {
             t.internal += c.internal;

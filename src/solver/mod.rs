@@ -8,6 +8,10 @@ pub mod axisymmetric;
 pub mod boundary;
 mod pairs;
 pub mod radial;
+// Shares disjoint chunks of the step's arrays between the threads of a
+// team: the only unsafe code of the solver besides the AVX-512 kernels.
+#[allow(unsafe_code)]
+mod team;
 
 /// Courant number of eq. (3.22).
 pub const COURANT: f64 = 0.2;
