@@ -5,8 +5,10 @@
 //! at its join several times a step. A [`Team`] is set up once a step
 //! instead: the thread running the step (the leader) spawns followers on the
 //! pool, and every pass is shared out chunk by chunk through one atomic
-//! counter, which leader and followers claim from; between passes the
-//! followers spin.
+//! claim word, the leader taking chunks from the front and the followers
+//! from the back (so each thread keeps to the same particles, and finds
+//! their rows in its own cache, from pass to pass); between passes the
+//! followers spin, then yield.
 //!
 //! Guarantees:
 //! - **Results do not depend on the team.** Each chunk is computed by
@@ -61,7 +63,7 @@ fn fields(w: u64) -> (u64, usize, usize) {
 
 /// The team of one step. See the module documentation.
 pub(super) struct Team {
-    /// The pass in progress, its number of chunks and the next chunk.
+    /// The pass in progress and its chunks left to claim (see [`word`]).
     claim: AtomicU64,
     /// Chunks of the pass in progress that are complete.
     done: AtomicUsize,
