@@ -487,21 +487,19 @@ impl TaylorSolver {
         let mut ws = std::mem::take(&mut self.ws);
         // The whole step runs on one worker of the thread pool, which leads
         // a team of the others through its parallel passes
-        // (src/solver/team.rs).
+        // (src/solver/team.rs). The neighbour rebuild comes first, with its
+        // own parallel loops, so that no follower waits through it.
         let result = rayon::scope(|_| {
-            let team = Team::new();
-            rayon::in_place_scope(|s| self.step_in(&mut ws, &team, s))
+            if self.needs_rebuild(&ws) {
+                self.rebuild_neighbours(&mut ws);
+            }
+            Team::lead(|team| self.step_in(&mut ws, team))
         });
         self.ws = ws;
         result
     }
 
-    fn step_in<'s>(
-        &mut self,
-        ws: &mut Workspace,
-        team: &'s Team,
-        scope: &rayon::Scope<'s>,
-    ) -> Result<()> {
+    fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
         let n = self.particles();
         let dt = self.dt;
         let alpha = self.p.smoothing_coefficient;
@@ -510,13 +508,6 @@ impl TaylorSolver {
         // Mirror images across the axis of the particles near it, so that
         // particles near the axis see a symmetric neighbourhood: U_R and
         // sigma_RZ change sign, the rest is even.
-        if self.needs_rebuild(ws) {
-            self.rebuild_neighbours(ws);
-        }
-        // After the rebuild (its own parallel loops), so that no follower
-        // waits on this thread meanwhile.
-        team.spawn_followers(scope);
-        let _finish = team.finish_on_drop();
         let Workspace {
             ghosts,
             stride,

@@ -33,7 +33,7 @@ use std::sync::atomic::{AtomicPtr, AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 /// How long a follower waits for work before it leaves the team.
-pub(super) const IDLE_LIMIT: Duration = Duration::from_millis(1);
+const IDLE_LIMIT: Duration = Duration::from_millis(1);
 
 /// The work of a pass: the function of a chunk index.
 type Job<'a> = &'a (dyn Fn(usize) + Sync + 'a);
@@ -46,7 +46,7 @@ const INDEX_MASK: u64 = (1 << INDEX_BITS) - 1;
 const END: u64 = 0xffff;
 
 /// Most chunks a pass can have.
-pub(super) const MAX_CHUNKS: usize = INDEX_MASK as usize;
+const MAX_CHUNKS: usize = INDEX_MASK as usize;
 
 fn word(pass: u64, front: usize, back: usize) -> u64 {
     (pass << (2 * INDEX_BITS)) | ((back as u64) << INDEX_BITS) | front as u64
@@ -79,8 +79,29 @@ pub(super) struct Team {
 }
 
 impl Team {
+    /// Runs `lead` on a worker of the pool, as the leader of a team with a
+    /// follower for every other worker, and returns its result once it has
+    /// returned and the followers have left. The followers are pushed with
+    /// `rayon::join`, on the stack: nothing is allocated.
+    pub fn lead<R: Send>(lead: impl FnOnce(&Team) -> R + Send) -> R {
+        rayon::scope(|_| {
+            let team = Team::new();
+            team.with_followers(rayon::current_num_threads().saturating_sub(1), lead)
+        })
+    }
+
+    /// `lead(self)` alongside `n` followers; the step ends when `lead`
+    /// returns (or panics), before the joins wait for the followers.
+    fn with_followers<R: Send>(&self, n: usize, lead: impl FnOnce(&Team) -> R + Send) -> R {
+        if n == 0 {
+            let _finish = Finish(self);
+            return lead(self);
+        }
+        rayon::join(|| self.with_followers(n - 1, lead), || self.follow()).0
+    }
+
     /// A team led by the calling thread.
-    pub fn new() -> Self {
+    fn new() -> Self {
         Team {
             claim: AtomicU64::new(word(0, 0, 0)),
             done: AtomicUsize::new(0),
@@ -88,13 +109,6 @@ impl Team {
             panic: Mutex::new(None),
             leader: rayon::current_thread_index(),
             passes: AtomicU64::new(0),
-        }
-    }
-
-    /// Spawns a follower on `scope` for every other thread of the pool.
-    pub fn spawn_followers<'s>(&'s self, scope: &rayon::Scope<'s>) {
-        for _ in 1..rayon::current_num_threads() {
-            scope.spawn(|_| self.follow());
         }
     }
 
@@ -169,14 +183,8 @@ impl Team {
     }
 
     /// Ends the step: the followers leave.
-    pub fn finish(&self) {
+    fn finish(&self) {
         self.claim.store(word(END, 0, 0), Ordering::Release);
-    }
-
-    /// A guard that ends the step when dropped (also on an early return or
-    /// a panic), so that the scope of the followers can close.
-    pub fn finish_on_drop(&self) -> Finish<'_> {
-        Finish(self)
     }
 
     /// A follower: claims chunks of the passes in progress until the step
@@ -217,8 +225,8 @@ impl Team {
     }
 }
 
-/// Ends the step of a [`Team`] when dropped.
-pub(super) struct Finish<'a>(&'a Team);
+/// Ends the step of a [`Team`] when dropped, also on a panic.
+struct Finish<'a>(&'a Team);
 
 impl Drop for Finish<'_> {
     fn drop(&mut self) {
@@ -339,10 +347,8 @@ mod tests {
                 .build()
                 .unwrap();
             pool.install(|| {
-                let team = Team::new();
                 let mut out = vec![0u64; 1000];
-                rayon::scope(|s| {
-                    team.spawn_followers(s);
+                Team::lead(|team| {
                     for pass in 1..=20u64 {
                         team.run_parts(&Chunks::new(&mut out, 7), |c, chunk| {
                             for (k, x) in chunk.iter_mut().enumerate() {
@@ -350,7 +356,6 @@ mod tests {
                             }
                         });
                     }
-                    team.finish();
                 });
                 for (i, x) in out.iter().enumerate() {
                     assert_eq!(*x, 210 * i as u64, "element {i}, {threads} threads");
@@ -366,12 +371,9 @@ mod tests {
             .build()
             .unwrap();
         pool.install(|| {
-            let team = Team::new();
             let count = AtomicUsize::new(0);
             let r = catch_unwind(AssertUnwindSafe(|| {
-                rayon::scope(|s| {
-                    team.spawn_followers(s);
-                    let _end = team.finish_on_drop();
+                Team::lead(|team| {
                     team.run(50, &|c| {
                         count.fetch_add(1, Ordering::Relaxed);
                         assert!(c != 17, "chunk 17 fails");
