@@ -505,9 +505,6 @@ impl TaylorSolver {
         let alpha = self.p.smoothing_coefficient;
         let nr = self.nr;
         let axis = |i: usize| i.is_multiple_of(nr);
-        // Mirror images across the axis of the particles near it, so that
-        // particles near the axis see a symmetric neighbourhood: U_R and
-        // sigma_RZ change sign, the rest is even.
         let Workspace {
             ghosts,
             stride,
@@ -535,6 +532,9 @@ impl TaylorSolver {
         } = ws;
         scratch.fit();
         let stride = (*stride).max(1);
+        // Mirror images across the axis of the particles near it, so that
+        // particles near the axis see a symmetric neighbourhood: U_R and
+        // sigma_RZ change sign, the rest is even.
         pos[..n].copy_from_slice(&self.pos);
         fill_images(pos, n, ghosts, |x| [-x[0], x[1]]);
         for ((v, m), r) in vol.iter_mut().zip(&self.mass).zip(&self.rho) {
