@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The whole test suite: formatting, lints, Rust unit and integration tests
-# (release-optimised physics), and — as later layers land — the C examples and
-# the fmpy checks. Installs what it needs; run from anywhere.
+# The whole test suite: formatting, lints, the doc links, Rust unit and
+# integration tests (release-optimised physics), the C examples and the fmpy
+# checks. Installs what it needs; run from anywhere.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -9,6 +9,8 @@ echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --all-targets --release -- -D warnings
+echo "== cargo doc (broken or private links fail)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 echo "== cargo test (release)"
 cargo test --release --all-targets
 cargo test --release --doc

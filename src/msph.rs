@@ -228,9 +228,10 @@ pub const MIN_GRAM_PIVOT: f64 = 1e-6;
 /// The inverses of the moment matrices of [`W`] particles from their power
 /// sums (lane `l` of each sum for particle `l`), without pivoting.
 ///
-/// With `Phi_a = exp(-|s|^2) sum_c P[a][c] Theta_c - exp(-4) [a = 0]` (see
-/// [`PHI`] and [`THETA`]; `P` is lower triangular with the diagonal (1, 2, 2,
-/// 8, 8, 4) and -2 in column 0 of rows 3 and 4), the moment matrix factors as
+/// With `Phi_a = exp(-|s|^2) sum_c P[a][c] Theta_c - exp(-4) [a = 0]`, where
+/// `Theta = (1, s_R, s_Z, s_R^2 / 2, s_Z^2 / 2, s_R s_Z)` and `P` is lower
+/// triangular with the diagonal (1, 2, 2, 8, 8, 4) and -2 in column 0 of rows
+/// 3 and 4, the moment matrix factors as
 /// `B = P G - exp(-4) e_0 u^T` with the Gram matrix `G = sum_j V_j
 /// exp(-|s_j|^2) Theta(s_j) Theta(s_j)^T` (symmetric, positive definite for a
 /// neighbourhood that supports a quadratic fit) and `u = sum_j V_j

@@ -17,8 +17,11 @@
 //!   are fixed. `mi_sim_last_error` copies the message of the last failure on
 //!   a handle. Outputs are written only on `MI_OK` (the length output of the
 //!   buffer convention also on `MI_BUFFER_TOO_SMALL`).
-//! - **Buffers.** See [`ptr`]: `buf`, `len` and optional `needed`; `NULL`/0
-//!   asks for the length.
+//! - **Buffers.** A function that copies an array or a string takes `buf`,
+//!   `len` (in elements; for strings in bytes, the terminating NUL included)
+//!   and an optional `needed`, which receives the required length on `MI_OK`
+//!   and on `MI_BUFFER_TOO_SMALL`. `buf = NULL, len = 0` asks only for the
+//!   length; a `len` below the required length leaves `buf` untouched.
 //! - **Safety.** NULL is checked on every pointer; panics are caught
 //!   ([`panic`]); nothing is global, so separate handles may be used from
 //!   separate threads at once (one handle by one thread at a time).

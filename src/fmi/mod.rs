@@ -2,7 +2,7 @@
 //! identifier `TaylorImpact`).
 //!
 //! The FMUs expose the Taylor scene: every parameter of
-//! [`TAYLOR_PARAMS`](crate::scene::taylor::TAYLOR_PARAMS) as a fixed
+//! [`crate::scene::taylor::TAYLOR_PARAMS`] as a fixed
 //! parameter, every observable of [`TAYLOR_OBSERVABLES`] as an output.
 //! [`variables`] derives the variable list (and so the value references) from
 //! those tables; [`model_description`] writes the `modelDescription.xml` from

@@ -1,5 +1,5 @@
 //! `modelDescription.xml` for FMI 3.0 and FMI 2.0, generated from
-//! [`variables`](super::variables) (and so from the parameter and observable
+//! [`super::variables`] (and so from the parameter and observable
 //! tables). `cargo xtask fmu` writes its output into the FMUs; there is no
 //! hand-edited model description.
 
