@@ -148,17 +148,21 @@ fn run(a: RunArgs) -> Result<(), Error> {
     let mut vtk_times = a.vtk_times.clone();
     vtk_times.sort_by(f64::total_cmp);
     let mut next_vtk = 0usize;
-    let mut vtk_count = 0usize;
-    let write_vtk = |sim: &Simulation, count: &mut usize| -> Result<(), Error> {
+    // (time, file name) of the snapshots written so far; the collection
+    // `particles.pvd` is rewritten after each one, so it is whole even when a
+    // run stops early.
+    let mut vtk_written: Vec<(f64, String)> = Vec::new();
+    let write_vtk = |sim: &Simulation, written: &mut Vec<(f64, String)>| -> Result<(), Error> {
         if let Some(dir) = &a.vtk_dir {
-            let path = dir.join(format!("particles_{:04}.vtu", *count));
-            sim.snapshot().write_vtu(&path)?;
-            *count += 1;
+            let name = format!("particles_{:04}.vtu", written.len());
+            sim.snapshot().write_vtu(&dir.join(&name))?;
+            written.push((sim.time(), name));
+            observe::write_pvd(&dir.join("particles.pvd"), written)?;
         }
         Ok(())
     };
     if a.vtk_dir.is_some() && vtk_times.first().is_some_and(|&t| t <= 0.0) {
-        write_vtk(&sim, &mut vtk_count)?;
+        write_vtk(&sim, &mut vtk_written)?;
         next_vtk = vtk_times.iter().take_while(|&&t| t <= 0.0).count();
     }
 
@@ -179,7 +183,7 @@ fn run(a: RunArgs) -> Result<(), Error> {
                 break;
             }
             while next_vtk < vtk_times.len() && sim.time() >= vtk_times[next_vtk] {
-                if let Err(e) = write_vtk(&sim, &mut vtk_count) {
+                if let Err(e) = write_vtk(&sim, &mut vtk_written) {
                     vtk_error = Some(e);
                 }
                 next_vtk += 1;
@@ -216,7 +220,7 @@ fn run(a: RunArgs) -> Result<(), Error> {
     if let Some(e) = vtk_error {
         return Err(e);
     }
-    write_vtk(&sim, &mut vtk_count)?;
+    write_vtk(&sim, &mut vtk_written)?;
     if let Some(path) = &a.csv {
         sim.history().write_csv(path)?;
     }

@@ -1,5 +1,6 @@
 //! Observables (names, units, meanings), their time histories, particle
-//! snapshots, and the writers for CSV, JSON and VTK (`.vtu`).
+//! snapshots, and the writers for CSV, JSON and VTK (`.vtu` snapshots and
+//! the `.pvd` collection that gives ParaView their times).
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -187,7 +188,7 @@ impl Snapshot {
             }));
         }
         let vtk = Vtk {
-            version: Version::new((1, 0)),
+            version: Version::new_xml(1, 0),
             title: format!("meshless-impact t = {:e} s", self.time),
             byte_order: ByteOrder::LittleEndian,
             file_path: None,
@@ -209,6 +210,46 @@ impl Snapshot {
         vtk.export(path)
             .map_err(|e| crate::error::Error::io(path, format!("{e:?}")))
     }
+}
+
+/// Writes a ParaView collection (`.pvd`) of snapshot files with their
+/// times: `snapshots` holds (time in s, file name relative to the `.pvd`).
+/// The `.vtu` format has no place for the time of a snapshot, so ParaView
+/// takes it from here (open the `.pvd` to step through the run in time).
+pub fn write_pvd(path: &Path, snapshots: &[(f64, String)]) -> Result<()> {
+    use quick_xml::Writer;
+    use quick_xml::events::{BytesDecl, Event};
+    let f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    let mut w = Writer::new_with_indent(std::io::BufWriter::new(f), b' ', 2);
+    let xml = |e: quick_xml::Error| Error::io(path, e);
+    w.write_event(Event::Decl(BytesDecl::new("1.0", None, None)))
+        .map_err(xml)?;
+    w.create_element("VTKFile")
+        .with_attributes([
+            ("type", "Collection"),
+            ("version", "0.1"),
+            ("byte_order", "LittleEndian"),
+        ])
+        .write_inner_content(|w| {
+            w.create_element("Collection")
+                .write_inner_content(|w| {
+                    for (time, file) in snapshots {
+                        w.create_element("DataSet")
+                            .with_attributes([
+                                ("timestep", format!("{time:e}").as_str()),
+                                ("part", "0"),
+                                ("file", file.as_str()),
+                            ])
+                            .write_empty()?;
+                    }
+                    Ok::<_, quick_xml::Error>(())
+                })
+                .map(drop)
+        })
+        .map_err(xml)?;
+    let mut f = w.into_inner();
+    writeln!(f).map_err(|e| Error::io(path, e))?;
+    f.flush().map_err(|e| Error::io(path, e))
 }
 
 /// Final values of a run as a JSON object: every observable by name, plus
