@@ -158,7 +158,8 @@ impl Snapshot {
 
     /// Writes the snapshot as a VTK XML unstructured grid (`.vtu`) of vertex
     /// cells in the R-Z plane (x = R, y = Z), readable by ParaView. Two-component
-    /// vectors are padded to three.
+    /// vectors are padded to three. The file holds no time: list it in a
+    /// [`write_pvd`] collection for that.
     pub fn write_vtu(&self, path: &Path) -> Result<()> {
         use vtkio::model::*;
         let n = self.positions.len();
@@ -189,6 +190,9 @@ impl Snapshot {
         }
         let vtk = Vtk {
             version: Version::new_xml(1, 0),
+            // Kept by the legacy format only: the XML file has no title, and
+            // the snapshot's time goes into the `.pvd` collection
+            // ([`write_pvd`]).
             title: format!("meshless-impact t = {:e} s", self.time),
             byte_order: ByteOrder::LittleEndian,
             file_path: None,
