@@ -23,6 +23,8 @@ param_table! {
             "bulk modulus K of the linear EOS P = K(rho/rho0 - 1)";
         specific_heat: "J/(kg.K)" = 460.0, Range::open_closed(0.0, 1.0e5),
             "specific heat C";
+        taylor_quinney: "1" = 1.0, Range::closed(0.0, 1.0),
+            "Taylor-Quinney coefficient: the fraction of plastic work that becomes heat";
         jc_a: "Pa" = 792.0e6, Range::closed(0.0, 1.0e11),
             "Johnson-Cook a (initial yield stress)";
         jc_b: "Pa" = 510.0e6, Range::closed(0.0, 1.0e11),

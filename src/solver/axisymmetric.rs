@@ -705,11 +705,12 @@ impl TaylorSolver {
         // constitutive update, positions x^{n+1} = x^n + dt v^{n+1/2}, anvil
         // contact, the generic stress boundary condition, and the sums of the
         // step, MIN_LEN particles at a time.
-        let (jc, eos, mu, cap) = (
+        let (jc, eos, mu, cap, heat) = (
             self.jc,
             self.eos,
             self.p.shear_modulus,
             self.p.specific_heat,
+            self.p.taylor_quinney,
         );
         let modulus = self.p.bulk_modulus + 4.0 / 3.0 * self.p.shear_modulus;
         let (grads, rho_raw) = (&*grads, &*rho_raw);
@@ -788,7 +789,7 @@ impl TaylorSolver {
                         dev[k] = ret.stress;
                         pressure[k] = p_new;
                         eps_p[k] += ret.plastic_strain;
-                        temp[k] += ret.plastic_work / (rho_new * cap);
+                        temp[k] += heat * ret.plastic_work / (rho_new * cap);
                         rho[k] = rho_new;
                         t.internal += dt * power * mass[i] / rho_new;
 
