@@ -602,7 +602,7 @@ fn every_error_code_is_produced() {
         check(r, MI_SINGULAR_MOMENT_MATRIX, &m, "singular");
         let (r, m) = run_code(
             "taylor",
-            &[("particles_radial", 5.0), ("impact_speed", 2000.0)],
+            &[("particles_radial", 6.0), ("smoothing_coefficient", 0.0)],
         );
         check(r, MI_ENERGY_DRIFT, &m, "energy error");
         let (r, m) = run_code(

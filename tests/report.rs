@@ -43,7 +43,7 @@ const EXPECTED: &[(&str, &str)] = &[
     // the energy balance fails first.
     ("speed_400", "finished"),
     ("speed_600", "SpacingCollapse"),
-    ("speed_800", "EnergyDrift"),
+    ("speed_800", "SpacingCollapse"),
     ("bulk_x10", "finished"),
     ("bulk_x100", "finished"),
     ("soft_plastic", "EnergyDrift"),

@@ -42,19 +42,10 @@ use crate::scene::taylor::TaylorParams;
 /// Radial strain below which the rod counts as undeformed (0.2 %).
 pub const UNDEFORMED_STRAIN: f64 = 0.002;
 
-/// Smallest distance between two neighbouring particles, neither of them
-/// from the impact face, relative to the initial spacing, below which a run
+/// Smallest distance between two neighbouring particles (every pair, mirror
+/// images included), relative to the initial spacing, below which a run
 /// stops with [`Error::SpacingCollapse`]: particles that close no longer
 /// resolve the material between them.
-///
-/// Pairs with a particle of the impact face are left out. At the centre of
-/// the face the flow stagnates and the axial strain grows without bound: the
-/// row above the face closes on the face row the way material points close
-/// on a stagnation point, and the discretisation lets it reach the face. In
-/// the faster Table 1 tests (4, 10, 11 and 12 at 20 particles across) the two
-/// rows meet late in the run while the rod's length and face diameter agree
-/// with experiment (VALIDATION.md, a known limitation);
-/// [`TaylorSolver::min_spacing_ratio`] still reports every pair.
 pub const SPACING_COLLAPSE_BOUND: f64 = 0.1;
 
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
@@ -115,10 +106,8 @@ const MIN_LEN: usize = 64;
 struct BatchTally {
     /// First particle with a degenerate moment matrix, and its condition.
     singular: Option<(usize, f64)>,
-    /// Smallest squared distances between neighbours: all pairs, and pairs
-    /// without a particle of the impact face.
+    /// Smallest squared distance between neighbours.
     min_d2: f64,
-    min_d2_free: f64,
     /// Kinetic energy removed by holding particles on the anvil.
     held: f64,
 }
@@ -128,7 +117,6 @@ impl Default for BatchTally {
         BatchTally {
             singular: None,
             min_d2: f64::INFINITY,
-            min_d2_free: f64::INFINITY,
             held: 0.0,
         }
     }
@@ -163,8 +151,8 @@ struct Tally {
 /// positions after a restore.
 #[derive(Debug, Clone, Default)]
 struct Workspace {
-    /// Real particle copied by each mirror image; image `k` has index `n + k`.
-    ghosts: Vec<u32>,
+    /// Mirror images; image `k` has index `n + k`.
+    images: Vec<Image>,
     /// Row length of the padded neighbour arrays.
     stride: usize,
     /// Candidate neighbours of particle `i`: `nbr[i * stride..][..nbr_len[i]]`,
@@ -173,13 +161,12 @@ struct Workspace {
     nbr_len: Vec<u32>,
     /// Positions when the lists were built.
     built_at: Vec<[f64; 2]>,
+    /// Contact flags of the impact-face particles when the images were made.
+    face_contact: Vec<bool>,
     /// Fields of the particles and their images.
     pos: Vec<[f64; 2]>,
     vol: Vec<f64>,
     sbc: Vec<Stress>,
-    /// Index ranges of the particles that started on the impact face and of
-    /// their images (the images come in the order of the particles).
-    face: [[u32; 2]; 2],
     vel: Vec<[f64; 2]>,
     vel_s: Vec<[f64; 2]>,
     rho: Vec<[f64; 1]>,
@@ -226,11 +213,82 @@ impl Default for Strength {
     }
 }
 
-/// Writes the image values `f[n + k] = mirror(f[ghosts[k]])`.
-fn fill_images<T: Copy>(f: &mut [T], n: usize, ghosts: &[u32], mirror: impl Fn(T) -> T) {
-    let (real, images) = f.split_at_mut(n);
-    for (img, &g) in images.iter_mut().zip(ghosts) {
-        *img = mirror(real[g as usize]);
+/// The plane or planes a mirror image is reflected across: the axis R = 0,
+/// the anvil Z = 0, or both (an image of a particle near the axis and the
+/// anvil).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mirror {
+    Axis,
+    Anvil,
+    Both,
+}
+
+impl Mirror {
+    /// Whether R (and the R components of vectors) change sign.
+    fn flips_r(self) -> bool {
+        self != Mirror::Anvil
+    }
+    /// Whether Z (and the Z components of vectors) change sign.
+    fn flips_z(self) -> bool {
+        self != Mirror::Axis
+    }
+}
+
+/// A mirror image of a real particle.
+#[derive(Debug, Clone, Copy)]
+struct Image {
+    source: u32,
+    mirror: Mirror,
+}
+
+/// A field value as seen at a mirror image.
+trait Mirrored: Copy {
+    fn mirrored(self, m: Mirror) -> Self;
+}
+
+/// Scalars (volume, density) are even across both planes.
+impl Mirrored for f64 {
+    fn mirrored(self, _: Mirror) -> Self {
+        self
+    }
+}
+
+impl Mirrored for [f64; 1] {
+    fn mirrored(self, _: Mirror) -> Self {
+        self
+    }
+}
+
+/// Vectors in (R, Z), positions and velocities: the component normal to the
+/// plane changes sign.
+impl Mirrored for [f64; 2] {
+    fn mirrored(self, m: Mirror) -> Self {
+        [
+            if m.flips_r() { -self[0] } else { self[0] },
+            if m.flips_z() { -self[1] } else { self[1] },
+        ]
+    }
+}
+
+/// Stresses (RR, ZZ, theta-theta, RZ): the shear changes sign across one
+/// plane and is even across both.
+impl Mirrored for Stress {
+    fn mirrored(self, m: Mirror) -> Self {
+        let odd = m.flips_r() != m.flips_z();
+        [
+            self[0],
+            self[1],
+            self[2],
+            if odd { -self[3] } else { self[3] },
+        ]
+    }
+}
+
+/// Writes the image values `f[n + k] = f[images[k].source]` mirrored.
+fn fill_images<T: Mirrored>(f: &mut [T], n: usize, images: &[Image]) {
+    let (real, out) = f.split_at_mut(n);
+    for (img, im) in out.iter_mut().zip(images) {
+        *img = real[im.source as usize].mirrored(im.mirror);
     }
 }
 
@@ -419,22 +477,59 @@ impl TaylorSolver {
         COURANT * self.h / worst
     }
 
+    /// Height above the anvil below which a particle counts as on it and has
+    /// no mirror image across it: half the spacing guard, so that a particle
+    /// and its own image are never closer than the guard allows.
+    fn anvil_gap(&self) -> f64 {
+        0.5 * SPACING_COLLAPSE_BOUND * self.r0 / (self.nr - 1) as f64
+    }
+
+    /// Whether particle `i` is mirrored across the anvil: it lies within
+    /// `reach` of it and above [`Self::anvil_gap`], it is neither in contact
+    /// nor a particle of the impact face (the face row is the plane of
+    /// symmetry itself), and the face particle nearest to it in R is pressed
+    /// on the anvil. A mirror image carries tension as well as compression,
+    /// so above a part of the face that has left the anvil there is none:
+    /// that part is a free surface.
+    fn anvil_image(&self, i: usize, reach: f64) -> bool {
+        let [r, z] = self.pos[i];
+        if i < self.nr || self.contact[i] || z < self.anvil_gap() || z >= reach {
+            return false;
+        }
+        let nearest = (0..self.nr)
+            .min_by(|&a, &b| {
+                let (da, db) = ((self.pos[a][0] - r).abs(), (self.pos[b][0] - r).abs());
+                da.total_cmp(&db)
+            })
+            .expect("a face row");
+        self.contact[nearest]
+    }
+
     /// Rebuilds the mirror images and the candidate neighbour lists, with a
     /// skin of [`SKIN`] h, from the current positions.
     fn rebuild_neighbours(&self, ws: &mut Workspace) {
         let n = self.particles();
         let nr = self.nr;
         let reach = (SUPPORT + SKIN) * self.h;
-        ws.ghosts.clear();
-        ws.ghosts.extend(
-            (0..n)
-                .filter(|&i| !i.is_multiple_of(nr) && self.pos[i][0] < reach)
-                .map(|i| i as u32),
-        );
-        let m = n + ws.ghosts.len();
+        ws.images.clear();
+        for i in 0..n {
+            let axis = !i.is_multiple_of(nr) && self.pos[i][0] < reach;
+            let anvil = self.anvil_image(i, reach);
+            let source = i as u32;
+            for (yes, mirror) in [
+                (axis, Mirror::Axis),
+                (anvil, Mirror::Anvil),
+                (axis && anvil, Mirror::Both),
+            ] {
+                if yes {
+                    ws.images.push(Image { source, mirror });
+                }
+            }
+        }
+        let m = n + ws.images.len();
         ws.pos.resize(m, [0.0; 2]);
         ws.pos[..n].copy_from_slice(&self.pos);
-        fill_images(&mut ws.pos, n, &ws.ghosts, |x| [-x[0], x[1]]);
+        fill_images(&mut ws.pos, n, &ws.images);
         ws.stride = padded_rows(
             &ws.pos,
             n,
@@ -447,6 +542,8 @@ impl TaylorSolver {
         let stride = ws.stride;
         ws.built_at.clear();
         ws.built_at.extend_from_slice(&self.pos);
+        ws.face_contact.clear();
+        ws.face_contact.extend_from_slice(&self.contact[..nr]);
         // Whole batches of W rows.
         let rows = n.next_multiple_of(W) * stride;
         ws.act.resize(rows, 0);
@@ -455,8 +552,6 @@ impl TaylorSolver {
         ws.wk.resize(rows, 0.0);
         ws.vol.resize(m, 0.0);
         ws.sbc.resize(m, [0.0; 4]);
-        let face_images = ws.ghosts.iter().take_while(|&&g| (g as usize) < nr).count();
-        ws.face = [[0, nr as u32], [n as u32, (n + face_images) as u32]];
         ws.vel.resize(m, [0.0; 2]);
         ws.vel_s.resize(m, [0.0; 2]);
         ws.rho.resize(m, [0.0]);
@@ -469,9 +564,19 @@ impl TaylorSolver {
     }
 
     /// Whether a particle moved more than half the skin since the lists were
-    /// built (or they were never built).
+    /// built (or they were never built), a particle mirrored across the
+    /// anvil has come down onto it (its image would meet it), or a particle
+    /// of the impact face has touched or left the anvil (which changes the
+    /// images).
     fn needs_rebuild(&self, ws: &Workspace) -> bool {
-        if ws.built_at.len() != self.particles() {
+        if ws.built_at.len() != self.particles() || ws.face_contact[..] != self.contact[..self.nr] {
+            return true;
+        }
+        let gap = self.anvil_gap();
+        if ws.images.iter().any(|im| {
+            let i = im.source as usize;
+            im.mirror == Mirror::Anvil && (self.contact[i] || self.pos[i][1] < gap)
+        }) {
             return true;
         }
         let limit = 0.5 * SKIN * self.h;
@@ -506,14 +611,13 @@ impl TaylorSolver {
         let nr = self.nr;
         let axis = |i: usize| i.is_multiple_of(nr);
         let Workspace {
-            ghosts,
+            images,
             stride,
             nbr,
             nbr_len,
             pos,
             vol,
             sbc,
-            face,
             vel,
             vel_s,
             rho: rho_raw,
@@ -532,17 +636,18 @@ impl TaylorSolver {
         } = ws;
         scratch.fit();
         let stride = (*stride).max(1);
-        // Mirror images across the axis of the particles near it, so that
-        // particles near the axis see a symmetric neighbourhood: U_R and
-        // sigma_RZ change sign, the rest is even.
+        // Mirror images across the axis and the anvil of the particles near
+        // them, so that those particles see a symmetric neighbourhood (the
+        // anvil is rigid and smooth): the velocity component and the shear
+        // stress odd across the plane, the rest even.
         pos[..n].copy_from_slice(&self.pos);
-        fill_images(pos, n, ghosts, |x| [-x[0], x[1]]);
+        fill_images(pos, n, images);
         for ((v, m), r) in vol.iter_mut().zip(&self.mass).zip(&self.rho) {
             *v = m / r;
         }
-        fill_images(vol, n, ghosts, |v| v);
+        fill_images(vol, n, images);
         sbc[..n].copy_from_slice(&self.stress_bc);
-        fill_images(sbc, n, ghosts, |s| [s[0], s[1], s[2], -s[3]]);
+        fill_images(sbc, n, images);
 
         // 1-2. Per particle: the MSPH moment matrix over the neighbours in
         // the support, the derivative and Shepard weights of each pair, and
@@ -553,7 +658,6 @@ impl TaylorSolver {
             pos,
             vol,
             sbc,
-            face: *face,
             nbr,
             nbr_len,
             stride,
@@ -604,7 +708,6 @@ impl TaylorSolver {
                             t.singular = Some((i, p.condition));
                         }
                         t.min_d2 = t.min_d2.min(p.min_d2);
-                        t.min_d2_free = t.min_d2_free.min(p.min_d2_free);
                         if contact[i] {
                             t.held += 0.5 * mass[i] * v[1] * v[1];
                             v[1] = 0.0;
@@ -618,7 +721,6 @@ impl TaylorSolver {
         for t in batches.iter() {
             a.singular = a.singular.or(t.singular);
             a.min_d2 = a.min_d2.min(t.min_d2);
-            a.min_d2_free = a.min_d2_free.min(t.min_d2_free);
             a.held += t.held;
         }
         if let Some((particle, condition)) = a.singular {
@@ -629,10 +731,11 @@ impl TaylorSolver {
             });
         }
         let d0 = self.r0 / (self.nr - 1) as f64;
-        self.min_spacing = self.min_spacing.min(a.min_d2.sqrt() / d0);
-        if a.min_d2_free.sqrt() / d0 < SPACING_COLLAPSE_BOUND {
+        let ratio = a.min_d2.sqrt() / d0;
+        self.min_spacing = self.min_spacing.min(ratio);
+        if ratio < SPACING_COLLAPSE_BOUND {
             return Err(Error::SpacingCollapse {
-                ratio: a.min_d2_free.sqrt() / d0,
+                ratio,
                 bound: SPACING_COLLAPSE_BOUND,
                 time: self.time,
             });
@@ -640,7 +743,7 @@ impl TaylorSolver {
         self.contact_dissipation += a.held;
 
         // 3. Conservative smoothing of the velocity.
-        fill_images(vel, n, ghosts, |v| [-v[0], v[1]]);
+        fill_images(vel, n, images);
         let rows = Rows {
             act,
             wr,
@@ -680,7 +783,7 @@ impl TaylorSolver {
         self.smoothing_dissipation += ke[0] - ke[1];
 
         // 4. Velocity gradients and continuity.
-        fill_images(vel_s, n, ghosts, |v| [-v[0], v[1]]);
+        fill_images(vel_s, n, images);
         let vel = &*vel_s;
         {
             let parts = (
@@ -699,7 +802,7 @@ impl TaylorSolver {
                 }
             });
         }
-        fill_images(rho_raw, n, ghosts, |r| r);
+        fill_images(rho_raw, n, images);
 
         // 5-6. Per particle: conservative smoothing of the density, the
         // constitutive update, positions x^{n+1} = x^n + dt v^{n+1/2}, anvil

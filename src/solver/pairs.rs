@@ -31,11 +31,9 @@ pub(super) struct PairPass {
     pub len: u32,
     /// Condition number of a degenerate moment matrix, or zero.
     pub condition: f64,
-    /// Smallest squared distance to another particle in the support.
+    /// Smallest squared distance to another particle in the support, mirror
+    /// images included.
     pub min_d2: f64,
-    /// The same among particles not from the impact face (infinite for a
-    /// particle of the face).
-    pub min_d2_free: f64,
 }
 
 /// What the pair pass reads: the particles followed by their mirror images.
@@ -44,9 +42,6 @@ pub(super) struct PairInputs<'a> {
     pub pos: &'a [[f64; 2]],
     pub vol: &'a [f64],
     pub sbc: &'a [Stress],
-    /// Index ranges `[start, end)` of the particles that started on the
-    /// impact face and of their images.
-    pub face: [[u32; 2]; 2],
     /// Candidate neighbours, padded rows of `stride`.
     pub nbr: &'a [u32],
     pub nbr_len: &'a [u32],
@@ -162,32 +157,17 @@ fn stress_divergence(act: &[u32], wr: &[f64], wz: &[f64], sbc: &[Stress], si: St
     acc.map(lanes::total)
 }
 
-/// Whether particle `j` is one of the impact-face particles or their images
-/// (the index ranges `face`).
-#[inline(always)]
-fn on_face(face: &[[u32; 2]; 2], j: u32) -> bool {
-    face.iter().any(|&[a, b]| a <= j && j < b)
-}
-
 /// Appends the candidates of particle `i` that lie in its support to `hood`
 /// (scaled offsets and volumes) and their indices to `act`, in candidate
-/// order, and returns the smallest squared distances to another particle in
-/// the support: over all of them, and over those not from the impact face
-/// (infinite when `face_i`, the particle itself is from the face).
-/// [`avx512::scan_candidates`] is the same with AVX-512 compress
-/// instructions, bit for bit.
+/// order, and returns the smallest squared distance to another particle (or
+/// image) in the support. [`avx512::scan_candidates`] is the same with
+/// AVX-512 compress instructions, bit for bit.
 #[inline(always)]
-fn scan_candidates(
-    inp: &PairInputs,
-    i: usize,
-    face_i: bool,
-    hood: &mut Neighbourhood,
-    act: &mut [u32],
-) -> (f64, f64) {
+fn scan_candidates(inp: &PairInputs, i: usize, hood: &mut Neighbourhood, act: &mut [u32]) -> f64 {
     let stride = inp.stride;
     let xi = inp.pos[i];
     let inv_h = 1.0 / inp.h;
-    let (mut min_d2, mut min_d2_free) = ([f64::INFINITY; W], [f64::INFINITY; W]);
+    let mut min_d2 = [f64::INFINITY; W];
     let cand = &inp.nbr[i * stride..(i + 1) * stride];
     let n_cand = inp.nbr_len[i] as usize;
     hood.reserve(n_cand);
@@ -203,13 +183,9 @@ fn scan_candidates(
             keep[l] = sr[l] * sr[l] + sz[l] * sz[l] <= SUPPORT * SUPPORT && c + l < n_cand;
             let d2 = dr * dr + dz * dz;
             let other = keep[l] && idx[l] as usize != i;
-            let free = other && !face_i && !on_face(&inp.face, idx[l]);
-            // Plain compare-and-select: one vector instruction each.
+            // Plain compare-and-select: one vector instruction.
             if other && d2 < min_d2[l] {
                 min_d2[l] = d2;
-            }
-            if free && d2 < min_d2_free[l] {
-                min_d2_free[l] = d2;
             }
         }
         let mut k = hood.len();
@@ -219,8 +195,7 @@ fn scan_candidates(
         }
         hood.push_lanes(keep, sr, sz, v);
     }
-    let fold = |x: Lanes| x.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-    (fold(min_d2), fold(min_d2_free))
+    min_d2.iter().fold(f64::INFINITY, |a, &b| a.min(b))
 }
 
 /// [`lanes::totals`] of the power sums of a batch: lane `p` of sum `k` is
@@ -252,10 +227,9 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         let hood = &mut scratch.hoods[p];
         hood.clear();
         let act = &mut out.act[p * stride..(p + 1) * stride];
-        let face_i = on_face(&inp.face, i as u32);
-        let (min_d2, min_d2_free) = match_target! {
-            "x86_64+avx512f+avx512vl" => avx512::scan_candidates(inp, i, face_i, hood, act),
-            _ => scan_candidates(inp, i, face_i, hood, act),
+        let min_d2 = match_target! {
+            "x86_64+avx512f+avx512vl" => avx512::scan_candidates(inp, i, hood, act),
+            _ => scan_candidates(inp, i, hood, act),
         };
         let len = hood.len();
         // Padded slots: the particle itself, with zero weight.
@@ -266,7 +240,6 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
             len: len as u32,
             condition: 0.0,
             min_d2,
-            min_d2_free,
         };
         scratch.partials[p] = hood.power_partials();
     }
@@ -553,8 +526,7 @@ mod avx512_tests {
     }
 
     /// The AVX-512 candidate scan gives the portable scan's neighbourhoods,
-    /// rows and minimum distances bit for bit, on a jittered lattice whose
-    /// first row plays the impact face (so both minima are exercised).
+    /// rows and minimum distances bit for bit, on a jittered lattice.
     #[test]
     #[allow(unsafe_code)]
     fn avx512_scan_equals_portable_scan() {
@@ -588,7 +560,6 @@ mod avx512_tests {
             pos: &pos,
             vol: &vol,
             sbc: &zeros,
-            face: [[0, nr as u32], [n as u32, n as u32]],
             nbr: &nbr,
             nbr_len: &nbr_len,
             stride,
@@ -598,22 +569,18 @@ mod avx512_tests {
             h,
             dt: 0.0,
         };
-        let (mut faces, mut kept, mut candidates) = (0, 0, 0);
+        let (mut kept, mut candidates) = (0, 0);
         for i in 0..n {
-            let face_i = on_face(&inp.face, i as u32);
-            faces += face_i as usize;
             let (mut a, mut b) = (
                 Neighbourhood::with_capacity(stride),
                 Neighbourhood::with_capacity(stride),
             );
             let (mut act_a, mut act_b) = (vec![0u32; stride], vec![0u32; stride]);
-            let ma = scan_candidates(&inp, i, face_i, &mut a, &mut act_a);
+            let ma = scan_candidates(&inp, i, &mut a, &mut act_a);
             // SAFETY: the CPU has AVX-512F and VL (checked above).
-            let mb = unsafe { avx512::scan_candidates(&inp, i, face_i, &mut b, &mut act_b) };
-            assert_eq!(ma.0.to_bits(), mb.0.to_bits(), "particle {i}");
-            assert_eq!(ma.1.to_bits(), mb.1.to_bits(), "particle {i}");
-            assert!(ma.0 > 0.0 && ma.0.is_finite());
-            assert_eq!(ma.1.is_infinite(), face_i);
+            let mb = unsafe { avx512::scan_candidates(&inp, i, &mut b, &mut act_b) };
+            assert_eq!(ma.to_bits(), mb.to_bits(), "particle {i}");
+            assert!(ma > 0.0 && ma.is_finite());
             let len = a.len();
             assert_eq!(len, b.len());
             assert!(
@@ -628,7 +595,6 @@ mod avx512_tests {
             assert_eq!(za[..len], zb[..len]);
             assert_eq!(va[..len], vb[..len]);
         }
-        assert_eq!(faces, nr);
         // The skin holds candidates outside the support: some were dropped.
         assert!(kept < candidates * 9 / 10, "{kept} of {candidates}");
     }

@@ -27,10 +27,9 @@ fn low_lanes(k: usize) -> u8 {
 pub(super) fn scan_candidates(
     inp: &PairInputs,
     i: usize,
-    face_i: bool,
     hood: &mut Neighbourhood,
     act: &mut [u32],
-) -> (f64, f64) {
+) -> f64 {
     let stride = inp.stride;
     let cand = &inp.nbr[i * stride..(i + 1) * stride];
     let n_cand = inp.nbr_len[i] as usize;
@@ -47,11 +46,7 @@ pub(super) fn scan_candidates(
     let (xi, zi) = (_mm512_set1_pd(inp.pos[i][0]), _mm512_set1_pd(inp.pos[i][1]));
     let support2 = _mm512_set1_pd(SUPPORT * SUPPORT);
     let me = _mm256_set1_epi32(i as i32);
-    let face = inp
-        .face
-        .map(|[a, b]| [a, b].map(|x| _mm256_set1_epi32(x as i32)));
     let mut min_d2 = _mm512_set1_pd(f64::INFINITY);
-    let mut min_free = min_d2;
     let mut k = *len;
     for c in (0..n_cand).step_by(W) {
         let valid = low_lanes((n_cand - c).min(W));
@@ -80,14 +75,6 @@ pub(super) fn scan_candidates(
         let other = keep & _mm256_cmpneq_epi32_mask(idx, me);
         let closer = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(other, d2, min_d2);
         min_d2 = _mm512_mask_blend_pd(closer, min_d2, d2);
-        if !face_i {
-            let in_range = |[a, b]: [__m256i; 2]| {
-                _mm256_cmpge_epu32_mask(idx, a) & _mm256_cmplt_epu32_mask(idx, b)
-            };
-            let free = other & !(in_range(face[0]) | in_range(face[1]));
-            let closer = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(free, d2, min_free);
-            min_free = _mm512_mask_blend_pd(closer, min_free, d2);
-        }
         let n = keep.count_ones() as usize;
         let room = low_lanes(n);
         assert!(k + n <= n_cand);
@@ -107,7 +94,7 @@ pub(super) fn scan_candidates(
         k += n;
     }
     *len = k;
-    (_mm512_reduce_min_pd(min_d2), _mm512_reduce_min_pd(min_free))
+    _mm512_reduce_min_pd(min_d2)
 }
 
 /// [`crate::lanes::totals`] of the power sums of a batch: lane `p` of sum
