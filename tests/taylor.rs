@@ -185,28 +185,29 @@ fn serialized_state_resumes_bit_for_bit() {
 /// deformation must not depend on beta at all (bit for bit).
 #[test]
 fn taylor_quinney_fraction_of_plastic_work_heats_the_rod() {
-    let (a, b, c, t0) = (400e6, 100e6, 460.0, 293.0);
+    let base = wilkins_scene();
+    let g = |n: &str| base.get(n).unwrap();
+    let (a, b, c, t0) = (
+        g("jc_a"),
+        g("jc_b"),
+        g("specific_heat"),
+        g("initial_temperature"),
+    );
+    assert_eq!(
+        (g("jc_n"), g("jc_c")),
+        (1.0, 0.0),
+        "flow stress A + B eps_p"
+    );
     let sets = |beta: f64| {
         vec![
             ("taylor_quinney", beta),
             ("particles_radial", 6.0),
-            ("impact_speed", 227.0),
-            ("initial_length", 0.0324),
-            ("initial_diameter", 0.0064),
-            ("density", 8930.0),
-            ("shear_modulus", 43.333e9),
-            ("bulk_modulus", 130e9),
-            ("specific_heat", c),
-            ("jc_a", a),
-            ("jc_b", b),
-            ("jc_n", 1.0),
-            ("jc_c", 0.0),
             ("jc_m", 10.0),
             ("melt_temperature", 1e5),
             ("end_time", 10e-6),
         ]
     };
-    let snap = |beta: f64| run(Scene::builtin("taylor").unwrap(), &sets(beta)).snapshot();
+    let snap = |beta: f64| run(base.clone(), &sets(beta)).snapshot();
     let reference = snap(1.0);
     for beta in [0.9, 0.5] {
         let s = snap(beta);
@@ -288,12 +289,10 @@ fn benchmark_scene_files_hold_the_published_constants() {
 /// above the face reaches the anvil.
 #[test]
 fn rows_pressed_on_the_anvil_close_evenly_and_stay_above_the_guard() {
-    let scene = Scene::from_file(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/wilkins_copper.toml"
-    ))
-    .unwrap();
-    let sim = run(scene, &[("particles_radial", 10.0), ("end_time", 25e-6)]);
+    let sim = run(
+        wilkins_scene(),
+        &[("particles_radial", 10.0), ("end_time", 25e-6)],
+    );
     let nr = 10;
     let spacing = 0.0032 / (nr - 1) as f64;
     let guard = meshless_impact::solver::axisymmetric::SPACING_COLLAPSE_BOUND;
@@ -314,4 +313,13 @@ fn rows_pressed_on_the_anvil_close_evenly_and_stay_above_the_guard() {
         contact[nr..].iter().all(|&c| c == 0.0),
         "a row above the face touches"
     );
+}
+
+/// The Wilkins copper bar of `scenes/wilkins_copper.toml`.
+fn wilkins_scene() -> Scene {
+    Scene::from_file(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/wilkins_copper.toml"
+    ))
+    .unwrap()
 }
