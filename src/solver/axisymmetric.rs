@@ -15,7 +15,10 @@
 //! 1. neighbours and MSPH first-derivative weights at `x^n`;
 //! 2. acceleration from the divergence of stress; `v^{n+1/2} = v^{n-1/2} + dt a`,
 //!    then `U_R = 0` on the axis and `U_Z = 0` on particles touching the anvil;
-//! 3. conservative smoothing of the velocity (boundary conditions re-applied);
+//! 3. conservative smoothing of the velocity (boundary conditions re-applied):
+//!    (3.23), or with `smoothing_order = 2` its bi-Laplacian
+//!    `v - alpha L(L v)`, `L v` = Shepard mean minus value, which damps the
+//!    particle-scale waves as (3.23) does and the resolved flow far less;
 //! 4. velocity gradients, continuity, conservative smoothing of the density;
 //! 5. stress update (Jaumann rate, trial deviator, Johnson-Cook radial return,
 //!    linear EOS), heating from plastic work, internal energy from stress power;
@@ -25,8 +28,8 @@
 
 use super::boundary::{Stress, Surface, corner_free, traction_free};
 use super::pairs::{
-    PairInputs, PairOutputs, PairPass, Rows, ScratchPool, pair_batch, shepard_means, smooth,
-    velocity_gradients,
+    PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
+    smooth, smooth2, velocity_gradients,
 };
 use super::team::{Chunks, Team};
 use super::{COURANT, check_time_step};
@@ -169,6 +172,9 @@ struct Workspace {
     sbc: Vec<Stress>,
     vel: Vec<[f64; 2]>,
     vel_s: Vec<[f64; 2]>,
+    /// The smoothing operator applied once to the velocity (the Shepard
+    /// mean minus the value), for the smoothing of order 2.
+    lap: Vec<[f64; 2]>,
     rho: Vec<[f64; 1]>,
     /// Neighbours in the support this step, and their MSPH derivative
     /// weights (d/dR, d/dZ) and Shepard weights, in the padded layout.
@@ -554,6 +560,9 @@ impl TaylorSolver {
         ws.sbc.resize(m, [0.0; 4]);
         ws.vel.resize(m, [0.0; 2]);
         ws.vel_s.resize(m, [0.0; 2]);
+        if self.p.smoothing_order == 2.0 {
+            ws.lap.resize(m, [0.0; 2]);
+        }
         ws.rho.resize(m, [0.0]);
         ws.part.resize(n, PairPass::default());
         ws.grads.resize(n, [0.0; 4]);
@@ -620,6 +629,7 @@ impl TaylorSolver {
             sbc,
             vel,
             vel_s,
+            lap,
             rho: rho_raw,
             act,
             wr,
@@ -752,8 +762,22 @@ impl TaylorSolver {
             part,
             stride,
         };
-        {
+        let order2 = self.p.smoothing_order == 2.0;
+        if order2 {
+            // Order 2: first the operator L v = (Shepard mean of v) - v.
             let vel = &*vel;
+            let parts = Chunks::new(&mut lap[..n], MIN_LEN);
+            team.run_parts(&parts, |c, out| {
+                let i0 = c * MIN_LEN;
+                shepard_means(rows, vel, i0, out);
+                for (k, l) in out.iter_mut().enumerate() {
+                    *l = laplacian(vel[i0 + k], *l);
+                }
+            });
+            fill_images(lap, n, images);
+        }
+        {
+            let (vel, lap) = (&*vel, &*lap);
             let parts = (
                 Chunks::new(&mut vel_s[..n], MIN_LEN),
                 Chunks::new(smoothing, 1),
@@ -761,11 +785,20 @@ impl TaylorSolver {
             team.run_parts(&parts, |c, (out, ke)| {
                 let ke = &mut ke[0];
                 let i0 = c * MIN_LEN;
-                shepard_means(rows, vel, i0, out);
                 *ke = [0.0; 2];
+                if order2 {
+                    // v - alpha L(L v): the mean of L v is taken into `out`.
+                    shepard_means(rows, lap, i0, out);
+                } else {
+                    shepard_means(rows, vel, i0, out);
+                }
                 for (k, v) in out.iter_mut().enumerate() {
                     let i = i0 + k;
-                    *v = smooth(vel[i], *v, alpha);
+                    *v = if order2 {
+                        smooth2(vel[i], lap[i], *v, alpha)
+                    } else {
+                        smooth(vel[i], *v, alpha)
+                    };
                     if axis(i) {
                         v[0] = 0.0;
                     }
