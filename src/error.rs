@@ -108,7 +108,7 @@ pub enum Error {
     /// spacing: the particle arrangement collapsed, and the MSPH sums that
     /// follow would be garbage.
     #[error(
-        "particle spacing collapsed to {ratio:.3e} of the initial spacing, below the bound {bound} (t = {time:.4e} s)"
+        "particle spacing collapsed to {ratio:.3e} of the initial spacing, below the bound {bound} (t = {time:.4e} s){hint}"
     )]
     SpacingCollapse {
         /// Smallest neighbour distance over the initial spacing.
@@ -117,6 +117,8 @@ pub enum Error {
         bound: f64,
         /// Simulated time.
         time: f64,
+        /// What to try, or empty.
+        hint: &'static str,
     },
     /// The caller cancelled the run from a progress callback.
     #[error("run cancelled by the caller at t = {time:.4e} s")]

@@ -1,6 +1,7 @@
 //! The verification report (`meshless-impact report --out DIR`): error against
-//! run time, sensitivity, Table 1, figures like the paper's, and a stability
-//! matrix of stiff, extreme and invalid cases. It is written as `DIR/index.md`
+//! run time, sensitivity, Table 1, figures like the paper's, a stability
+//! matrix of stiff, extreme and invalid cases, and the large-strain
+//! benchmarks beside their references. It is written as `DIR/index.md`
 //! with a CSV file for every table and an SVG file for every figure.
 //!
 //! The report only uses the public [`Simulation`](crate::Simulation) and
@@ -11,6 +12,7 @@
 //! The sensitivity, Table 1 and stability cases run side by side (rayon) and
 //! share the cores, so their wall times are only indicative.
 
+mod benchmarks;
 mod convergence;
 mod figures;
 pub mod plot;
@@ -272,6 +274,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     sensitivity::smoothing(&plan, &mut doc)?;
     sensitivity::table1(&plan, &mut doc)?;
     let stability = stability::matrix(&plan, &mut doc)?;
+    benchmarks::run(&plan, &mut doc)?;
     let wall_s = start.elapsed().as_secs_f64();
     let _ = writeln!(doc.text, "---\n\nWhole report: {wall_s:.1} s wall time.");
     let index = dir.join("index.md");

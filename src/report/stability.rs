@@ -52,6 +52,18 @@ fn cases(plan: &Plan) -> Vec<Def> {
         v.extend_from_slice(sets);
         v
     };
+    // The large-strain scheme (README): h = 2.0 spacings, velocity smoothing
+    // of order 2, particle shifting.
+    let large = |speed: f64, extra: &[(&'static str, f64)]| {
+        let mut v = vec![
+            ("impact_speed", speed),
+            ("smoothing_ratio", 2.0),
+            ("smoothing_order", 2.0),
+            ("shifting", 0.1),
+        ];
+        v.extend_from_slice(extra);
+        v
+    };
     let fine = if plan.quick { 10.0 } else { 61.0 };
     let noh_fine = if plan.quick { 1600.0 } else { 6400.0 };
     vec![
@@ -101,6 +113,22 @@ fn cases(plan: &Plan) -> Vec<Def> {
             "smoothing_ratio_3.0",
             "taylor",
             t(&[("smoothing_ratio", 3.0)]),
+        ),
+        def("large_strain_400", "taylor", t(&large(400.0, &[]))),
+        def("large_strain_600", "taylor", t(&large(600.0, &[]))),
+        def("large_strain_800", "taylor", t(&large(800.0, &[]))),
+        def(
+            "large_strain_soft",
+            "taylor",
+            t(&large(p.impact_speed, &[("jc_a", 50e6), ("jc_b", 0.0)])),
+        ),
+        def(
+            "large_strain_near_melt",
+            "taylor",
+            t(&large(
+                p.impact_speed,
+                &[("initial_temperature", p.melt_temperature - 50.0)],
+            )),
         ),
         def(
             "smoothing_coefficient_0",
@@ -211,7 +239,9 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
     doc.para(&format!(
         "## 5. Stability on stiff and extreme cases\n\n\
          Taylor cases run at {} particles across the radius unless the case sets it \
-         (test 7 otherwise; SI units), Noh cases as given. `outcome` is `finished` \
+         (test 7 otherwise; SI units), Noh cases as given. The `large_strain_` cases \
+         use the large-strain scheme (`smoothing_ratio=2 smoothing_order=2 \
+         shifting=0.1`, README). `outcome` is `finished` \
          (end condition reached: the rod at rest, or t = 0.6 for Noh) or the name of \
          the error that stopped the run or refused the input. `max_speed` is the \
          largest particle speed over the recorded times (m/s; Noh: dimensionless); \

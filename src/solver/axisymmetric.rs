@@ -31,6 +31,7 @@ use super::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
     smooth, smooth2, velocity_gradients,
 };
+use super::shift::{Candidates, Freedom, carry, shifts};
 use super::team::{Chunks, Team};
 use super::{COURANT, check_time_step};
 use crate::error::{Error, Result};
@@ -50,6 +51,14 @@ pub const UNDEFORMED_STRAIN: f64 = 0.002;
 /// stops with [`Error::SpacingCollapse`]: particles that close no longer
 /// resolve the material between them.
 pub const SPACING_COLLAPSE_BOUND: f64 = 0.1;
+
+/// Longest shift of a particle in one step, relative to the initial
+/// spacing.
+pub const SHIFT_CAP: f64 = 0.05;
+
+/// Range of the shifting repulsion, relative to the initial spacing: pairs
+/// closer than this push each other apart.
+pub const SHIFT_RANGE: f64 = 0.5;
 
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
 pub const ENERGY_ERROR_BOUND: f64 = 0.5;
@@ -603,14 +612,112 @@ impl TaylorSolver {
         // a team of the others through its parallel passes
         // (src/solver/team.rs). The neighbour rebuild comes first, with its
         // own parallel loops, so that no follower waits through it.
+        // Particle shifting, if on, comes first, on lists that hold every
+        // pair in the support (so that it does not depend on when they were
+        // built, and a restored run shifts as the original did).
         let result = rayon::scope(|_| {
             if self.needs_rebuild(&ws) {
+                self.rebuild_neighbours(&mut ws);
+            }
+            if self.p.shifting > 0.0 && self.shift(&mut ws) && self.needs_rebuild(&ws) {
                 self.rebuild_neighbours(&mut ws);
             }
             Team::lead(|team| self.step_in(&mut ws, team))
         });
         self.ws = ws;
         result
+    }
+
+    /// The directions each particle may shift in: none on the surfaces (the
+    /// face row, the mantle and the top, which carry the boundary
+    /// conditions and the rod's outline), along Z on the axis, along R on
+    /// the anvil, none on both.
+    fn freedoms(&self) -> Vec<Freedom> {
+        let n = self.particles();
+        let nr = self.nr;
+        let mut free = vec![Freedom::Both; n];
+        for (i, f) in free.iter_mut().enumerate() {
+            *f = match (i.is_multiple_of(nr), self.contact[i]) {
+                (true, true) => Freedom::Fixed,
+                (true, false) => Freedom::Across([1.0, 0.0]),
+                (false, true) => Freedom::Across([0.0, 1.0]),
+                (false, false) => Freedom::Both,
+            };
+        }
+        for s in [&self.mantle, &self.top, &self.face] {
+            for &i in &s.particles {
+                free[i] = Freedom::Fixed;
+            }
+        }
+        free
+    }
+
+    /// Particle shifting (src/solver/shift.rs): pushes apart the pairs closer
+    /// than [`SHIFT_RANGE`] and carries the fields of the moved particles
+    /// along. The kinetic energy the carrying changes is booked with the
+    /// smoothing. Returns whether a particle moved.
+    fn shift(&mut self, ws: &mut Workspace) -> bool {
+        let n = self.particles();
+        ws.pos[..n].copy_from_slice(&self.pos);
+        fill_images(&mut ws.pos, n, &ws.images);
+        let c = Candidates {
+            pos: &ws.pos,
+            nbr: &ws.nbr,
+            nbr_len: &ws.nbr_len,
+            stride: ws.stride,
+        };
+        let spacing = self.r0 / (self.nr - 1) as f64;
+        let d = shifts(
+            c,
+            &self.freedoms(),
+            spacing,
+            SHIFT_RANGE * spacing,
+            self.p.shifting,
+            SHIFT_CAP * spacing,
+        );
+        if d.iter().all(|d| *d == [0.0; 2]) {
+            return false;
+        }
+        let mut f: Vec<[f64; 9]> = (0..n)
+            .map(|i| {
+                let (v, s) = (self.vel[i], self.dev[i]);
+                [
+                    v[0],
+                    v[1],
+                    s[0],
+                    s[1],
+                    s[2],
+                    s[3],
+                    self.rho[i],
+                    self.eps_p[i],
+                    self.temp[i],
+                ]
+            })
+            .collect();
+        carry(c, n, self.h, &mut f, &d);
+        let mut ke = [0.0; 2];
+        for (i, (fi, di)) in f.iter().zip(&d).enumerate() {
+            if *di == [0.0; 2] {
+                continue;
+            }
+            ke[0] += kinetic1(self.vel[i], self.mass[i]);
+            self.vel[i] = [fi[0], fi[1]];
+            ke[1] += kinetic1(self.vel[i], self.mass[i]);
+            self.dev[i] = [fi[2], fi[3], fi[4], fi[5]];
+            self.rho[i] = fi[6];
+            self.eps_p[i] = fi[7].max(0.0);
+            self.temp[i] = fi[8];
+            let p = self.eos.pressure(fi[6]);
+            self.pressure[i] = p;
+            let s = self.dev[i];
+            self.stress_bc[i] = [s[0] - p, s[1] - p, s[2] - p, s[3]];
+            if self.contact[i] {
+                self.stress_bc[i][3] = 0.0;
+            }
+            self.pos[i] = [self.pos[i][0] + di[0], self.pos[i][1] + di[1]];
+        }
+        self.smoothing_dissipation += ke[0] - ke[1];
+        true
     }
 
     fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
@@ -748,6 +855,12 @@ impl TaylorSolver {
                 ratio,
                 bound: SPACING_COLLAPSE_BOUND,
                 time: self.time,
+                hint: if self.p.shifting == 0.0 {
+                    "; at large strain, use smoothing_order = 2, smoothing_ratio = 2 and \
+                     shifting = 0.1 (README, \"Particle shifting\")"
+                } else {
+                    ""
+                },
             });
         }
         self.contact_dissipation += a.held;

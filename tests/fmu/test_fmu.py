@@ -161,7 +161,7 @@ def test_variables_match_the_tables(fmu3, fmu2, tmp_path_factory):
     names2 = {v.name for v in fmu2.md.modelVariables}
     assert names3 - names2 == {"time"}
     params = [v for v in fmu3.md.modelVariables if v.causality == "parameter"]
-    assert len(params) == 22
+    assert len(params) == 23
     assert all(v.variability == "fixed" and v.start is not None for v in params)
     assert fmu3.var("particles_radial").type == "Int32" and fmu2.var("particles_radial").type == "Integer"
     assert fmu3.var("at_rest").type == "Boolean" and fmu3.var("at_rest").causality == "output"

@@ -1,0 +1,280 @@
+//! Particle shifting (regularisation) for the axisymmetric solver: pairs of
+//! particles closer than a fraction of the initial spacing push each other
+//! apart, relative to the material, and the fields of a moved particle are
+//! carried to its new place by a first-order Taylor expansion. Lagrangian
+//! rows follow the material's stretch, e^(-eps) at the impact face, and fall
+//! below any fixed fraction of the spacing once the plastic strain passes a
+//! few; shifting lets the crowded particles leave the face centre instead.
+//! A repulsion that grows as the pair closes is used rather than the
+//! gradient of the kernel-summed number density (Lind et al. 2012, J.
+//! Comput. Phys. 231, 1499): the Gaussian kernel's gradient vanishes as a
+//! pair closes, and with it the face-centre rows paired up sooner than
+//! without shifting (README, "Particle shifting").
+
+use crate::kernel::{SUPPORT, kernel2};
+use rayon::prelude::*;
+
+/// The directions a particle may shift in.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Freedom {
+    /// It stays where the material takes it (surfaces, and particles whose
+    /// support reaches a free surface, where the truncated kernel would pull
+    /// them outward).
+    Fixed,
+    /// Across the unit vector only (the component along it is removed): a
+    /// particle pressed on the anvil moves along R, one on the axis along Z,
+    /// one near a free surface along that surface.
+    Across([f64; 2]),
+    /// Both.
+    Both,
+}
+
+/// The neighbour candidates of the solver (padded rows, images included).
+#[derive(Clone, Copy)]
+pub(super) struct Candidates<'a> {
+    /// Positions of the particles and then of their images.
+    pub pos: &'a [[f64; 2]],
+    pub nbr: &'a [u32],
+    pub nbr_len: &'a [u32],
+    pub stride: usize,
+}
+
+impl Candidates<'_> {
+    /// Candidate neighbours of particle `i` (itself included).
+    fn of(&self, i: usize) -> &[u32] {
+        &self.nbr[i * self.stride..][..self.nbr_len[i] as usize]
+    }
+}
+
+/// Shift of each particle: `beta D sum_j (1 - r_ij / l)^2 e_ij` over the
+/// neighbours closer than `l` (`e_ij` the unit vector from `j` to `i`, `D`
+/// the initial spacing), limited to `cap` in length and projected on the
+/// directions the particle is free in. Mirror images count, so a particle
+/// is pushed off the axis and the anvil by its own image as by any other.
+pub(super) fn shifts(
+    c: Candidates,
+    free: &[Freedom],
+    spacing: f64,
+    range: f64,
+    beta: f64,
+    cap: f64,
+) -> Vec<[f64; 2]> {
+    (0..free.len())
+        .into_par_iter()
+        .map(|i| {
+            if free[i] == Freedom::Fixed {
+                return [0.0; 2];
+            }
+            let xi = c.pos[i];
+            let mut d = [0.0; 2];
+            let range2 = range * range;
+            for &j in c.of(i) {
+                let xj = c.pos[j as usize];
+                let (a, b) = (xi[0] - xj[0], xi[1] - xj[1]);
+                let r2 = a * a + b * b;
+                if r2 > 0.0 && r2 < range2 {
+                    let r = r2.sqrt();
+                    let w = beta * spacing * (1.0 - r / range).powi(2) / r;
+                    d[0] += w * a;
+                    d[1] += w * b;
+                }
+            }
+            if let Freedom::Across(n) = free[i] {
+                let dn = d[0] * n[0] + d[1] * n[1];
+                d = [d[0] - dn * n[0], d[1] - dn * n[1]];
+            }
+            let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+            if len > cap {
+                d = [d[0] * cap / len, d[1] * cap / len];
+            }
+            d
+        })
+        .collect()
+}
+
+/// Gradient (d/dR, d/dZ) of each of the `K` components of `f` at particle
+/// `i`, from its real neighbours (index below `n`) within the support, by
+/// the kernel gradient corrected to be exact for linear fields:
+/// `grad f_i = M^-1 sum_j (f_j - f_i) grad W_ij`,
+/// `M = sum_j grad W_ij (x_j - x_i)^T`. `None` where `M` is singular.
+pub(super) fn gradient<const K: usize>(
+    c: Candidates,
+    n: usize,
+    h: f64,
+    f: &[[f64; K]],
+    i: usize,
+) -> Option<[[f64; 2]; K]> {
+    let xi = c.pos[i];
+    let mut m = [[0.0; 2]; 2];
+    let mut a = [[0.0; 2]; K];
+    let reach2 = SUPPORT * SUPPORT * h * h;
+    for &j in c.of(i) {
+        let j = j as usize;
+        if j >= n || j == i {
+            continue;
+        }
+        let (dr, dz) = (c.pos[j][0] - xi[0], c.pos[j][1] - xi[1]);
+        if dr * dr + dz * dz >= reach2 {
+            continue;
+        }
+        let k = kernel2(-dr, -dz, h);
+        let gw = [k.w_r, k.w_z];
+        for p in 0..2 {
+            m[p][0] += gw[p] * dr;
+            m[p][1] += gw[p] * dz;
+        }
+        for q in 0..K {
+            let df = f[j][q] - f[i][q];
+            a[q][0] += df * gw[0];
+            a[q][1] += df * gw[1];
+        }
+    }
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    let scale = (m[0][0] * m[0][0] + m[1][1] * m[1][1] + m[0][1] * m[0][1] + m[1][0] * m[1][0])
+        .max(f64::MIN_POSITIVE);
+    if det.abs() < 1e-6 * scale {
+        return None;
+    }
+    // M g = a for each component.
+    Some(std::array::from_fn(|q| {
+        [
+            (m[1][1] * a[q][0] - m[0][1] * a[q][1]) / det,
+            (-m[1][0] * a[q][0] + m[0][0] * a[q][1]) / det,
+        ]
+    }))
+}
+
+/// `f_i + dr_i . grad f_i` for the shifted particles (gradients taken from
+/// the fields before any is moved).
+pub(super) fn carry<const K: usize>(
+    c: Candidates,
+    n: usize,
+    h: f64,
+    f: &mut [[f64; K]],
+    d: &[[f64; 2]],
+) {
+    let moved: Vec<Option<[f64; K]>> = (0..d.len())
+        .into_par_iter()
+        .map(|i| {
+            if d[i] == [0.0; 2] {
+                return None;
+            }
+            let g = gradient(c, n, h, f, i)?;
+            Some(std::array::from_fn(|q| {
+                f[i][q] + d[i][0] * g[q][0] + d[i][1] * g[q][1]
+            }))
+        })
+        .collect();
+    for (fi, m) in f.iter_mut().zip(moved) {
+        if let Some(m) = m {
+            *fi = m;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A lattice of `nx` by `ny` points at spacing `d`, with all pairs as
+    /// candidates.
+    fn lattice(nx: usize, ny: usize, d: f64) -> (Vec<[f64; 2]>, Vec<u32>, Vec<u32>, usize) {
+        let pos: Vec<[f64; 2]> = (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| [i as f64 * d, j as f64 * d]))
+            .collect();
+        let n = pos.len();
+        let nbr: Vec<u32> = (0..n).flat_map(|_| 0..n as u32).collect();
+        (pos, nbr, vec![n as u32; n], n)
+    }
+
+    #[test]
+    fn gradients_of_linear_fields_are_exact_on_a_distorted_lattice() {
+        let (mut pos, nbr, len, stride) = lattice(9, 9, 1.0);
+        for (k, x) in pos.iter_mut().enumerate() {
+            x[0] += 0.2 * ((k * 7) % 5) as f64 / 5.0;
+            x[1] *= 0.3 + 0.05 * x[0];
+        }
+        let c = Candidates {
+            pos: &pos,
+            nbr: &nbr,
+            nbr_len: &len,
+            stride,
+        };
+        let f: Vec<[f64; 2]> = pos
+            .iter()
+            .map(|x| [2.0 + 3.0 * x[0] - 5.0 * x[1], -x[0] + 0.5 * x[1]])
+            .collect();
+        let g = gradient(c, pos.len(), 1.5, &f, 40).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(g[0][0], 3.0) && close(g[0][1], -5.0), "{g:?}");
+        assert!(close(g[1][0], -1.0) && close(g[1][1], 0.5), "{g:?}");
+        // Carried by a shift, a linear field takes its value at the new place.
+        let mut d = vec![[0.0; 2]; pos.len()];
+        d[40] = [0.03, -0.02];
+        let mut moved = f.clone();
+        carry(c, pos.len(), 1.5, &mut moved, &d);
+        let (x, y) = (pos[40][0] + 0.03, pos[40][1] - 0.02);
+        assert!(close(moved[40][0], 2.0 + 3.0 * x - 5.0 * y));
+        assert!(close(moved[40][1], -x + 0.5 * y));
+        assert!(
+            moved
+                .iter()
+                .zip(&f)
+                .enumerate()
+                .all(|(i, (a, b))| i == 40 || a == b)
+        );
+    }
+
+    #[test]
+    fn close_pairs_push_apart_and_distant_ones_do_not() {
+        // A lattice at the initial spacing: nobody is within the range.
+        let (mut pos, nbr, len, stride) = lattice(5, 5, 1.0);
+        let free = vec![Freedom::Both; pos.len()];
+        let c = Candidates {
+            pos: &pos,
+            nbr: &nbr,
+            nbr_len: &len,
+            stride,
+        };
+        let (beta, range) = (0.1, 0.5);
+        assert!(
+            shifts(c, &free, 1.0, range, beta, 1.0)
+                .iter()
+                .all(|d| *d == [0.0; 2])
+        );
+        // Particle 12 (the centre) brought to 0.2 above particle 7: each is
+        // pushed away from the other by beta D (1 - 0.2 / 0.5)^2 = 0.036.
+        pos[12] = [2.0, 1.2];
+        let c = Candidates {
+            pos: &pos,
+            nbr: &nbr,
+            nbr_len: &len,
+            stride,
+        };
+        let d = shifts(c, &free, 1.0, range, beta, 1.0);
+        let push = beta * (1.0f64 - 0.2 / 0.5).powi(2);
+        assert!(
+            (d[12][1] - push).abs() < 1e-15 && d[12][0] == 0.0,
+            "{:?}",
+            d[12]
+        );
+        assert!(
+            (d[7][1] + push).abs() < 1e-15 && d[7][0] == 0.0,
+            "{:?}",
+            d[7]
+        );
+        assert!(
+            d.iter()
+                .enumerate()
+                .all(|(i, d)| i == 7 || i == 12 || *d == [0.0; 2])
+        );
+        // The cap and the freedoms hold.
+        let d = shifts(c, &free, 1.0, range, beta, 0.01);
+        assert!((d[12][1] - 0.01).abs() < 1e-15);
+        let mut only_r = free.clone();
+        only_r[12] = Freedom::Across([0.0, 1.0]);
+        only_r[7] = Freedom::Fixed;
+        let d = shifts(c, &only_r, 1.0, range, beta, 1.0);
+        assert_eq!((d[12], d[7]), ([0.0; 2], [0.0; 2]));
+    }
+}
