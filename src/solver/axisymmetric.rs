@@ -149,6 +149,8 @@ struct Tally {
     contact_lost: f64,
     /// Largest `c + |v|` (for the time step).
     worst_speed: f64,
+    /// Largest `|v|^2`.
+    fastest2: f64,
     /// Whether a particle touches the anvil.
     touching: bool,
     /// First particle through the anvil or the axis: (particle, boundary,
@@ -175,6 +177,12 @@ struct Workspace {
     built_at: Vec<[f64; 2]>,
     /// Contact flags of the impact-face particles when the images were made.
     face_contact: Vec<bool>,
+    /// Twice the farthest any particle moved since the pair pass of the last
+    /// step: a particle whose closest neighbour then (`part[i].min_d2`) was
+    /// farther than the shifting range plus this has no neighbour within
+    /// the range now, and is left out of the shifting pass (which gives the
+    /// same bits). None after a restore.
+    shift_margin: Option<f64>,
     /// Fields of the particles and their images.
     pos: Vec<[f64; 2]>,
     vol: Vec<f64>,
@@ -616,10 +624,13 @@ impl TaylorSolver {
         // pair in the support (so that it does not depend on when they were
         // built, and a restored run shifts as the original did).
         let result = rayon::scope(|_| {
-            if self.needs_rebuild(&ws) {
+            let rebuilt = self.needs_rebuild(&ws);
+            if rebuilt {
                 self.rebuild_neighbours(&mut ws);
             }
-            if self.p.shifting > 0.0 && self.shift(&mut ws) && self.needs_rebuild(&ws) {
+            // New lists may bring new mirror images, and pairs with them.
+            let margin = if rebuilt { None } else { ws.shift_margin };
+            if self.p.shifting > 0.0 && self.shift(&mut ws, margin) && self.needs_rebuild(&ws) {
                 self.rebuild_neighbours(&mut ws);
             }
             Team::lead(|team| self.step_in(&mut ws, team))
@@ -655,8 +666,10 @@ impl TaylorSolver {
     /// Particle shifting (src/solver/shift.rs): pushes apart the pairs closer
     /// than [`SHIFT_RANGE`] and carries the fields of the moved particles
     /// along. The kinetic energy the carrying changes is booked with the
-    /// smoothing. Returns whether a particle moved.
-    fn shift(&mut self, ws: &mut Workspace) -> bool {
+    /// smoothing. With a `margin` ([`Workspace::shift_margin`]) only the
+    /// particles that may have a neighbour within the range are looked at.
+    /// Returns whether a particle moved.
+    fn shift(&mut self, ws: &mut Workspace, margin: Option<f64>) -> bool {
         let n = self.particles();
         ws.pos[..n].copy_from_slice(&self.pos);
         fill_images(&mut ws.pos, n, &ws.images);
@@ -667,9 +680,21 @@ impl TaylorSolver {
             stride: ws.stride,
         };
         let spacing = self.r0 / (self.nr - 1) as f64;
+        let mut free = self.freedoms();
+        if let Some(m) = margin {
+            let reach = SHIFT_RANGE * spacing * (1.0 + 1e-9) + m;
+            for (f, p) in free.iter_mut().zip(&ws.part) {
+                if p.min_d2 > reach * reach {
+                    *f = Freedom::Fixed;
+                }
+            }
+            if free.iter().all(|f| *f == Freedom::Fixed) {
+                return false;
+            }
+        }
         let d = shifts(
             c,
-            &self.freedoms(),
+            &free,
             spacing,
             SHIFT_RANGE * spacing,
             self.p.shifting,
@@ -1079,6 +1104,10 @@ impl TaylorSolver {
                         t.touching |= touch[k];
                         t.worst_speed =
                             t.worst_speed.max(wave_and_flow_speed(modulus, rho_new, vi));
+                        // The velocity the particle moved with (before
+                        // a contact stopped it).
+                        let moved = vel[i];
+                        t.fastest2 = t.fastest2.max(moved[0] * moved[0] + moved[1] * moved[1]);
                     }
                     *tally = t;
                 },
@@ -1092,12 +1121,14 @@ impl TaylorSolver {
             t.mass += c.mass;
             t.contact_lost += c.contact_lost;
             t.worst_speed = t.worst_speed.max(c.worst_speed);
+            t.fastest2 = t.fastest2.max(c.fastest2);
             t.touching |= c.touching;
             t.through = t.through.or(c.through);
             t.non_finite = t.non_finite.or(c.non_finite);
         }
         self.internal_energy += t.internal;
         self.contact_dissipation += t.contact_lost;
+        ws.shift_margin = Some(2.0 * dt * t.fastest2.sqrt());
         self.time += dt;
         self.steps += 1;
         if let Some((particle, boundary, position)) = t.through {

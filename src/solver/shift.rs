@@ -12,7 +12,6 @@
 //! without shifting (README, "Particle shifting").
 
 use crate::kernel::{SUPPORT, kernel2};
-use rayon::prelude::*;
 
 /// The directions a particle may shift in.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,7 +59,6 @@ pub(super) fn shifts(
     cap: f64,
 ) -> Vec<[f64; 2]> {
     (0..free.len())
-        .into_par_iter()
         .map(|i| {
             if free[i] == Freedom::Fixed {
                 return [0.0; 2];
@@ -154,7 +152,6 @@ pub(super) fn carry<const K: usize>(
     d: &[[f64; 2]],
 ) {
     let moved: Vec<Option<[f64; K]>> = (0..d.len())
-        .into_par_iter()
         .map(|i| {
             if d[i] == [0.0; 2] {
                 return None;
