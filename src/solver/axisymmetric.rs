@@ -12,6 +12,9 @@
 //!
 //! One step, from positions `x^n`, velocities `v^{n-1/2}` and stresses
 //! `sigma^n` (with boundary conditions applied):
+//! 0. with `shifting > 0`, particle shifting (src/solver/shift.rs): pairs
+//!    closer than half the initial spacing push apart, and the moved
+//!    particles take the fields of their new place;
 //! 1. neighbours and MSPH first-derivative weights at `x^n`;
 //! 2. acceleration from the divergence of stress; `v^{n+1/2} = v^{n-1/2} + dt a`,
 //!    then `U_R = 0` on the axis and `U_Z = 0` on particles touching the anvil;
