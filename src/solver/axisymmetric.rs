@@ -503,11 +503,16 @@ impl TaylorSolver {
         COURANT * self.h / worst
     }
 
+    /// Initial particle spacing.
+    fn spacing(&self) -> f64 {
+        self.r0 / (self.nr - 1) as f64
+    }
+
     /// Height above the anvil below which a particle counts as on it and has
     /// no mirror image across it: half the spacing guard, so that a particle
     /// and its own image are never closer than the guard allows.
     fn anvil_gap(&self) -> f64 {
-        0.5 * SPACING_COLLAPSE_BOUND * self.r0 / (self.nr - 1) as f64
+        0.5 * SPACING_COLLAPSE_BOUND * self.spacing()
     }
 
     /// Whether particle `i` is mirrored across the anvil: it lies within
@@ -622,10 +627,10 @@ impl TaylorSolver {
         // The whole step runs on one worker of the thread pool, which leads
         // a team of the others through its parallel passes
         // (src/solver/team.rs). The neighbour rebuild comes first, with its
-        // own parallel loops, so that no follower waits through it.
-        // Particle shifting, if on, comes first, on lists that hold every
-        // pair in the support (so that it does not depend on when they were
-        // built, and a restored run shifts as the original did).
+        // own parallel loops, so that no follower waits through it. Particle
+        // shifting, if on, follows it, on lists that hold every pair in the
+        // support (so that it does not depend on when they were built, and a
+        // restored run shifts as the original did).
         let result = rayon::scope(|_| {
             let rebuilt = self.needs_rebuild(&ws);
             if rebuilt {
@@ -647,17 +652,18 @@ impl TaylorSolver {
     /// conditions and the rod's outline), along Z on the axis, along R on
     /// the anvil, none on both.
     fn freedoms(&self) -> Vec<Freedom> {
-        let n = self.particles();
         let nr = self.nr;
-        let mut free = vec![Freedom::Both; n];
-        for (i, f) in free.iter_mut().enumerate() {
-            *f = match (i.is_multiple_of(nr), self.contact[i]) {
+        let mut free: Vec<Freedom> = self
+            .contact
+            .iter()
+            .enumerate()
+            .map(|(i, &touch)| match (i.is_multiple_of(nr), touch) {
                 (true, true) => Freedom::Fixed,
                 (true, false) => Freedom::Across([1.0, 0.0]),
                 (false, true) => Freedom::Across([0.0, 1.0]),
                 (false, false) => Freedom::Both,
-            };
-        }
+            })
+            .collect();
         for s in [&self.mantle, &self.top, &self.face] {
             for &i in &s.particles {
                 free[i] = Freedom::Fixed;
@@ -674,15 +680,7 @@ impl TaylorSolver {
     /// Returns whether a particle moved.
     fn shift(&mut self, ws: &mut Workspace, margin: Option<f64>) -> bool {
         let n = self.particles();
-        ws.pos[..n].copy_from_slice(&self.pos);
-        fill_images(&mut ws.pos, n, &ws.images);
-        let c = Candidates {
-            pos: &ws.pos,
-            nbr: &ws.nbr,
-            nbr_len: &ws.nbr_len,
-            stride: ws.stride,
-        };
-        let spacing = self.r0 / (self.nr - 1) as f64;
+        let spacing = self.spacing();
         let mut free = self.freedoms();
         if let Some(m) = margin {
             let reach = SHIFT_RANGE * spacing * (1.0 + 1e-9) + m;
@@ -695,6 +693,14 @@ impl TaylorSolver {
                 return false;
             }
         }
+        ws.pos[..n].copy_from_slice(&self.pos);
+        fill_images(&mut ws.pos, n, &ws.images);
+        let c = Candidates {
+            pos: &ws.pos,
+            nbr: &ws.nbr,
+            nbr_len: &ws.nbr_len,
+            stride: ws.stride,
+        };
         let d = shifts(
             c,
             &free,
@@ -875,7 +881,7 @@ impl TaylorSolver {
                 condition,
             });
         }
-        let d0 = self.r0 / (self.nr - 1) as f64;
+        let d0 = self.spacing();
         let ratio = a.min_d2.sqrt() / d0;
         self.min_spacing = self.min_spacing.min(ratio);
         if ratio < SPACING_COLLAPSE_BOUND {

@@ -16,13 +16,11 @@ use crate::kernel::{SUPPORT, kernel2};
 /// The directions a particle may shift in.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Freedom {
-    /// It stays where the material takes it (surfaces, and particles whose
-    /// support reaches a free surface, where the truncated kernel would pull
-    /// them outward).
+    /// It stays where the material takes it (the surfaces, which carry the
+    /// boundary conditions and the rod's outline).
     Fixed,
     /// Across the unit vector only (the component along it is removed): a
-    /// particle pressed on the anvil moves along R, one on the axis along Z,
-    /// one near a free surface along that surface.
+    /// particle pressed on the anvil moves along R, one on the axis along Z.
     Across([f64; 2]),
     /// Both.
     Both,
