@@ -34,7 +34,7 @@ use super::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
     smooth, smooth2, velocity_gradients,
 };
-use super::shift::{Candidates, Freedom, carry, shifts};
+use super::shift::{Candidates, Freedom, carry, leaving, shifts};
 use super::team::{Chunks, Team};
 use super::{COURANT, check_time_step};
 use crate::error::{Error, Result};
@@ -63,6 +63,15 @@ pub const SHIFT_CAP: f64 = 0.05;
 /// closer than this push each other apart.
 pub const SHIFT_RANGE: f64 = 0.5;
 
+/// Gap along the axis, relative to the initial spacing, below which an
+/// axis particle may leave the axis (src/solver/shift.rs, `leaving`).
+pub const AXIS_CROWD: f64 = 0.3;
+
+/// Distance from the axis, relative to the initial spacing, that a particle
+/// leaving it is moved to: its mirror image is then twice that away, above
+/// [`SPACING_COLLAPSE_BOUND`].
+pub const AXIS_LEAVE: f64 = 0.1;
+
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
 pub const ENERGY_ERROR_BOUND: f64 = 0.5;
 
@@ -88,6 +97,10 @@ pub struct TaylorSolver {
     /// Stress with boundary conditions, used by the momentum equation.
     stress_bc: Vec<Stress>,
     contact: Vec<bool>,
+    /// Whether each particle lies on the axis (a disc rather than a ring):
+    /// the first of each lattice row at the start; shifting may move a
+    /// crowded one off it.
+    on_axis: Vec<bool>,
     mantle: Surface,
     top: Surface,
     face: Surface,
@@ -180,6 +193,8 @@ struct Workspace {
     built_at: Vec<[f64; 2]>,
     /// Contact flags of the impact-face particles when the images were made.
     face_contact: Vec<bool>,
+    /// Particles on the axis when the images were made.
+    axis_count: usize,
     /// Twice the farthest any particle moved since the pair pass of the last
     /// step: a particle whose closest neighbour then (`part[i].min_d2`) was
     /// farther than the shifting range plus this has no neighbour within
@@ -422,6 +437,7 @@ impl TaylorSolver {
             temp: vec![p.initial_temperature; n],
             stress_bc: vec![[0.0; 4]; n],
             contact,
+            on_axis: (0..n).map(|i| i.is_multiple_of(nr)).collect(),
             mantle,
             top,
             face,
@@ -544,7 +560,7 @@ impl TaylorSolver {
         let reach = (SUPPORT + SKIN) * self.h;
         ws.images.clear();
         for i in 0..n {
-            let axis = !i.is_multiple_of(nr) && self.pos[i][0] < reach;
+            let axis = !self.on_axis[i] && self.pos[i][0] < reach;
             let anvil = self.anvil_image(i, reach);
             let source = i as u32;
             for (yes, mirror) in [
@@ -575,6 +591,7 @@ impl TaylorSolver {
         ws.built_at.extend_from_slice(&self.pos);
         ws.face_contact.clear();
         ws.face_contact.extend_from_slice(&self.contact[..nr]);
+        ws.axis_count = self.axis_count();
         // Whole batches of W rows.
         let rows = n.next_multiple_of(W) * stride;
         ws.act.resize(rows, 0);
@@ -603,7 +620,10 @@ impl TaylorSolver {
     /// of the impact face has touched or left the anvil (which changes the
     /// images).
     fn needs_rebuild(&self, ws: &Workspace) -> bool {
-        if ws.built_at.len() != self.particles() || ws.face_contact[..] != self.contact[..self.nr] {
+        if ws.built_at.len() != self.particles()
+            || ws.face_contact[..] != self.contact[..self.nr]
+            || ws.axis_count != self.axis_count()
+        {
             return true;
         }
         let gap = self.anvil_gap();
@@ -619,6 +639,11 @@ impl TaylorSolver {
             let (a, b) = (x[0] - x0[0], x[1] - x0[1]);
             a * a + b * b > limit2
         })
+    }
+
+    /// Number of particles on the axis (particles only ever leave it).
+    fn axis_count(&self) -> usize {
+        self.on_axis.iter().filter(|&&a| a).count()
     }
 
     /// Advances one step.
@@ -652,12 +677,11 @@ impl TaylorSolver {
     /// conditions and the rod's outline), along Z on the axis, along R on
     /// the anvil, none on both.
     fn freedoms(&self) -> Vec<Freedom> {
-        let nr = self.nr;
         let mut free: Vec<Freedom> = self
             .contact
             .iter()
             .enumerate()
-            .map(|(i, &touch)| match (i.is_multiple_of(nr), touch) {
+            .map(|(i, &touch)| match (self.on_axis[i], touch) {
                 (true, true) => Freedom::Fixed,
                 (true, false) => Freedom::Across([1.0, 0.0]),
                 (false, true) => Freedom::Across([0.0, 1.0]),
@@ -701,7 +725,7 @@ impl TaylorSolver {
             nbr_len: &ws.nbr_len,
             stride: ws.stride,
         };
-        let d = shifts(
+        let mut d = shifts(
             c,
             &free,
             spacing,
@@ -709,6 +733,7 @@ impl TaylorSolver {
             self.p.shifting,
             SHIFT_CAP * spacing,
         );
+        self.leave_axis(&free, spacing, &mut d);
         if d.iter().all(|d| *d == [0.0; 2]) {
             return false;
         }
@@ -754,12 +779,33 @@ impl TaylorSolver {
         true
     }
 
+    /// Moves crowded particles off the axis ([`leaving`]): each leaves by
+    /// [`AXIS_LEAVE`] along R, on top of its shift along Z, and from then on
+    /// is a ring with its own mirror image.
+    fn leave_axis(&mut self, free: &[Freedom], spacing: f64, d: &mut [[f64; 2]]) {
+        let column: Vec<usize> = (0..self.particles())
+            .step_by(self.nr)
+            .filter(|&i| self.on_axis[i])
+            .collect();
+        let z: Vec<f64> = column.iter().map(|&i| self.pos[i][1]).collect();
+        let may: Vec<bool> = column
+            .iter()
+            .map(|&i| free[i] == Freedom::Across([1.0, 0.0]))
+            .collect();
+        for (&i, leaves) in column.iter().zip(leaving(&z, &may, AXIS_CROWD * spacing)) {
+            if leaves {
+                d[i] = [AXIS_LEAVE * spacing, d[i][1]];
+                self.on_axis[i] = false;
+            }
+        }
+    }
+
     fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
         let n = self.particles();
         let dt = self.dt;
         let alpha = self.p.smoothing_coefficient;
-        let nr = self.nr;
-        let axis = |i: usize| i.is_multiple_of(nr);
+        let on_axis = &self.on_axis;
+        let axis = |i: usize| on_axis[i];
         let Workspace {
             images,
             stride,
@@ -814,7 +860,7 @@ impl TaylorSolver {
             stride,
             vel: &self.vel,
             rho: &self.rho,
-            nr,
+            on_axis: &self.on_axis,
             h: self.h,
             dt,
         };

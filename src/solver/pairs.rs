@@ -49,8 +49,8 @@ pub(super) struct PairInputs<'a> {
     /// Velocities `v^{n-1/2}` and densities of the real particles.
     pub vel: &'a [[f64; 2]],
     pub rho: &'a [f64],
-    /// Particles across the radius (axis particles are multiples of it).
-    pub nr: usize,
+    /// Whether each real particle lies on the axis.
+    pub on_axis: &'a [bool],
     pub h: f64,
     pub dt: f64,
 }
@@ -313,7 +313,7 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
             _ => stress_divergence(act, wr, wz, inp.sbc, si),
         };
         let (v, rho, dt) = (inp.vel[i], inp.rho[i], inp.dt);
-        out.vel[p] = if i.is_multiple_of(inp.nr) {
+        out.vel[p] = if inp.on_axis[i] {
             [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho]
         } else {
             let r = inp.pos[i][0];
@@ -645,7 +645,7 @@ mod avx512_tests {
             stride,
             vel: &[],
             rho: &[],
-            nr,
+            on_axis: &[],
             h,
             dt: 0.0,
         };

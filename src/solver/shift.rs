@@ -88,6 +88,30 @@ pub(super) fn shifts(
         .collect()
 }
 
+/// Which particles of the axis column leave the axis, given their places
+/// along Z from the bottom up and whether each may move across the axis.
+/// Along the axis the repulsion of [`shifts`] only spreads a column as a
+/// diffusion does, while at the face centre the material thins along Z as
+/// e^(-eps) and spreads in R; so, walking up the column, a particle closer
+/// than `crowd` to the axis particle below it leaves, unless that one has
+/// just left (a crowded column sheds every other particle per pass).
+pub(super) fn leaving(z: &[f64], may: &[bool], crowd: f64) -> Vec<bool> {
+    let mut out = vec![false; z.len()];
+    let mut below: Option<f64> = None;
+    let mut just_left = false;
+    for (k, (&zk, &mk)) in z.iter().zip(may).enumerate() {
+        let crowded = below.is_some_and(|zb| zk - zb < crowd);
+        if crowded && mk && !just_left {
+            out[k] = true;
+            just_left = true;
+        } else {
+            below = Some(zk);
+            just_left = false;
+        }
+    }
+    out
+}
+
 /// Gradient (d/dR, d/dZ) of each of the `K` components of `f` at particle
 /// `i`, from its real neighbours (index below `n`) within the support, by
 /// the kernel gradient corrected to be exact for linear fields:
@@ -180,6 +204,22 @@ mod tests {
         let n = pos.len();
         let nbr: Vec<u32> = (0..n).flat_map(|_| 0..n as u32).collect();
         (pos, nbr, vec![n as u32; n], n)
+    }
+
+    /// A crowded axis column sheds every other particle per pass, a sparse
+    /// one none, and a particle that may not move stays (and still counts
+    /// as the one below).
+    #[test]
+    fn a_crowded_axis_column_sheds_every_other_particle() {
+        let all = [true; 7];
+        let z = [0.0, 0.1, 0.2, 0.3, 0.4, 1.0, 1.1];
+        let out = leaving(&z, &all, 0.3);
+        assert_eq!(out, [false, true, false, true, false, false, true]);
+        let sparse = [0.0, 0.35, 0.7, 1.05];
+        assert_eq!(leaving(&sparse, &all[..4], 0.3), [false; 4]);
+        let may = [true, false, true, true, true, true, true];
+        let out = leaving(&z, &may, 0.3);
+        assert_eq!(out, [false, false, true, false, true, false, true]);
     }
 
     #[test]
