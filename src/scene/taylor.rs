@@ -52,7 +52,7 @@ param_table! {
         smoothing_order: "1" = 1.0, Range::integer(1.0, 2.0),
             "velocity smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)";
         shifting: "1" = 0.0, Range::closed(0.0, 1.0),
-            "particle shifting beta (dr = -beta h^2 grad C per step); 0 = Lagrangian, as the paper";
+            "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper";
         end_time: "s" = 400.0e-6, Range::open_closed(0.0, 1.0),
             "latest simulated time; the run normally ends earlier, when the rod is at rest";
     }

@@ -114,6 +114,10 @@ pub struct TaylorSolver {
     smoothing_dissipation: f64,
     contact_dissipation: f64,
     at_rest: bool,
+    /// Time since which the kinetic energy has stayed at or below
+    /// [`QUIET_FRACTION`] of the impact energy (`None` while it is above).
+    #[serde(default)]
+    quiet_since: Option<f64>,
     /// Smallest spacing seen between neighbours, relative to the initial one.
     min_spacing: f64,
     #[serde(skip)]
@@ -125,6 +129,16 @@ pub struct TaylorSolver {
 /// half the skin. Pairs outside the support contribute exactly nothing, so
 /// the result does not depend on when the lists were rebuilt.
 pub const SKIN: f64 = 0.3;
+
+/// The rod is quiet (at rest though still touching the anvil) once its
+/// kinetic energy has stayed at or below this fraction of the impact energy
+/// for [`QUIET_TRANSITS`] elastic transits.
+pub const QUIET_FRACTION: f64 = 0.01;
+
+/// Length of the quiet window in elastic transits `L0 / Ce`: two, the period
+/// of the rod's slowest (free-free) longitudinal mode, so the rod's own
+/// ringing cannot pass as rest.
+pub const QUIET_TRANSITS: f64 = 2.0;
 
 /// Smallest number of particles a thread takes at a time.
 const MIN_LEN: usize = 64;
@@ -201,6 +215,13 @@ struct Workspace {
     /// the range now, and is left out of the shifting pass (which gives the
     /// same bits). None after a restore.
     shift_margin: Option<f64>,
+    /// Per particle, the weights that turn a stress into the work it did in
+    /// the last step, `dt/2 (m/rho) (D_RR, D_ZZ, D_TT, 2 D_RZ)`: the
+    /// internal energy books the boundary conditions' change to the stress
+    /// with them.
+    rate: Vec<[f64; 4]>,
+    /// The stress before the boundary conditions at the end of a step.
+    raw_bc: Vec<Stress>,
     /// Fields of the particles and their images.
     pos: Vec<[f64; 2]>,
     vol: Vec<f64>,
@@ -452,6 +473,7 @@ impl TaylorSolver {
             smoothing_dissipation: 0.0,
             contact_dissipation: 0.0,
             at_rest: false,
+            quiet_since: None,
             min_spacing: 1.0,
             ws: Workspace::default(),
             p,
@@ -829,8 +851,10 @@ impl TaylorSolver {
             tallies,
             strength,
             scratch,
+            rate,
             ..
         } = ws;
+        rate.resize(n, [0.0; 4]);
         scratch.fit();
         let stride = (*stride).max(1);
         // Mirror images across the axis and the anvil of the particles near
@@ -1060,11 +1084,12 @@ impl TaylorSolver {
                     Chunks::new(&mut self.contact, MIN_LEN),
                     Chunks::new(&mut self.stress_bc, MIN_LEN),
                     Chunks::new(tallies, 1),
+                    Chunks::new(&mut rate[..], MIN_LEN),
                 ),
             );
             team.run_parts(
                 &parts,
-                |c, ((dev, pressure, eps_p, temp, rho, memo), (x, v, touch, sbc, tally))| {
+                |c, ((dev, pressure, eps_p, temp, rho, memo), (x, v, touch, sbc, tally, work))| {
                     let tally = &mut tally[0];
                     let i0 = c * MIN_LEN;
                     let mut means = [[0.0]; MIN_LEN];
@@ -1107,14 +1132,19 @@ impl TaylorSolver {
                         let sy = jc.strength(f.hardening, rate, f.thermal);
                         let ret = radial_return(&trial, sy, mu);
                         let p_new = eos.pressure(rho_new);
-                        // Stress power with the mid-step stress, per unit mass.
-                        let p_old = pressure[k];
-                        let sm = |k: usize, p: f64| 0.5 * (s[k] + ret.stress[k]) - p;
-                        let pm = 0.5 * (p_old + p_new);
-                        let power = sm(0, pm) * d_rr
-                            + sm(1, pm) * d_zz
-                            + sm(2, pm) * d_tt
-                            + 2.0 * 0.5 * (s[3] + ret.stress[3]) * d_rz;
+                        // Stress power with the mid-step stress: the mean of
+                        // the stress the momentum equation used (boundary
+                        // conditions applied) and the new one (whose
+                        // conditions the end of the step books), per unit
+                        // mass.
+                        let old = sbc[k];
+                        let sm = |k: usize, p: f64| 0.5 * (old[k] + ret.stress[k] - p);
+                        let power = sm(0, p_new) * d_rr
+                            + sm(1, p_new) * d_zz
+                            + sm(2, p_new) * d_tt
+                            + 2.0 * 0.5 * (old[3] + ret.stress[3]) * d_rz;
+                        let w = 0.5 * dt * mass[i] / rho_new;
+                        work[k] = [w * d_rr, w * d_zz, w * d_tt, w * 2.0 * d_rz];
                         dev[k] = ret.stress;
                         pressure[k] = p_new;
                         eps_p[k] += ret.plastic_strain;
@@ -1201,7 +1231,18 @@ impl TaylorSolver {
                 time: self.time,
             });
         }
+        // The boundary conditions on the new stress, and the work they take
+        // from the new half of the step's stress power.
+        ws.raw_bc.clear();
+        ws.raw_bc.extend_from_slice(&self.stress_bc);
         self.apply_surface_stress_bc();
+        let mut booked = 0.0;
+        for ((bc, raw), w) in self.stress_bc.iter().zip(&ws.raw_bc).zip(&ws.rate) {
+            for c in 0..4 {
+                booked += (bc[c] - raw[c]) * w[c];
+            }
+        }
+        self.internal_energy += booked;
 
         let e = self.energy_error_with(t.kinetic);
         if e > ENERGY_ERROR_BOUND {
@@ -1217,6 +1258,19 @@ impl TaylorSolver {
         // centre of mass no longer moves toward the anvil.
         if -t.momentum / t.mass <= 0.0 && !t.touching {
             self.at_rest = true;
+        }
+        // Or once it is quiet: a flange pressed flat on the anvil never
+        // leaves it, and the rod rings elastically on it for ever. Its impact
+        // energy is spent once the kinetic energy has stayed below
+        // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
+        if t.kinetic <= QUIET_FRACTION * self.initial_energy {
+            let since = *self.quiet_since.get_or_insert(self.time);
+            let window = QUIET_TRANSITS * self.p.initial_length / self.wave_speed();
+            if self.time - since >= window {
+                self.at_rest = true;
+            }
+        } else {
+            self.quiet_since = None;
         }
         Ok(())
     }
