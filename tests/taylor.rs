@@ -352,8 +352,8 @@ fn rows_pressed_on_the_anvil_close_evenly_and_stay_above_the_guard() {
 /// scheme, with particle shifting) at the default 20 particles across runs to
 /// rest, no pair closer than the spacing guard, within 2% in length of
 /// 21.42 mm and 3% in face radius of 7.15 mm (the published finite-element
-/// solutions), with the energy balanced within 5%. Measured: +1.21% and
-/// +0.13%, energy error 0.020, at rest at 86.1 us.
+/// solutions), with the energy balanced within 5%. Measured: +1.10% and
+/// +0.17%, energy error 0.020, at rest at 84.7 us.
 #[test]
 fn wilkins_bar_runs_to_rest_with_the_face_of_the_finite_element_solutions() {
     let sim = run(wilkins_scene(), &[]);
@@ -380,7 +380,7 @@ fn check_benchmark(sim: &Simulation, length: (f64, f64), radius: (f64, f64)) {
 
 /// Test 7 at 400 m/s, more than twice its speed, with the large-strain
 /// scheme runs to rest with the energy balanced within 5% (measured: at
-/// rest at 63.5 us, energy error 0.023); with the paper's scheme it stops
+/// rest at 61.6 us, energy error 0.028); with the paper's scheme it stops
 /// with a singular moment matrix at the face centre at 15.3 us.
 #[test]
 fn test7_at_400_mps_runs_to_rest_with_the_large_strain_scheme() {
@@ -483,7 +483,7 @@ fn test7_at_600_mps_runs_to_rest_at_paper_resolution() {
 /// the default 20 particles across runs to rest within 1% in length and 3%
 /// in face diameter of the converged axisymmetric finite-element results
 /// (DynELA and Abaqus: Lf 26.54 mm, Df 11.16 mm), with the energy balanced
-/// within 5%. Measured: +0.17% and +1.44%, energy error 0.0098.
+/// within 5%. Measured: +0.17% and +1.43%, energy error 0.0091.
 #[test]
 fn crmo4_bar_matches_the_converged_finite_element_results() {
     let sim = run(
