@@ -110,7 +110,7 @@ int main(void) {
     check(NULL, mi_sim_new("taylor", &sim), "mi_sim_new");
     expect(sim, mi_sim_set_param(sim, "impact_sped", 1.0), MI_UNKNOWN_PARAMETER, "impact_speed",
            "set(impact_sped)");
-    expect(sim, mi_sim_set_param(sim, "impact_speed", -1.0), MI_OUT_OF_RANGE, "(0, 2000]",
+    expect(sim, mi_sim_set_param(sim, "impact_speed", -1.0), MI_OUT_OF_RANGE, "[0.01, 2000]",
            "set(impact_speed = -1)");
     expect(sim, mi_sim_set_param(sim, "impact_speed", NAN), MI_OUT_OF_RANGE, "NaN",
            "set(impact_speed = NaN)");

@@ -5,7 +5,7 @@
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
     /// A parameter value is outside its allowed range (or NaN/infinite).
-    #[error("parameter `{name}` = {value} is out of range: allowed {range}")]
+    #[error("parameter `{name}` = {} is out of range: allowed {range}", number(*.value))]
     OutOfRange {
         /// Parameter name.
         name: String,
@@ -173,3 +173,15 @@ impl Error {
 
 /// Result alias of the core.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A number as a person reads it: plain decimals for everyday magnitudes,
+/// and the exponent form for very small or very large ones (`1.6e-298`
+/// rather than three hundred zeros).
+pub fn number(x: f64) -> String {
+    let a = x.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e15).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}

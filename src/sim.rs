@@ -70,6 +70,7 @@ impl Simulation {
                 p.end_time / 600.0,
             ),
         };
+        crate::solver::check_derived("record interval", record_interval, "")?;
         let mut sim = Simulation {
             history: History::new(scene.kind().observable_specs()),
             scene,

@@ -541,7 +541,7 @@ fn every_error_code_is_produced() {
             s.set("impact_speed", -1.0),
             MI_OUT_OF_RANGE,
             &s.error(),
-            "(0, 2000]",
+            "[0.01, 2000]",
         );
         check(
             s.set("impact_speed", f64::NAN),

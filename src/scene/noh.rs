@@ -28,7 +28,7 @@ param_table! {
             "c_q of the radial von Neumann-Richtmyer artificial viscosity";
         viscosity_linear: "1" = 0.5, Range::closed(0.0, 10.0),
             "c_l of the radial artificial viscosity";
-        end_time: "1" = 0.6, Range::open_closed(0.0, 100.0),
+        end_time: "1" = 0.6, Range::closed(1.0e-3, 100.0),
             "simulated time at which the run ends";
     }
 }
@@ -45,6 +45,19 @@ impl NohParams {
                 "outer_radius = {} must be at least 0.9 + end_time = {need} so that gas \
                  fills the observation windows (0.1 <= r <= 0.9) until the end",
                 self.outer_radius
+            )));
+        }
+        // The pre-shock gas keeps its initial spacing, so a window at least
+        // one spacing wide always holds a particle to measure.
+        let spacing = self.outer_radius / (self.particles_radial - 1.0);
+        let width = PRE_SHOCK_WINDOW.1 - PRE_SHOCK_WINDOW.0;
+        if spacing > width {
+            return Err(crate::Error::Inconsistent(format!(
+                "outer_radius = {} over particles_radial = {} gives a spacing of {spacing}, \
+                 wider than the pre-shock window ({width}); use at least {} particles",
+                self.outer_radius,
+                self.particles_radial,
+                (self.outer_radius / width).ceil() + 1.0
             )));
         }
         Ok(())

@@ -9,19 +9,19 @@ param_table! {
     /// Parameters of the Taylor impact scene (SI units). Defaults are House et
     /// al. test 7 with the 4340 steel constants of Batra & Zhang (2008).
     TaylorParams, TAYLOR_PARAMS {
-        impact_speed: "m/s" = 181.0, Range::open_closed(0.0, 2000.0),
+        impact_speed: "m/s" = 181.0, Range::closed(0.01, 2000.0),
             "speed of the rod toward the anvil";
-        initial_length: "m" = 0.03797, Range::open_closed(0.0, 10.0),
+        initial_length: "m" = 0.03797, Range::closed(1.0e-4, 10.0),
             "rod length L0";
-        initial_diameter: "m" = 0.007595, Range::open_closed(0.0, 10.0),
+        initial_diameter: "m" = 0.007595, Range::closed(1.0e-4, 10.0),
             "rod diameter D0";
-        density: "kg/m3" = 7830.0, Range::open_closed(0.0, 1.0e5),
+        density: "kg/m3" = 7830.0, Range::closed(100.0, 1.0e5),
             "reference mass density";
-        shear_modulus: "Pa" = 82.9e9, Range::open_closed(0.0, 1.0e14),
+        shear_modulus: "Pa" = 82.9e9, Range::closed(1.0e6, 1.0e14),
             "shear modulus mu";
-        bulk_modulus: "Pa" = 169.1e9, Range::open_closed(0.0, 1.0e15),
+        bulk_modulus: "Pa" = 169.1e9, Range::closed(1.0e6, 1.0e15),
             "bulk modulus K of the linear EOS P = K(rho/rho0 - 1)";
-        specific_heat: "J/(kg.K)" = 460.0, Range::open_closed(0.0, 1.0e5),
+        specific_heat: "J/(kg.K)" = 460.0, Range::closed(1.0, 1.0e5),
             "specific heat C";
         taylor_quinney: "1" = 1.0, Range::closed(0.0, 1.0),
             "Taylor-Quinney coefficient: the fraction of plastic work that becomes heat";
@@ -35,13 +35,13 @@ param_table! {
             "Johnson-Cook c (strain-rate sensitivity)";
         jc_m: "1" = 1.03, Range::open_closed(0.0, 10.0),
             "Johnson-Cook m (thermal softening exponent)";
-        melt_temperature: "K" = 1293.0, Range::open_closed(0.0, 1.0e5),
+        melt_temperature: "K" = 1293.0, Range::closed(1.0, 1.0e5),
             "melting temperature T_M";
-        room_temperature: "K" = 293.0, Range::open_closed(0.0, 1.0e5),
+        room_temperature: "K" = 293.0, Range::closed(1.0, 1.0e5),
             "room temperature T_room";
-        initial_temperature: "K" = 293.0, Range::open_closed(0.0, 1.0e5),
+        initial_temperature: "K" = 293.0, Range::closed(1.0, 1.0e5),
             "rod temperature at impact";
-        ref_strain_rate: "1/s" = 1.0, Range::open_closed(0.0, 1.0e12),
+        ref_strain_rate: "1/s" = 1.0, Range::closed(1.0e-6, 1.0e12),
             "reference strain rate of Johnson-Cook";
         particles_radial: "1" = 20.0, Range::integer(3.0, 200.0),
             "particles across the radius, axis and mantle included; axial spacing matches";
@@ -53,7 +53,7 @@ param_table! {
             "velocity smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)";
         shifting: "1" = 0.0, Range::closed(0.0, 1.0),
             "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper";
-        end_time: "s" = 400.0e-6, Range::open_closed(0.0, 1.0),
+        end_time: "s" = 400.0e-6, Range::closed(1.0e-9, 1.0),
             "latest simulated time; the run normally ends earlier, when the rod is at rest";
     }
 }

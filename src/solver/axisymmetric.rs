@@ -36,7 +36,7 @@ use super::pairs::{
 };
 use super::shift::{Candidates, Freedom, carry, leaving, shifts};
 use super::team::{Chunks, Team};
-use super::{COURANT, check_time_step};
+use super::{COURANT, check_derived, check_time_step};
 use crate::error::{Error, Result};
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
@@ -478,7 +478,9 @@ impl TaylorSolver {
             ws: Workspace::default(),
             p,
         };
+        check_derived("wave speed", s.wave_speed(), " m/s")?;
         s.dt = s.stable_dt();
+        check_derived("time step", s.dt, " s")?;
         s.dt0 = s.dt;
         Ok(s)
     }

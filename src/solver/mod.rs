@@ -48,6 +48,20 @@ pub(crate) fn first_degenerate(
     }
 }
 
+/// Refuses a quantity derived from the parameters (a wave speed, a time
+/// step, a record interval) that is not a positive finite number, so that no
+/// loop can start with a step of zero or a NaN: each parameter can be in its
+/// range while a product or quotient of them overflows or underflows.
+pub(crate) fn check_derived(name: &str, value: f64, unit: &str) -> crate::Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(crate::Error::Inconsistent(format!(
+            "the {name} derived from the parameters is {value}{unit}, not a positive finite number"
+        )))
+    }
+}
+
 /// Stops a run whose stable step fell below [`MIN_DT_FRACTION`] of the first.
 pub(crate) fn check_time_step(dt: f64, dt0: f64, time: f64) -> crate::Result<()> {
     if dt < MIN_DT_FRACTION * dt0 {

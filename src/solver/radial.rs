@@ -36,7 +36,9 @@
 //! of 0.2 at t = 0.6. The density is not smoothed: it is the shell's mass over
 //! its volume.
 
-use super::{COURANT, check_time_step, first_degenerate, first_non_finite, rows_mut};
+use super::{
+    COURANT, check_derived, check_time_step, first_degenerate, first_non_finite, rows_mut,
+};
 use crate::error::{Error, Result};
 use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
@@ -131,6 +133,7 @@ impl NohSolver {
             p,
         };
         s.dt = s.stable_dt();
+        check_derived("time step", s.dt, "")?;
         s.dt0 = s.dt;
         Ok(s)
     }
