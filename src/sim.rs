@@ -219,8 +219,44 @@ impl Simulation {
     }
 
     /// Restores a run from [`Simulation::serialize_state`] bytes.
+    /// The state is checked as a new run is, and refused with
+    /// [`Error::InvalidState`] unless it is one that a run of its scene can
+    /// reach: see [`Simulation::check_restored`].
     pub fn deserialize_state(bytes: &[u8]) -> Result<Self> {
-        serde_json::from_slice(bytes).map_err(|e| Error::InvalidState(e.to_string()))
+        let sim: Simulation =
+            serde_json::from_slice(bytes).map_err(|e| Error::InvalidState(e.to_string()))?;
+        sim.check_restored()
+            .map_err(|e| Error::InvalidState(format!("the state is not valid: {e}")))?;
+        Ok(sim)
+    }
+
+    /// Checks a restored run: its scene passes the checks of a new one, and
+    /// its solver and history agree with a new run of that scene (the same
+    /// lattice, masses and material, bit for bit; one finite value per
+    /// particle in every field; histories of the scene's observables with
+    /// finite values at increasing times).
+    pub fn check_restored(&self) -> std::result::Result<(), String> {
+        let fresh = Simulation::new(self.scene.clone()).map_err(|e| format!("its scene: {e}"))?;
+        match (&self.solver, &fresh.solver) {
+            (Solver::Taylor(a), Solver::Taylor(b)) => a.check_restored(b)?,
+            (Solver::Noh(a), Solver::Noh(b)) => a.check_restored(b)?,
+            _ => return Err("its solver is not its scene's".into()),
+        }
+        if self.record_interval.to_bits() != fresh.record_interval.to_bits()
+            || !self.next_record.is_finite()
+        {
+            return Err("its record times do not follow from its scene".into());
+        }
+        let h = &self.history;
+        let rows = h.times.len();
+        if h.names != fresh.history.names
+            || h.values.len() != rows * h.names.len()
+            || !h.values.iter().chain(&h.times).all(|x| x.is_finite())
+            || h.times.windows(2).any(|w| w[1] < w[0])
+        {
+            return Err("its history is not one of the scene's observables".into());
+        }
+        Ok(())
     }
 
     /// Runs to the end condition.

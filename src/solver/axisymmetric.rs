@@ -124,6 +124,12 @@ pub struct TaylorSolver {
     ws: Workspace,
 }
 
+/// A value as JSON text, to compare restored state with a fresh build bit
+/// for bit (serde_json writes every f64 so that it reads back the same).
+pub(crate) fn json<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_string(v).unwrap_or_default()
+}
+
 /// Neighbour-list skin, in units of h: the candidate lists hold every pair
 /// within `(2 + SKIN) h` and are rebuilt once a particle has moved more than
 /// half the skin. Pairs outside the support contribute exactly nothing, so
@@ -488,6 +494,108 @@ impl TaylorSolver {
     /// Number of particles.
     pub fn particles(&self) -> usize {
         self.pos.len()
+    }
+
+    /// Checks a restored state against `fresh`, a new run of the same
+    /// parameters: what follows from the parameters (lattice, masses,
+    /// material, surfaces, first step, impact energy) must be the same bits,
+    /// and the evolving fields must have one finite, physical value per
+    /// particle. A forged state that passes cannot index out of bounds or
+    /// feed NaN into a step.
+    pub(crate) fn check_restored(&self, fresh: &TaylorSolver) -> std::result::Result<(), String> {
+        let same = |what: &str, a: String, b: String| {
+            if a == b {
+                Ok(())
+            } else {
+                Err(format!("its {what} does not follow from its parameters"))
+            }
+        };
+        same("parameters", json(&self.p), json(&fresh.p))?;
+        same("material", json(&self.jc), json(&fresh.jc))?;
+        same("equation of state", json(&self.eos), json(&fresh.eos))?;
+        same(
+            "lattice",
+            json(&(self.nr, self.nz, self.h, self.r0)),
+            json(&(fresh.nr, fresh.nz, fresh.h, fresh.r0)),
+        )?;
+        same("masses", json(&self.mass), json(&fresh.mass))?;
+        same(
+            "surfaces",
+            json(&(&self.mantle, &self.top, &self.face)),
+            json(&(&fresh.mantle, &fresh.top, &fresh.face)),
+        )?;
+        same(
+            "first step and impact energy",
+            json(&(self.dt0, self.initial_energy)),
+            json(&(fresh.dt0, fresh.initial_energy)),
+        )?;
+        let n = fresh.particles();
+        let lens = [
+            ("positions", self.pos.len()),
+            ("velocities", self.vel.len()),
+            ("densities", self.rho.len()),
+            ("deviatoric stresses", self.dev.len()),
+            ("pressures", self.pressure.len()),
+            ("plastic strains", self.eps_p.len()),
+            ("temperatures", self.temp.len()),
+            ("boundary stresses", self.stress_bc.len()),
+            ("contact flags", self.contact.len()),
+            ("axis flags", self.on_axis.len()),
+        ];
+        for (what, len) in lens {
+            if len != n {
+                return Err(format!("it holds {len} {what} for {n} particles"));
+            }
+        }
+        let finite = |what: &str, ok: bool| {
+            if ok {
+                Ok(())
+            } else {
+                Err(format!("its {what} are not all finite and in range"))
+            }
+        };
+        let flat = |v: &[[f64; 2]]| v.iter().flatten().all(|x| x.is_finite());
+        finite("positions", flat(&self.pos))?;
+        finite("velocities", flat(&self.vel))?;
+        finite(
+            "densities",
+            self.rho.iter().all(|&x| x.is_finite() && x > 0.0),
+        )?;
+        finite(
+            "stresses",
+            self.dev
+                .iter()
+                .chain(&self.stress_bc)
+                .flatten()
+                .chain(&self.pressure)
+                .all(|x| x.is_finite()),
+        )?;
+        finite(
+            "plastic strains",
+            self.eps_p.iter().all(|&x| x.is_finite() && x >= 0.0),
+        )?;
+        finite(
+            "temperatures",
+            self.temp.iter().all(|&x| x.is_finite() && x > 0.0),
+        )?;
+        let scalars = [
+            self.time,
+            self.dt,
+            self.internal_energy,
+            self.smoothing_dissipation,
+            self.contact_dissipation,
+            self.min_spacing,
+            self.quiet_since.unwrap_or(0.0),
+        ];
+        finite("clock and energies", scalars.iter().all(|x| x.is_finite()))?;
+        finite("clock", self.time >= 0.0 && self.dt > 0.0)?;
+        if (self.steps == 0) != (self.time == 0.0) {
+            return Err(format!(
+                "its step count {} does not match its time {}",
+                self.steps, self.time
+            ));
+        }
+        Ok(())
     }
 
     /// Particles across the radius and along the axis.

@@ -143,6 +143,66 @@ impl NohSolver {
         self.r.len()
     }
 
+    /// Checks a restored state against `fresh`, a new run of the same
+    /// parameters (as [`super::axisymmetric::TaylorSolver`] does): what
+    /// follows from the parameters must be the same bits, and every field
+    /// one finite value per particle.
+    pub(crate) fn check_restored(&self, fresh: &NohSolver) -> std::result::Result<(), String> {
+        use super::axisymmetric::json;
+        if json(&(
+            &self.p,
+            &self.gas,
+            self.h,
+            &self.mass,
+            self.dt0,
+            self.initial_energy,
+        )) != json(&(
+            &fresh.p,
+            &fresh.gas,
+            fresh.h,
+            &fresh.mass,
+            fresh.dt0,
+            fresh.initial_energy,
+        )) {
+            return Err("its lattice, masses or gas do not follow from its parameters".into());
+        }
+        let n = fresh.particles();
+        let fields = [
+            ("radii", &self.r),
+            ("velocities", &self.v),
+            ("densities", &self.rho),
+            ("specific energies", &self.e),
+            ("pressures", &self.pres),
+            ("viscous pressures", &self.q),
+            ("signal speeds", &self.signal),
+            ("divergences", &self.div),
+        ];
+        for (what, f) in fields {
+            if f.len() != n {
+                return Err(format!("it holds {} {what} for {n} particles", f.len()));
+            }
+            if !f.iter().all(|x| x.is_finite()) {
+                return Err(format!("its {what} are not all finite"));
+            }
+        }
+        if !self.rho.iter().all(|&x| x > 0.0) {
+            return Err("its densities are not all positive".into());
+        }
+        if !(self.time.is_finite() && self.time >= 0.0 && self.dt.is_finite() && self.dt > 0.0) {
+            return Err(format!(
+                "its clock (t = {}, dt = {}) is not valid",
+                self.time, self.dt
+            ));
+        }
+        if (self.steps == 0) != (self.time == 0.0) {
+            return Err(format!(
+                "its step count {} does not match its time {}",
+                self.steps, self.time
+            ));
+        }
+        Ok(())
+    }
+
     /// Simulated time.
     pub fn time(&self) -> f64 {
         self.time

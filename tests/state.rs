@@ -1,0 +1,143 @@
+//! Saved states edited by hand (forged) are refused with `InvalidState`, the
+//! way a new scene with the same values would be refused; an unedited state
+//! is accepted and resumes (issue: forged saved states are accepted).
+
+use meshless_impact::{Scene, Simulation};
+use serde_json::{Value, json};
+
+/// A coarse run of `name` advanced to `t`, and its saved state as JSON.
+fn saved(name: &str, sets: &[(&str, f64)], t: f64) -> (Simulation, Value) {
+    let mut scene = Scene::builtin(name).unwrap();
+    for (k, v) in sets {
+        scene.set(k, *v).unwrap();
+    }
+    let mut sim = Simulation::new(scene).unwrap();
+    sim.advance_to(t).unwrap();
+    let state = serde_json::from_slice(&sim.serialize_state()).unwrap();
+    (sim, state)
+}
+
+/// The solver's state inside a saved simulation (`{"Taylor": {...}}`).
+fn solver<'a>(state: &'a mut Value, kind: &str) -> &'a mut Value {
+    &mut state["solver"][kind]
+}
+
+/// Asserts that the edited state is refused with `InvalidState`, and
+/// returns the message.
+fn refused(state: &Value) -> String {
+    let bytes = serde_json::to_vec(state).unwrap();
+    match Simulation::deserialize_state(&bytes) {
+        Ok(_) => panic!("a forged state was accepted"),
+        Err(e) => {
+            assert_eq!(e.name(), "InvalidState", "{e}");
+            e.to_string()
+        }
+    }
+}
+
+#[test]
+fn an_unedited_state_is_accepted_and_resumes() {
+    for (name, sets, t) in [
+        ("taylor", &[("particles_radial", 5.0)][..], 5e-6),
+        ("noh", &[("particles_radial", 100.0)][..], 0.1),
+    ] {
+        let (mut sim, state) = saved(name, sets, t);
+        let bytes = serde_json::to_vec(&state).unwrap();
+        let mut back = Simulation::deserialize_state(&bytes).unwrap();
+        sim.run().unwrap();
+        back.run().unwrap();
+        assert_eq!(sim.observables(), back.observables());
+    }
+}
+
+/// Each edit a forger might make to a Taylor state, each refused with a
+/// message that says what is wrong.
+#[test]
+fn forged_taylor_states_are_refused() {
+    let (_, base) = saved("taylor", &[("particles_radial", 5.0)], 5e-6);
+    type Edit = fn(&mut Value);
+    let edits: [(&str, Edit, &str); 11] = [
+        (
+            "scene parameter out of range",
+            |s| s["scene"]["params"]["Taylor"]["density"] = json!(-5.0),
+            "density",
+        ),
+        (
+            "solver parameters differ from the scene's",
+            |s| solver(s, "Taylor")["p"]["density"] = json!(8000.0),
+            "parameters",
+        ),
+        (
+            "a particle removed",
+            |s| {
+                solver(s, "Taylor")["vel"].as_array_mut().unwrap().pop();
+            },
+            "velocities",
+        ),
+        (
+            "a mass changed",
+            |s| solver(s, "Taylor")["mass"][3] = json!(1.0),
+            "masses",
+        ),
+        (
+            "a surface index past the particles",
+            |s| solver(s, "Taylor")["mantle"]["particles"][0] = json!(100000),
+            "surfaces",
+        ),
+        (
+            "a negative density",
+            |s| solver(s, "Taylor")["rho"][7] = json!(-1.0),
+            "densities",
+        ),
+        (
+            "a negative temperature",
+            |s| solver(s, "Taylor")["temp"][2] = json!(-300.0),
+            "temperatures",
+        ),
+        (
+            "a zero time step",
+            |s| solver(s, "Taylor")["dt"] = json!(0.0),
+            "clock",
+        ),
+        (
+            "steps reset at a later time",
+            |s| solver(s, "Taylor")["steps"] = json!(0),
+            "step count",
+        ),
+        (
+            "a record interval of zero (the hang)",
+            |s| s["record_interval"] = json!(0.0),
+            "record",
+        ),
+        (
+            "a history row cut short",
+            |s| {
+                s["history"]["values"].as_array_mut().unwrap().pop();
+            },
+            "history",
+        ),
+    ];
+    for (what, edit, says) in edits {
+        let mut state = base.clone();
+        edit(&mut state);
+        let msg = refused(&state);
+        assert!(msg.contains(says), "{what}: {msg}");
+    }
+}
+
+#[test]
+fn forged_noh_states_are_refused() {
+    let (_, base) = saved("noh", &[("particles_radial", 100.0)], 0.1);
+    let mut s = base.clone();
+    solver(&mut s, "Noh")["r"].as_array_mut().unwrap().pop();
+    assert!(refused(&s).contains("radii"));
+    let mut s = base.clone();
+    solver(&mut s, "Noh")["rho"][5] = json!(0.0);
+    assert!(refused(&s).contains("densities"));
+    let mut s = base.clone();
+    solver(&mut s, "Noh")["mass"][5] = json!(2.0);
+    assert!(refused(&s).contains("masses"));
+    let mut s = base;
+    s["scene"]["params"]["Noh"]["end_time"] = json!(5e-324);
+    assert!(refused(&s).contains("end_time"));
+}
