@@ -4,7 +4,8 @@ use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use meshless_impact::{Error, Scene, Simulation, Table1Row, observe};
 use rayon::prelude::*;
-use std::io::IsTerminal;
+use std::fs::{File, OpenOptions};
+use std::io::{ErrorKind, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -75,9 +76,16 @@ struct RunArgs {
     /// Directory for VTK (.vtu) particle snapshots.
     #[arg(long, value_name = "DIR")]
     vtk_dir: Option<PathBuf>,
-    /// Times (s) of the snapshots, comma-separated; the final state is always written
-    /// when --vtk-dir is given.
-    #[arg(long, value_name = "T1,T2,...", value_delimiter = ',')]
+    /// Times (s) of the snapshots, comma-separated, from 0 to the scene's end_time;
+    /// the final state is always written when --vtk-dir is given.
+    // Values may start with `-`, so that `--vtk-times -1e-6` reaches the range
+    // check and its error instead of being taken for an option.
+    #[arg(
+        long,
+        value_name = "T1,T2,...",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     vtk_times: Vec<f64>,
     /// No progress bar and no table on stdout (errors are still reported).
     #[arg(long, short)]
@@ -96,24 +104,108 @@ struct SweepArgs {
     set: Vec<String>,
 }
 
+/// Why the program stops before the end of `main`.
+enum Stop {
+    /// The reader of stdout or stderr went away (`... | head`): exit 0
+    /// quietly, as Unix tools do.
+    BrokenPipe,
+    /// One or more failures, one line each: printed as `error: ...` on
+    /// stderr, exit status 1.
+    Failed(Vec<String>),
+}
+
+impl Stop {
+    /// One failure.
+    fn failed(message: String) -> Stop {
+        Stop::Failed(vec![message])
+    }
+
+    /// A failed write to `stream` (`stdout` or `stderr`).
+    fn write(stream: &str, e: std::io::Error) -> Stop {
+        if e.kind() == ErrorKind::BrokenPipe {
+            Stop::BrokenPipe
+        } else {
+            Stop::failed(format!("writing to {stream}: {e}"))
+        }
+    }
+}
+
+impl From<Error> for Stop {
+    fn from(e: Error) -> Stop {
+        Stop::failed(e.to_string())
+    }
+}
+
+/// `println!` that returns a [`Stop`] instead of panicking when stdout cannot
+/// be written (closed pipe, full disk).
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        writeln!(std::io::stdout(), $($arg)*).map_err(|e| Stop::write("stdout", e))
+    };
+}
+
+/// `eprintln!` that returns a [`Stop`] instead of panicking when stderr
+/// cannot be written.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        writeln!(std::io::stderr(), $($arg)*).map_err(|e| Stop::write("stderr", e))
+    };
+}
+
 fn main() {
-    let cli = Cli::parse();
-    let result = match cli.command {
+    let status = match try_main() {
+        Ok(()) | Err(Stop::BrokenPipe) => 0,
+        Err(Stop::Failed(messages)) => {
+            for m in messages {
+                // Nothing is left to tell if stderr itself fails.
+                let _ = writeln!(std::io::stderr(), "error: {m}");
+            }
+            1
+        }
+    };
+    std::process::exit(status);
+}
+
+fn try_main() -> Result<(), Stop> {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(e),
+    };
+    match cli.command {
         None => run(RunArgs {
             scene: "taylor".into(),
             ..Default::default()
-        }),
-        Some(Command::Run(a)) => run(a),
-        Some(Command::Sweep(a)) => sweep(a),
-        Some(Command::Report { out, quick }) => report(out, quick),
-        Some(Command::Params { scene }) => params(&scene),
-        Some(Command::Observables { scene }) => observables(&scene),
-        Some(Command::Scene { name }) => Scene::builtin(&name).map(|s| print!("{}", s.to_toml())),
-    };
-    if let Err(e) = result {
-        eprintln!("error: {e}");
-        std::process::exit(1);
+        })?,
+        Some(Command::Run(a)) => run(a)?,
+        Some(Command::Sweep(a)) => sweep(a)?,
+        Some(Command::Report { out, quick }) => report(out, quick)?,
+        Some(Command::Params { scene }) => params(&scene)?,
+        Some(Command::Observables { scene }) => observables(&scene)?,
+        Some(Command::Scene { name }) => {
+            let toml = Scene::builtin(&name)?.to_toml();
+            write!(std::io::stdout(), "{toml}").map_err(|e| Stop::write("stdout", e))?;
+        }
     }
+    // stdout is line-buffered: what is left must reach its reader, or fail here.
+    std::io::stdout()
+        .flush()
+        .map_err(|e| Stop::write("stdout", e))
+}
+
+/// What clap reports instead of arguments: `--help` and `--version` go to
+/// stdout and succeed; usage errors go to stderr with exit status 1 (clap's
+/// own `exit` would use 2).
+fn usage_error(e: clap::Error) -> Result<(), Stop> {
+    if e.use_stderr() {
+        // clap's message already starts with `error:`; whether or not stderr
+        // takes it, the status is 1.
+        let _ = e.print();
+        return Err(Stop::Failed(Vec::new()));
+    }
+    e.print().map_err(|e| Stop::write("stdout", e))?;
+    std::io::stdout()
+        .flush()
+        .map_err(|e| Stop::write("stdout", e))
 }
 
 fn apply_sets(scene: &mut Scene, sets: &[String]) -> Result<(), Error> {
@@ -135,18 +227,26 @@ fn fmt_duration(s: f64) -> String {
     }
 }
 
-fn run(a: RunArgs) -> Result<(), Error> {
+fn run(a: RunArgs) -> Result<(), Stop> {
     let mut scene = match &a.scene_file {
         Some(f) => Scene::from_file(f)?,
         None => Scene::builtin(&a.scene)?,
     };
     apply_sets(&mut scene, &a.set)?;
     let mut sim = Simulation::new(scene)?;
-    if let Some(dir) = &a.vtk_dir {
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let end_time = sim.end_time();
+    // Every output is checked before the run, so that a typo does not cost
+    // the results of a long run.
+    let vtk_times = check_vtk_times(&a.vtk_times, end_time)?;
+    if let Some(path) = &a.json {
+        check_output_file("--json", path)?;
     }
-    let mut vtk_times = a.vtk_times.clone();
-    vtk_times.sort_by(f64::total_cmp);
+    if let Some(path) = &a.csv {
+        check_output_file("--csv", path)?;
+    }
+    if let Some(dir) = &a.vtk_dir {
+        check_output_dir("--vtk-dir", dir, "particles.pvd")?;
+    }
     let mut next_vtk = 0usize;
     // (time, file name) of the snapshots written so far; the collection
     // `particles.pvd` is rewritten after each one, so it is whole even when a
@@ -161,17 +261,19 @@ fn run(a: RunArgs) -> Result<(), Error> {
         }
         Ok(())
     };
+    // The first snapshot failure, reported after the run.
+    let mut vtk_error = None;
     if a.vtk_dir.is_some() && vtk_times.first().is_some_and(|&t| t <= 0.0) {
-        write_vtk(&sim, &mut vtk_written)?;
+        if let Err(e) = write_vtk(&sim, &mut vtk_written) {
+            vtk_error = Some(e);
+        }
         next_vtk = vtk_times.iter().take_while(|&&t| t <= 0.0).count();
     }
 
     let start = Instant::now();
     let show_bar = !a.quiet && std::io::stderr().is_terminal();
     let mut bar: Option<ProgressBar> = None;
-    let end_time = sim.end_time();
     let mut last_draw = Instant::now();
-    let mut vtk_error = None;
     // Snapshots need the state between steps, so the loop is written out here.
     let mut status = Ok(());
     // The whole loop runs on a worker of the thread pool, so a step does not
@@ -184,7 +286,7 @@ fn run(a: RunArgs) -> Result<(), Error> {
             }
             while next_vtk < vtk_times.len() && sim.time() >= vtk_times[next_vtk] {
                 if let Err(e) = write_vtk(&sim, &mut vtk_written) {
-                    vtk_error = Some(e);
+                    vtk_error.get_or_insert(e);
                 }
                 next_vtk += 1;
             }
@@ -217,46 +319,141 @@ fn run(a: RunArgs) -> Result<(), Error> {
         b.finish_and_clear();
     }
     let wall = start.elapsed().as_secs_f64();
+
+    // Every output is written, even when the run stopped early or another
+    // output failed; the failures are reported together at the end.
+    let mut failures = Vec::new();
+    if let Err(e) = status {
+        failures.push(e.to_string());
+    }
+    if let Err(e) = write_vtk(&sim, &mut vtk_written) {
+        vtk_error.get_or_insert(e);
+    }
     if let Some(e) = vtk_error {
-        return Err(e);
+        failures.push(format!("--vtk-dir: {e}"));
     }
-    write_vtk(&sim, &mut vtk_written)?;
-    if let Some(path) = &a.csv {
-        sim.history().write_csv(path)?;
+    if let Some(path) = &a.csv
+        && let Err(e) = sim.history().write_csv(path)
+    {
+        failures.push(format!("--csv: {e}"));
     }
-    let json = observe::final_json(
-        sim.observable_specs(),
-        &sim.observables(),
-        sim.particles(),
-        sim.steps(),
-        sim.time(),
-        wall,
-    );
     if let Some(path) = &a.json {
-        observe::write_json(path, &json)?;
+        let json = observe::final_json(
+            sim.observable_specs(),
+            &sim.observables(),
+            sim.particles(),
+            sim.steps(),
+            sim.time(),
+            wall,
+        );
+        if let Err(e) = observe::write_json(path, &json) {
+            failures.push(format!("--json: {e}"));
+        }
     }
-    if !a.quiet {
-        print_summary(&sim, wall);
-    }
-    status
+    let printed = if a.quiet {
+        Ok(())
+    } else {
+        print_summary(&sim, wall)
+    };
+    outcome(failures, printed)
 }
 
-fn print_summary(sim: &Simulation, wall: f64) {
-    println!("scene: {}", sim.scene().title);
-    println!(
+/// The end of a command that attempted all its outputs: `failures` (one line
+/// each) and the result of printing to stdout. A closed stdout ends quietly
+/// only when nothing else failed.
+fn outcome(mut failures: Vec<String>, printed: Result<(), Stop>) -> Result<(), Stop> {
+    match printed {
+        Err(Stop::Failed(m)) => failures.extend(m),
+        Err(Stop::BrokenPipe) if failures.is_empty() => return Err(Stop::BrokenPipe),
+        _ => {}
+    }
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(Stop::Failed(failures))
+    }
+}
+
+/// The snapshot times of `--vtk-times`, sorted. Each must be finite and
+/// between 0 and the scene's `end_time`: a time outside never comes.
+fn check_vtk_times(times: &[f64], end_time: f64) -> Result<Vec<f64>, Stop> {
+    if let Some(t) = times.iter().find(|t| !(0.0..=end_time).contains(*t)) {
+        return Err(Stop::failed(format!(
+            "--vtk-times: {t:e} s is out of range: allowed [0, {end_time:e}] s \
+             (0 to the scene's end_time)"
+        )));
+    }
+    let mut sorted = times.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    Ok(sorted)
+}
+
+/// Checks before a run that `path`, given to `option`, can be written: its
+/// directory exists and the file opens for writing. Nothing that exists is
+/// changed: an existing file is opened without truncating it, and a file
+/// created for the test is removed again.
+fn check_output_file(option: &str, path: &Path) -> Result<(), Stop> {
+    let fail = |why: String| Stop::failed(format!("{option} {}: {why}", path.display()));
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match std::fs::metadata(dir) {
+        Err(e) if e.kind() == ErrorKind::NotFound => {
+            return Err(fail(format!("directory {} does not exist", dir.display())));
+        }
+        Err(e) => return Err(fail(format!("directory {}: {e}", dir.display()))),
+        Ok(m) if !m.is_dir() => {
+            return Err(fail(format!("{} is not a directory", dir.display())));
+        }
+        Ok(_) => {}
+    }
+    if path.is_dir() {
+        return Err(fail("is a directory".into()));
+    }
+    if path.exists() {
+        OpenOptions::new()
+            .write(true)
+            .open(path)
+            .map_err(|e| fail(e.to_string()))?;
+    } else {
+        File::create_new(path).map_err(|e| fail(e.to_string()))?;
+        std::fs::remove_file(path).map_err(|e| fail(e.to_string()))?;
+    }
+    Ok(())
+}
+
+/// Creates the output directory `dir` of `option` before a run and checks
+/// that `file`, one of the files the run writes there, can be written.
+fn check_output_dir(option: &str, dir: &Path, file: &str) -> Result<(), Stop> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Stop::failed(format!(
+            "{option} {}: cannot create the directory: {e}",
+            dir.display()
+        ))
+    })?;
+    check_output_file(option, &dir.join(file))
+}
+
+fn print_summary(sim: &Simulation, wall: f64) -> Result<(), Stop> {
+    outln!("scene: {}", sim.scene().title)?;
+    outln!(
         "particles {}, steps {}, end time {}, wall time {:.2} s",
         sim.particles(),
         sim.steps(),
         fmt_duration(sim.time()),
         wall
-    );
+    )?;
     if let Some(e) = sim.error() {
-        println!("stopped early: {e}");
+        outln!("stopped early: {e}")?;
     }
-    println!(
+    outln!(
         "{:<24} {:>14} {:>14} {:>9}  unit",
-        "observable", "value", "reference", "error"
-    );
+        "observable",
+        "value",
+        "reference",
+        "error"
+    )?;
     for (s, v) in sim.observable_specs().iter().zip(sim.observables()) {
         let reference = sim.scene().reference.get(s.name).copied();
         let (r, e) = match reference {
@@ -268,47 +465,51 @@ fn print_summary(sim: &Simulation, wall: f64) {
         } else {
             format!("{v:.6}")
         };
-        println!("{:<24} {:>14} {:>14} {:>9}  {}", s.name, val, r, e, s.unit);
+        outln!("{:<24} {:>14} {:>14} {:>9}  {}", s.name, val, r, e, s.unit)?;
     }
+    Ok(())
 }
 
-fn report(out: PathBuf, quick: bool) -> Result<(), Error> {
+fn report(out: PathBuf, quick: bool) -> Result<(), Stop> {
+    check_output_dir("--out", &out, "index.md")?;
     let r = meshless_impact::report::generate(&meshless_impact::report::ReportOptions {
         out: out.clone(),
         quick,
     })?;
-    println!(
+    outln!(
         "report written to {} ({} files, {:.1} s)",
         out.join("index.md").display(),
         r.files.len(),
         r.wall_s
-    );
-    Ok(())
+    )
 }
 
-fn params(scene: &str) -> Result<(), Error> {
+fn params(scene: &str) -> Result<(), Stop> {
     let s = Scene::builtin(scene)?;
-    println!(
+    outln!(
         "{:<24} {:<10} {:>12}  {:<28} meaning",
-        "name", "unit", "default", "allowed"
-    );
+        "name",
+        "unit",
+        "default",
+        "allowed"
+    )?;
     for p in s.param_specs() {
-        println!(
+        outln!(
             "{:<24} {:<10} {:>12}  {:<28} {}",
             p.name,
             p.unit,
             s.get(p.name)?,
             p.range.to_string(),
             p.description
-        );
+        )?;
     }
     Ok(())
 }
 
-fn observables(scene: &str) -> Result<(), Error> {
+fn observables(scene: &str) -> Result<(), Stop> {
     let s = Scene::builtin(scene)?;
     for o in s.kind().observable_specs() {
-        println!("{:<24} {:<6} {}", o.name, o.unit, o.description);
+        outln!("{:<24} {:<6} {}", o.name, o.unit, o.description)?;
     }
     Ok(())
 }
@@ -323,12 +524,13 @@ struct SweepRow {
     result: Result<SweepValues, Error>,
 }
 
-fn sweep(a: SweepArgs) -> Result<(), Error> {
+fn sweep(a: SweepArgs) -> Result<(), Stop> {
     if a.name != "table1" {
         return Err(Error::UnknownScene {
             name: a.name,
             allowed: "table1".into(),
-        });
+        }
+        .into());
     }
     let rows = Table1Row::all();
     let mut scenes = Vec::new();
@@ -337,11 +539,12 @@ fn sweep(a: SweepArgs) -> Result<(), Error> {
         apply_sets(&mut s, &a.set)?;
         scenes.push(s);
     }
+    check_output_file("--out", &a.out)?;
     let start = Instant::now();
-    eprintln!(
+    errln!(
         "running {} Table 1 configurations in parallel...",
         scenes.len()
-    );
+    )?;
     let results: Vec<SweepRow> = rows
         .par_iter()
         .zip(scenes)
@@ -366,37 +569,37 @@ fn sweep(a: SweepArgs) -> Result<(), Error> {
     write_sweep(&a.out, &results, start.elapsed().as_secs_f64())
 }
 
-fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Error> {
-    let mut w = csv::Writer::from_path(out).map_err(|e| Error::io(out, e))?;
-    let header = [
-        "test",
-        "V_mps",
-        "L0_mm",
-        "Lf_sim_mm",
-        "Lf_test_mm",
-        "Lf_msph_mm",
-        "Lf_err_pct",
-        "Lu_sim_mm",
-        "Lu_test_mm",
-        "Lu_msph_mm",
-        "Lu_err_pct",
-        "Df_sim_mm",
-        "Df_test_mm",
-        "Df_msph_mm",
-        "Df_err_pct",
-        "energy_error",
-        "particles",
-        "steps",
-        "wall_s",
-        "error",
-    ];
-    w.write_record(header).map_err(|e| Error::io(out, e))?;
-    println!(
-        "test     V     L0 |     Lf   test   MSPH    err% |     Lu   test   MSPH    err% \
-         |     Df   test   MSPH    err% |  E err  wall s"
-    );
+/// Columns of the sweep's CSV table.
+const SWEEP_HEADER: [&str; 20] = [
+    "test",
+    "V_mps",
+    "L0_mm",
+    "Lf_sim_mm",
+    "Lf_test_mm",
+    "Lf_msph_mm",
+    "Lf_err_pct",
+    "Lu_sim_mm",
+    "Lu_test_mm",
+    "Lu_msph_mm",
+    "Lu_err_pct",
+    "Df_sim_mm",
+    "Df_test_mm",
+    "Df_msph_mm",
+    "Df_err_pct",
+    "energy_error",
+    "particles",
+    "steps",
+    "wall_s",
+    "error",
+];
+
+/// Writes the sweep's results: the CSV table to `out` first, then the table
+/// and the error statistics on stdout (printed even when the CSV failed).
+fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Stop> {
     let pct = |sim: f64, exp: f64| 100.0 * (sim - exp) / exp;
     let (mut lf_err, mut df_err) = (Vec::new(), Vec::new());
+    // CSV records and the lines of the table on stdout.
+    let (mut records, mut lines) = (Vec::new(), Vec::new());
     for r in results {
         let t = &r.row;
         match &r.result {
@@ -421,7 +624,7 @@ fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Error>
                         g[0], g[1], g[2], g[3]
                     );
                 }
-                println!("{line} | {energy:>6.4} {secs:>7.1}");
+                lines.push(format!("{line} | {energy:>6.4} {secs:>7.1}"));
                 let mut rec = vec![
                     t.test.to_string(),
                     t.v.to_string(),
@@ -435,37 +638,72 @@ fn write_sweep(out: &Path, results: &[SweepRow], wall: f64) -> Result<(), Error>
                     secs.to_string(),
                     String::new(),
                 ]);
-                w.write_record(&rec).map_err(|e| Error::io(out, e))?;
+                records.push(rec);
             }
             Err(e) => {
-                println!("{:>4} {:>5} {:>6.2} | failed: {e}", t.test, t.v, t.l0 * 1e3);
-                let mut rec = vec![String::new(); header.len()];
+                lines.push(format!(
+                    "{:>4} {:>5} {:>6.2} | failed: {e}",
+                    t.test,
+                    t.v,
+                    t.l0 * 1e3
+                ));
+                let mut rec = vec![String::new(); SWEEP_HEADER.len()];
                 rec[0] = t.test.to_string();
-                rec[header.len() - 1] = e.to_string();
-                w.write_record(&rec).map_err(|e| Error::io(out, e))?;
+                rec[SWEEP_HEADER.len() - 1] = e.to_string();
+                records.push(rec);
             }
         }
     }
-    w.flush().map_err(|e| Error::io(out, e))?;
-    let stat = |v: &[f64]| {
-        (
-            v.iter().sum::<f64>() / v.len().max(1) as f64,
-            v.iter().copied().fold(0.0, f64::max),
-        )
+    let written = write_csv_records(out, &SWEEP_HEADER, &records);
+
+    let print = || -> Result<(), Stop> {
+        outln!(
+            "test     V     L0 |     Lf   test   MSPH    err% |     Lu   test   MSPH    err% \
+             |     Df   test   MSPH    err% |  E err  wall s"
+        )?;
+        for line in &lines {
+            outln!("{line}")?;
+        }
+        let stat = |v: &[f64]| {
+            (
+                v.iter().sum::<f64>() / v.len().max(1) as f64,
+                v.iter().copied().fold(0.0, f64::max),
+            )
+        };
+        let (lm, lx) = stat(&lf_err);
+        let (dm, dx) = stat(&df_err);
+        outln!(
+            "final length |error|: mean {lm:.2}%, max {lx:.2}% (paper max 4.3%); \
+             impact-face diameter |error|: mean {dm:.2}%, max {dx:.2}% (paper max 9.0%)"
+        )?;
+        if written.is_ok() {
+            outln!("wall time {wall:.1} s; table written to {}", out.display())
+        } else {
+            outln!("wall time {wall:.1} s; table not written")
+        }
     };
-    let (lm, lx) = stat(&lf_err);
-    let (dm, dx) = stat(&df_err);
-    println!(
-        "final length |error|: mean {lm:.2}%, max {lx:.2}% (paper max 4.3%); \
-         impact-face diameter |error|: mean {dm:.2}%, max {dx:.2}% (paper max 9.0%)"
-    );
-    println!("wall time {wall:.1} s; table written to {}", out.display());
+    let printed = print();
+
+    let mut failures = Vec::new();
+    if let Err(e) = written {
+        failures.push(format!("--out: {e}"));
+    }
     if lf_err.len() != results.len() {
-        return Err(Error::Inconsistent(format!(
+        failures.push(format!(
             "{} of {} configurations failed",
             results.len() - lf_err.len(),
             results.len()
-        )));
+        ));
     }
-    Ok(())
+    outcome(failures, printed)
+}
+
+/// Writes a CSV file of `header` and `records`.
+fn write_csv_records(out: &Path, header: &[&str], records: &[Vec<String>]) -> Result<(), Error> {
+    let mut w = csv::Writer::from_path(out).map_err(|e| Error::io(out, e))?;
+    w.write_record(header).map_err(|e| Error::io(out, e))?;
+    for rec in records {
+        w.write_record(rec).map_err(|e| Error::io(out, e))?;
+    }
+    w.flush().map_err(|e| Error::io(out, e))
 }

@@ -1,9 +1,52 @@
 //! The command-line program: errors, outputs and the documented JSON keys.
 
-use std::process::Command;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
+}
+
+/// A short Taylor run: a few milliseconds.
+const SMALL_RUN: [&str; 5] = [
+    "run",
+    "--set",
+    "particles_radial=4",
+    "--set",
+    "end_time=3e-6",
+];
+
+/// A short Table 1 sweep: a fraction of a second.
+const SMALL_SWEEP: [&str; 6] = [
+    "sweep",
+    "table1",
+    "--set",
+    "particles_radial=4",
+    "--set",
+    "end_time=2e-6",
+];
+
+/// A fresh, empty scratch directory for one test.
+fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mi-cli-{}-{test}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts that `out` failed with exit status 1 and an error on stderr that
+/// contains every one of `needles`.
+fn assert_error(out: &Output, needles: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "`{n}` not in: {err}");
+    }
 }
 
 #[test]
@@ -137,4 +180,258 @@ fn params_lists_units_defaults_and_ranges() {
     let out = bin().args(["params", "noh"]).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(!text.contains("jc_a"), "Noh takes no strength parameters");
+}
+
+/// Every subcommand that prints to stdout, with the small run and sweep.
+fn printing_commands(dir: &Path) -> Vec<Vec<String>> {
+    let strings = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let mut sweep = strings(&SMALL_SWEEP);
+    sweep.push("--out".into());
+    sweep.push(dir.join("sweep.csv").display().to_string());
+    vec![
+        strings(&["params", "taylor"]),
+        strings(&["observables", "taylor"]),
+        strings(&["scene", "taylor"]),
+        strings(&SMALL_RUN),
+        sweep,
+        strings(&["--help"]),
+        strings(&["--version"]),
+    ]
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn full_stdout_is_an_error_not_a_panic() {
+    let dir = scratch("full");
+    for args in printing_commands(&dir) {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = bin().args(&args).stdout(full).output().unwrap();
+        assert_error(&out, &["writing to stdout", "No space left on device"]);
+        let err = stderr(&out);
+        assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn closed_stdout_pipe_exits_quietly_with_status_0() {
+    let dir = scratch("pipe");
+    for args in printing_commands(&dir) {
+        // The reader is gone before the program starts, so its first write
+        // meets a closed pipe.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = bin().args(&args).stdout(writer).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+        assert!(
+            !err.contains("panicked") && !err.contains("error"),
+            "{args:?}: {err}"
+        );
+    }
+    // The sweep's table was written before its printing met the closed pipe.
+    let table = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    assert_eq!(table.lines().count(), 13, "{table}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn usage_errors_exit_1_help_and_version_exit_0() {
+    for (args, needle) in [
+        (&["run", "--bogus"][..], "unexpected argument '--bogus'"),
+        (&["run", "--set"][..], "a value is required for '--set"),
+        (&["frobnicate"][..], "unrecognized subcommand 'frobnicate'"),
+        (&["run", "--vtk-times", "abc"][..], "invalid value 'abc'"),
+    ] {
+        let out = bin().args(args).output().unwrap();
+        assert_error(&out, &[needle]);
+    }
+    for (args, needle) in [
+        (&["--help"][..], "Usage:"),
+        (&["run", "--help"][..], "--vtk-times"),
+        (&["--version"][..], env!("CARGO_PKG_VERSION")),
+    ] {
+        let out = bin().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains(needle),
+            "{args:?}"
+        );
+    }
+}
+
+#[test]
+fn output_paths_are_checked_before_the_run() {
+    let dir = scratch("paths");
+    let missing = dir.join("missing");
+    let a_file = dir.join("a_file");
+    std::fs::write(&a_file, "keep me").unwrap();
+    let csv = dir.join("hist.csv");
+    let json = dir.join("out.json");
+    let vtk = dir.join("vtk");
+    let cases: [(&str, PathBuf, &str); 5] = [
+        ("--json", missing.join("out.json"), "does not exist"),
+        ("--json", dir.clone(), "is a directory"),
+        ("--csv", a_file.join("hist.csv"), "is not a directory"),
+        ("--vtk-dir", a_file.clone(), "cannot create the directory"),
+        (
+            "--vtk-dir",
+            a_file.join("vtk"),
+            "cannot create the directory",
+        ),
+    ];
+    for (option, path, why) in &cases {
+        // The other outputs are good: with the check after the run they
+        // would be written before the bad one failed.
+        let mut cmd = bin();
+        cmd.args(SMALL_RUN).arg("-q").arg(option).arg(path);
+        for (other, good) in [("--json", &json), ("--csv", &csv), ("--vtk-dir", &vtk)] {
+            if other != *option {
+                cmd.arg(other).arg(good);
+            }
+        }
+        let out = cmd.output().unwrap();
+        let named = format!("{option} {}: ", path.display());
+        assert_error(&out, &[&named, why]);
+        assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
+        for good in [&json, &csv, &vtk] {
+            assert!(!good.exists(), "{option}: {} was written", good.display());
+        }
+    }
+    // The test of a good path neither changes an existing file nor leaves a new one.
+    std::fs::write(&json, "old results").unwrap();
+    let out = bin()
+        .args(SMALL_RUN)
+        .arg("--json")
+        .arg(&json)
+        .arg("--csv")
+        .arg(missing.join("hist.csv"))
+        .output()
+        .unwrap();
+    assert_error(&out, &["--csv"]);
+    assert_eq!(std::fs::read_to_string(&json).unwrap(), "old results");
+    std::fs::remove_file(&json).unwrap();
+    let out = bin()
+        .args(SMALL_RUN)
+        .arg("--json")
+        .arg(&json)
+        .args(["--set", "impact_speed=-1"])
+        .output()
+        .unwrap();
+    assert_error(&out, &["impact_speed"]);
+    let out = bin()
+        .args(SMALL_RUN)
+        .arg("--csv")
+        .arg(&csv)
+        .arg("--json")
+        .arg(missing.join("out.json"))
+        .output()
+        .unwrap();
+    assert_error(&out, &["--json"]);
+    assert!(!json.exists() && !csv.exists());
+    assert_eq!(std::fs::read_to_string(&a_file).unwrap(), "keep me");
+
+    // The sweep and the report check their --out before they start.
+    let bad = missing.join("sweep.csv");
+    let out = bin()
+        .args(SMALL_SWEEP)
+        .arg("--out")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_error(
+        &out,
+        &[&format!("--out {}: ", bad.display()), "does not exist"],
+    );
+    assert!(!stderr(&out).contains("running"), "{}", stderr(&out));
+    let bad = a_file.join("report");
+    let out = bin()
+        .args(["report", "--quick", "--out"])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_error(&out, &[&format!("--out {}: ", bad.display())]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn an_output_failing_at_the_end_is_named_and_the_others_are_written() {
+    let dir = scratch("late");
+    let csv = dir.join("hist.csv");
+    let vtk = dir.join("vtk");
+    // /dev/full passes the check (it opens for writing) and fails the write.
+    let out = bin()
+        .args(SMALL_RUN)
+        .args(["--json", "/dev/full", "--csv"])
+        .arg(&csv)
+        .arg("--vtk-dir")
+        .arg(&vtk)
+        .output()
+        .unwrap();
+    assert_error(&out, &["--json", "/dev/full", "No space left on device"]);
+    assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("rod_length"));
+    assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 10);
+    assert!(vtk.join("particles_0000.vtu").is_file());
+    assert!(vtk.join("particles.pvd").is_file());
+
+    // The sweep prints its table when its CSV cannot be written.
+    let out = bin()
+        .args(SMALL_SWEEP)
+        .args(["--out", "/dev/full"])
+        .output()
+        .unwrap();
+    assert_error(&out, &["--out", "/dev/full", "No space left on device"]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("final length |error|"), "{table}");
+    assert!(table.contains("table not written"), "{table}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn vtk_times_outside_the_run_are_refused() {
+    let dir = scratch("times");
+    let vtk = dir.join("vtk");
+    for (times, value) in [
+        ("-1e-6", "-1e-6"),
+        ("-1", "-1e0"),
+        ("1e-6,-0.5", "-5e-1"),
+        ("nan", "NaN"),
+        ("inf", "inf"),
+        ("-inf", "-inf"),
+        ("4e-6", "4e-6"),
+        ("1e-6,1", "1e0"),
+    ] {
+        let out = bin()
+            .args(SMALL_RUN)
+            .arg("--vtk-dir")
+            .arg(&vtk)
+            .args(["--vtk-times", times])
+            .output()
+            .unwrap();
+        assert_error(
+            &out,
+            &[
+                &format!("--vtk-times: {value} s is out of range"),
+                "allowed [0, 3e-6] s",
+            ],
+        );
+        assert!(!vtk.exists(), "{times}: a snapshot was written");
+    }
+    // The ends of the range are times of the run.
+    let out = bin()
+        .args(SMALL_RUN)
+        .arg("-q")
+        .arg("--vtk-dir")
+        .arg(&vtk)
+        .args(["--vtk-times", "0,3e-6"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(vtk.join("particles_0002.vtu").is_file());
+    std::fs::remove_dir_all(&dir).ok();
 }
