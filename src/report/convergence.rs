@@ -95,7 +95,7 @@ fn local_orders(resolution: &[f64], error: &[f64]) -> Vec<String> {
 pub(super) fn noh(plan: &Plan, doc: &mut Doc) -> Result<(Vec<NohPoint>, f64)> {
     let mut points = Vec::new();
     for &n in &plan.noh {
-        eprintln!("report: Noh, {n} particles");
+        super::progress!("report: Noh, {n} particles");
         let run = run_case(
             scene("noh", &[("particles_radial", n as f64)]),
             &Probe::default(),
@@ -221,7 +221,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
     let mut figure_run = None;
     let reference = crate::Scene::builtin("taylor")?.reference;
     for &n in &plan.taylor {
-        eprintln!("report: Taylor test 7, {n} particles across the radius");
+        super::progress!("report: Taylor test 7, {n} particles across the radius");
         let run = run_case(scene("taylor", &[("particles_radial", n as f64)]), &probe);
         points.push(TaylorPoint {
             across: n,

@@ -132,6 +132,16 @@ impl Table {
     }
 }
 
+/// Writes one progress line to stderr. A closed or full stderr loses the
+/// line and nothing else: progress never stops or panics a report.
+macro_rules! progress {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+pub(crate) use progress;
+
 /// Formats a number with `d` significant digits (scientific when very small or large).
 pub(crate) fn sig(v: f64, d: usize) -> String {
     if !v.is_finite() {

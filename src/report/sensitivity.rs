@@ -25,7 +25,7 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
         .map(|&v| ("smoothing_ratio", v))
         .chain(COEFFICIENTS.iter().map(|&v| ("smoothing_coefficient", v)))
         .collect();
-    eprintln!("report: {} smoothing cases in parallel", cases.len());
+    super::progress!("report: {} smoothing cases in parallel", cases.len());
     let runs = run_parallel(
         cases
             .iter()
@@ -128,7 +128,7 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
 pub(super) fn table1(plan: &Plan, doc: &mut Doc) -> Result<()> {
     let n = plan.resolution;
     let rows = Table1Row::all();
-    eprintln!("report: Table 1, {} tests in parallel", rows.len());
+    super::progress!("report: Table 1, {} tests in parallel", rows.len());
     let runs = run_parallel(
         rows.iter()
             .map(|r| {

@@ -179,7 +179,7 @@ fn setup_text(d: &Def) -> String {
 
 pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
     let defs = cases(plan);
-    eprintln!("report: stability matrix, {} cases in parallel", defs.len());
+    super::progress!("report: stability matrix, {} cases in parallel", defs.len());
     let runs = run_parallel(
         defs.iter().map(|d| scene(d.scene, &d.sets)).collect(),
         plan.wall_budget,
