@@ -707,6 +707,51 @@ fn invalid_inputs_are_refused_with_named_codes() {
     );
 }
 
+/// `mi_sim_new` takes only the documented scene names, spelled exactly:
+/// near misses get `MI_UNKNOWN_SCENE` ("unknown scene name") and no handle;
+/// every documented name gives the Rust API's scene.
+#[test]
+fn only_the_documented_scene_names_are_accepted() {
+    use mi_result::*;
+    for name in [
+        "table1-01",
+        "table1-+1",
+        "table1-0",
+        "table1-13",
+        "table1- 1",
+        "TAYLOR",
+    ] {
+        let mut p = null_mut();
+        // SAFETY: valid string and out pointer.
+        let r = unsafe { mi_sim_new(c(name).as_ptr(), &mut p) };
+        assert_eq!(r, MI_UNKNOWN_SCENE, "`{name}`");
+        assert!(p.is_null(), "`{name}`: no handle on failure");
+        // SAFETY: static NUL-terminated strings.
+        let (n, d) = unsafe {
+            (
+                CStr::from_ptr(mi_result_name(r as i32)),
+                CStr::from_ptr(mi_result_description(r as i32)),
+            )
+        };
+        assert_eq!(n.to_str().unwrap(), "MI_UNKNOWN_SCENE");
+        assert_eq!(d.to_str().unwrap(), "unknown scene name");
+    }
+    let names = meshless_impact::scene::builtin_names();
+    assert_eq!(names.len(), 14);
+    assert_eq!(names[13], "table1-12");
+    for name in &names {
+        let s = new_sim(name);
+        let scene = Scene::builtin(name).unwrap();
+        for spec in scene.param_specs() {
+            let mut v = f64::NAN;
+            // SAFETY: live handle, valid string and out pointer.
+            let r = unsafe { mi_sim_get_param(s.0, c(spec.name).as_ptr(), &mut v) };
+            assert_eq!(r, MI_OK, "{name}: {}", spec.name);
+            assert_eq!(v.to_bits(), scene.get(spec.name).unwrap().to_bits());
+        }
+    }
+}
+
 /// A scene from TOML text equals the built-in scene with the same
 /// parameters, and `mi_sim_load_toml` reports a parse error with its message.
 #[test]

@@ -158,7 +158,8 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
     })
 }
 
-/// `fmi2SetupExperiment`: records the start time.
+/// `fmi2SetupExperiment`: records the start time and, if defined, the stop
+/// time (a later `fmi2DoStep` past it returns `fmi2Error`).
 ///
 /// # Safety
 /// A live instance.
@@ -596,7 +597,8 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
 
 /// `fmi2DoStep`: advances to `currentCommunicationPoint +
 /// communicationStepSize`; `fmi2Discard` when the run ends (rod at rest or
-/// end_time) during the step or has already ended.
+/// end_time) during the step or has already ended; `fmi2Error` when the step
+/// would end past a defined stopTime.
 ///
 /// # Safety
 /// A live instance.

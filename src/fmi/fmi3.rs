@@ -667,7 +667,8 @@ unsupported_fns! {
 }
 
 /// `fmi3DoStep`: advances to `currentCommunicationPoint +
-/// communicationStepSize`, taking as many solver steps as needed.
+/// communicationStepSize`, taking as many solver steps as needed;
+/// `fmi3Error` when the step would end past a defined stopTime.
 ///
 /// # Safety
 /// FMI 3.0 contract: a live instance; the output pointers writable.

@@ -313,7 +313,7 @@ pub(crate) struct Instance {
     sim: Option<Simulation>,
     /// Start time given by the host; simulated time 0 corresponds to it.
     pub start_time: f64,
-    /// Stop time given by the host, if any.
+    /// Stop time given by the host, if any; doStep refuses to go past it.
     pub stop_time: Option<f64>,
     /// Current communication point (host time).
     time: f64,
@@ -613,6 +613,16 @@ impl Instance {
             )));
         }
         let target = current + h;
+        // FMI 2.0 (fmi2SetupExperiment) and FMI 3.0
+        // (fmi3EnterInitializationMode): computing past a defined stopTime
+        // is an error. Rounding slack: 1e-9 of |stopTime| + step size.
+        if let Some(stop) = self.stop_time
+            && target > stop + 1e-9 * (stop.abs() + h)
+        {
+            return Err(self.fail(&format!(
+                "{function}: the step would end at t = {target} s (currentCommunicationPoint = {current} s + communicationStepSize = {h} s), past stopTime = {stop} s"
+            )));
+        }
         if self.at_end {
             // The rod is at rest (or end_time passed): outputs hold.
             self.time = target;
@@ -890,6 +900,45 @@ mod tests {
             Status::Error
         );
         assert_eq!(inst.state, TERMINATED);
+    }
+
+    #[test]
+    fn step_past_stop_time_is_an_error() {
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        let start = |stop: Option<f64>| {
+            let mut inst = Instance::new(Standard::Fmi2, "t", LogSink::None, false);
+            inst.set("fmi2SetInteger", &[pr], &[4.0], VarType::Int32);
+            inst.stop_time = stop;
+            assert_eq!(inst.enter_initialization_mode(0.0), Status::Ok);
+            assert_eq!(inst.exit_initialization_mode(), Status::Ok);
+            inst
+        };
+        // Six steps of 0.3 us end one ulp past 1.8 us: rounding, accepted.
+        let mut inst = start(Some(1.8e-6));
+        let mut t = 0.0;
+        for _ in 0..6 {
+            inst.do_step("doStep", t, 3e-7).unwrap();
+            t += 3e-7;
+        }
+        assert!(t > 1.8e-6, "the sum overshoots, so the tolerance is used");
+        assert_eq!(inst.state, STEP_MODE);
+        // One more step goes past stopTime.
+        assert_eq!(inst.do_step("doStep", t, 3e-7).unwrap_err(), Status::Error);
+        assert_eq!(inst.state, TERMINATED);
+        // A single step just past it (1e-6 of stopTime), from the start.
+        let mut inst = start(Some(1.8e-6));
+        assert_eq!(
+            inst.do_step("doStep", 0.0, 1.8e-6 * (1.0 + 1e-6))
+                .unwrap_err(),
+            Status::Error
+        );
+        // Without a stop time the same step is fine.
+        let mut inst = start(None);
+        assert!(inst.do_step("doStep", 0.0, 1.8e-6 * (1.0 + 1e-6)).is_ok());
     }
 
     #[test]

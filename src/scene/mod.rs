@@ -112,15 +112,16 @@ impl Scene {
     }
 
     /// A built-in scene by name: `taylor`, `noh`, or `table1-N` for the N-th
-    /// configuration of Table 1 (N = 1..12).
+    /// configuration of Table 1 (N = 1..12). Only these exact names are
+    /// accepted (no other case, sign, leading zero or spaces).
     pub fn builtin(name: &str) -> Result<Scene> {
         match name {
             "taylor" => Ok(Scene::default_of(SceneKind::Taylor)),
             "noh" => Ok(Scene::default_of(SceneKind::Noh)),
-            _ => name
-                .strip_prefix("table1-")
-                .and_then(|k| k.parse::<usize>().ok())
-                .filter(|k| (1..=12).contains(k))
+            // Compared with the spelled-out names, not parsed as a number,
+            // so `table1-01` or `table1-+1` are not taken for `table1-1`.
+            _ => (1..=12)
+                .find(|k| name == format!("table1-{k}"))
                 .map(|k| table1::Table1Row::all()[k - 1].scene())
                 .ok_or_else(|| Error::UnknownScene {
                     name: name.to_string(),
@@ -340,5 +341,45 @@ mod tests {
             Scene::builtin("table1-13"),
             Err(Error::UnknownScene { .. })
         ));
+    }
+
+    #[test]
+    fn builtin_accepts_only_the_exact_names() {
+        for name in [
+            "table1-01",
+            "table1-+1",
+            "table1-0",
+            "table1-13",
+            "table1- 1",
+            "table1-1 ",
+            "TAYLOR",
+            "Noh",
+            "table1-",
+            "",
+        ] {
+            match Scene::builtin(name) {
+                Err(e @ Error::UnknownScene { .. }) => {
+                    let msg = e.to_string();
+                    assert!(
+                        msg.starts_with(&format!(
+                            "unknown scene `{name}`; allowed: taylor, noh, table1-1,"
+                        )),
+                        "{msg}"
+                    );
+                    assert!(msg.ends_with("table1-12"), "{msg}");
+                }
+                other => panic!("`{name}` accepted or refused oddly: {other:?}"),
+            }
+        }
+        let rows = table1::Table1Row::all();
+        for (k, name) in builtin_names().iter().enumerate() {
+            let scene = Scene::builtin(name).unwrap();
+            match k {
+                0 => assert_eq!(scene, Scene::default_of(SceneKind::Taylor)),
+                1 => assert_eq!(scene, Scene::default_of(SceneKind::Noh)),
+                _ => assert_eq!(scene, rows[k - 2].scene(), "{name}"),
+            }
+        }
+        assert_eq!(builtin_names().len(), 14);
     }
 }

@@ -306,6 +306,58 @@ def test_wrong_time_and_nonpositive_step_are_refused(fmu3, fmu2):
     s.freeInstance()
 
 
+@pytest.mark.parametrize("which", ["fmu3", "fmu2"])
+def test_step_past_stop_time_is_an_error(which, request):
+    """FMI 2.0 (fmi2SetupExperiment) and FMI 3.0 (fmi3EnterInitializationMode):
+    with a stop time defined, a doStep that would end past it returns Error;
+    one that ends on it up to rounding (1e-9 of |stopTime| + step) is fine."""
+    m = request.getfixturevalue(which)
+
+    def start(stop_time):
+        if which == "fmu3":
+            s = slave3(m)
+            set_params(s, m, {"particles_radial": COARSE})
+            s.enterInitializationMode(startTime=0.0, stopTime=stop_time)
+        else:
+            s = slave2(m)
+            set_params(s, m, {"particles_radial": COARSE})
+            s.setupExperiment(startTime=0.0, stopTime=stop_time)
+            s.enterInitializationMode()
+        s.exitInitializationMode()
+        return s
+
+    # Six steps of 0.3 us, summed as a host does, end one ulp past 1.8 us.
+    s = start(1.8e-6)
+    t, h = 0.0, 3e-7
+    for _ in range(6):
+        s.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        t += h
+    assert t > 1.8e-6
+    # One step more ends past stopTime.
+    MESSAGES.clear()
+    with pytest.raises(FMICallException) as e:
+        s.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+    assert e.value.status == 3
+    fn = "fmi3DoStep" if which == "fmu3" else "fmi2DoStep"
+    assert any(x.startswith(f"{fn}: the step would end at t = 0.0000021") and "past stopTime = 0.0000018 s" in x
+               for x in messages("logStatusError")), MESSAGES
+    # Error leads to Terminated.
+    with pytest.raises(FMICallException):
+        s.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+    assert any("not allowed in state Terminated" in x for x in messages("logStatusError")), MESSAGES
+    s.freeInstance()
+    # A single step just past stopTime (by 1e-6 of it) is refused too ...
+    s = start(1.8e-6)
+    with pytest.raises(FMICallException) as e:
+        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=1.8e-6 * (1 + 1e-6))
+    assert e.value.status == 3
+    s.freeInstance()
+    # ... and allowed when no stop time was given.
+    s = start(None)
+    s.doStep(currentCommunicationPoint=0.0, communicationStepSize=1.8e-6 * (1 + 1e-6))
+    s.freeInstance()
+
+
 def test_two_interleaved_instances_equal_two_separate_runs(fmu3, tmp_path_factory):
     a = init3(fmu3, {"particles_radial": COARSE}, name="a")
     b = init3(fmu3, {"particles_radial": COARSE, "impact_speed": 250.0}, name="b")
