@@ -242,8 +242,10 @@ impl Simulation {
             (Solver::Noh(a), Solver::Noh(b)) => a.check_restored(b)?,
             _ => return Err("its solver is not its scene's".into()),
         }
+        // After every record the next one is due within one interval.
+        let t = self.time();
         if self.record_interval.to_bits() != fresh.record_interval.to_bits()
-            || !self.next_record.is_finite()
+            || !(self.next_record > t && self.next_record <= t + 1.5 * self.record_interval)
         {
             return Err("its record times do not follow from its scene".into());
         }

@@ -56,7 +56,7 @@ fn an_unedited_state_is_accepted_and_resumes() {
 fn forged_taylor_states_are_refused() {
     let (_, base) = saved("taylor", &[("particles_radial", 5.0)], 5e-6);
     type Edit = fn(&mut Value);
-    let edits: [(&str, Edit, &str); 11] = [
+    let edits: [(&str, Edit, &str); 12] = [
         (
             "scene parameter out of range",
             |s| s["scene"]["params"]["Taylor"]["density"] = json!(-5.0),
@@ -107,6 +107,11 @@ fn forged_taylor_states_are_refused() {
         (
             "a record interval of zero (the hang)",
             |s| s["record_interval"] = json!(0.0),
+            "record",
+        ),
+        (
+            "the next record far in the past (the record loop would not end)",
+            |s| s["next_record"] = json!(-985633.9),
             "record",
         ),
         (

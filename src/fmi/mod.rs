@@ -746,6 +746,20 @@ impl Saved {
         if saved.state & ANY_STATE == 0 || saved.state.count_ones() != 1 {
             return Err("invalid serialized state: unknown instance state".into());
         }
+        // Checked as a new instance's values and run are: a forged state is
+        // refused here, not found out by a later step.
+        saved
+            .scene
+            .validate()
+            .map_err(|e| format!("invalid serialized state: its parameters: {e}"))?;
+        let times = [saved.start_time, saved.time, saved.last_successful_time];
+        if !times.iter().all(|t| t.is_finite()) || saved.time < saved.start_time {
+            return Err("invalid serialized state: its communication times are not valid".into());
+        }
+        if let Some(sim) = &saved.sim {
+            sim.check_restored()
+                .map_err(|e| format!("invalid serialized state: {e}"))?;
+        }
         Ok(saved)
     }
 }

@@ -5,6 +5,7 @@ Reference values come from the command-line program on the same scene
 observables must be bit-identical. Everything except the one equality check at
 the defaults runs at particles_radial = 6 (see conftest.COARSE)."""
 
+import json
 import subprocess
 import sys
 import threading
@@ -476,6 +477,49 @@ def test_fmu_state_rolls_back_a_step_exactly_fmi2(fmu2):
     s.setFMUstate(s.deSerializeFMUstate(data))
     s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
     assert outputs(s, fmu2) == after
+    s.freeInstance()
+
+
+def _forge(data, edit):
+    """A serialized FMU state with its JSON part edited by `edit`."""
+    raw = bytes(data)
+    magic_end = raw.index(b"\n") + 1
+    token_end = raw.index(b"\n", magic_end) + 1
+    state = json.loads(raw[token_end:])
+    edit(state)
+    return raw[:token_end] + json.dumps(state).encode()
+
+
+def test_forged_fmu_states_are_refused(fmu3):
+    s = init3(fmu3, {"particles_radial": COARSE})
+    for n in range(3):
+        s.doStep(currentCommunicationPoint=n * 1e-6, communicationStepSize=1e-6)
+    state = s.getFMUState()
+    data = s.serializeFMUState(state)
+
+    def density(st):
+        st["scene"]["params"]["Taylor"]["density"] = -5.0
+
+    def mass(st):
+        st["sim"]["solver"]["Taylor"]["mass"][0] = 1.0
+
+    def cut(st):
+        st["sim"]["solver"]["Taylor"]["vel"].pop()
+
+    def interval(st):
+        st["sim"]["record_interval"] = 0.0
+
+    for edit in (density, mass, cut, interval):
+        t = slave3(fmu3, name="forged")
+        with pytest.raises(FMICallException) as e:
+            t.deserializeFMUState(_forge(data, edit))
+        assert e.value.status == 3, edit.__name__
+        t.freeInstance()
+    # The unedited bytes still load.
+    t = slave3(fmu3, name="honest")
+    t.setFMUState(t.deserializeFMUState(_forge(data, lambda st: None)))
+    t.freeInstance()
+    s.freeFMUState(state)
     s.freeInstance()
 
 
