@@ -162,6 +162,9 @@ struct Cells<'a> {
     r2: f64,
 }
 
+/// Most cells in the grid (4 Mi: 32 MiB of cell starts).
+const MAX_CELLS: f64 = 4_194_304.0;
+
 impl<'a> Cells<'a> {
     /// The grid, or `None` for no points.
     fn new(points: &'a [[f64; 2]], radius: f64) -> Option<Self> {
@@ -175,7 +178,16 @@ impl<'a> Cells<'a> {
                 hi[d] = hi[d].max(p[d]);
             }
         }
-        let cell = radius.max(f64::MIN_POSITIVE);
+        // Cells no smaller than the radius (so the 3 x 3 block around a
+        // point holds all its neighbours), and no more than MAX_CELLS in
+        // all: one particle flung far away makes the cells coarser (more
+        // candidates), not the grid too large to allocate. At most about a
+        // thousand doublings, from the smallest positive radius to 1e308.
+        let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
+        let mut cell = radius.max(f64::MIN_POSITIVE);
+        while (w / cell + 1.0) * (h / cell + 1.0) > MAX_CELLS {
+            cell *= 2.0;
+        }
         let dims = [
             (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1),
             (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1),
@@ -287,6 +299,17 @@ mod tests {
         let nl = cell_list(&p, 0.035);
         assert_eq!(nl, naive(&p, 0.035));
         assert_eq!(nl.of(50), &[47, 48, 49, 50, 51, 52, 53]);
+    }
+
+    #[test]
+    fn a_point_flung_far_away_coarsens_the_grid_and_the_lists_stay_exact() {
+        // At the radius the grid would need 1e22 cells; capped, it is
+        // coarser and the lists still equal the oracle's.
+        let mut p = points(200, 7);
+        p.push([1e8, -1e8]);
+        p.push([f64::MAX / 4.0, 0.0]);
+        let nl = cell_list(&p, 0.05);
+        assert_eq!(nl, naive(&p, 0.05));
     }
 
     #[test]

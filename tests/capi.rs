@@ -449,6 +449,65 @@ fn run_code(scene: &str, set: &[(&str, f64)]) -> (mi_result, String) {
     (r, s.error())
 }
 
+/// A forged state (a parameter out of its range, the solver's own copy
+/// edited, a particle removed) is refused with `MI_INVALID_STATE` and a
+/// message saying what is wrong, and the handle keeps its run.
+#[test]
+fn forged_states_are_refused_and_the_handle_keeps_its_run() {
+    let s = new_sim("taylor");
+    s.set("particles_radial", 5.0);
+    let mut n = 0usize;
+    // SAFETY: live handles; buffers of the queried size.
+    unsafe {
+        assert_eq!(mi_sim_advance_to(s.0, 1e-6), mi_result::MI_OK);
+        mi_sim_state_save(s.0, null_mut(), 0, &mut n);
+        let mut bytes = vec![0u8; n];
+        mi_sim_state_save(s.0, bytes.as_mut_ptr(), n, null_mut());
+        let base: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        type Forgery = (fn(&mut serde_json::Value), &'static str);
+        let forgeries: [Forgery; 3] = [
+            (
+                |j| j["scene"]["params"]["Taylor"]["density"] = (-5.0).into(),
+                "density",
+            ),
+            (
+                |j| j["solver"]["Taylor"]["p"]["density"] = 8000.0.into(),
+                "parameters",
+            ),
+            (
+                |j| {
+                    j["solver"]["Taylor"]["pos"].as_array_mut().unwrap().pop();
+                },
+                "positions",
+            ),
+        ];
+        let t = new_sim("taylor");
+        t.set("particles_radial", 5.0);
+        let before = mi_sim_steps_of(&t);
+        for (edit, says) in forgeries {
+            let mut j = base.clone();
+            edit(&mut j);
+            let forged = serde_json::to_vec(&j).unwrap();
+            assert_eq!(
+                mi_sim_state_load(t.0, forged.as_ptr(), forged.len()),
+                mi_result::MI_INVALID_STATE
+            );
+            let msg = t.error();
+            assert!(msg.contains(says), "{msg}");
+        }
+        assert_eq!(mi_sim_steps_of(&t), before);
+        assert_eq!(t.run(), mi_result::MI_OK);
+    }
+}
+
+/// Steps taken by a handle.
+fn mi_sim_steps_of(s: &Sim) -> u64 {
+    let mut n = 0u64;
+    // SAFETY: live handle, valid out pointer.
+    assert_eq!(unsafe { mi_sim_steps(s.0, &mut n) }, mi_result::MI_OK);
+    n
+}
+
 /// A saved state whose `vel[particle][component]` is replaced by `value`,
 /// loaded into a fresh handle: the solver's own checks then stop the next step.
 fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_result, String) {
