@@ -454,16 +454,9 @@ fn run_code(scene: &str, set: &[(&str, f64)]) -> (mi_result, String) {
 /// message saying what is wrong, and the handle keeps its run.
 #[test]
 fn forged_states_are_refused_and_the_handle_keeps_its_run() {
-    let s = new_sim("taylor");
-    s.set("particles_radial", 5.0);
-    let mut n = 0usize;
-    // SAFETY: live handles; buffers of the queried size.
+    let base = coarse_state_at_1us();
+    // SAFETY: live handles; buffers of the right length.
     unsafe {
-        assert_eq!(mi_sim_advance_to(s.0, 1e-6), mi_result::MI_OK);
-        mi_sim_state_save(s.0, null_mut(), 0, &mut n);
-        let mut bytes = vec![0u8; n];
-        mi_sim_state_save(s.0, bytes.as_mut_ptr(), n, null_mut());
-        let base: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
         type Forgery = (fn(&mut serde_json::Value), &'static str);
         let forgeries: [Forgery; 3] = [
             (
@@ -508,13 +501,13 @@ fn mi_sim_steps_of(s: &Sim) -> u64 {
     n
 }
 
-/// A saved state whose `vel[particle][component]` is replaced by `value`,
-/// loaded into a fresh handle: the solver's own checks then stop the next step.
-fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_result, String) {
+/// The saved state, as JSON, of test 7 at 5 particles across advanced to
+/// 1 us through the C ABI.
+fn coarse_state_at_1us() -> serde_json::Value {
     let s = new_sim("taylor");
     s.set("particles_radial", 5.0);
     let mut n = 0usize;
-    // SAFETY: live handle; buffers of the queried size.
+    // SAFETY: live handle; a buffer of the queried size.
     unsafe {
         assert_eq!(mi_sim_advance_to(s.0, 1e-6), mi_result::MI_OK);
         mi_sim_state_save(s.0, null_mut(), 0, &mut n);
@@ -523,7 +516,16 @@ fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_resu
             mi_sim_state_save(s.0, bytes.as_mut_ptr(), n, null_mut()),
             mi_result::MI_OK
         );
-        let mut json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        serde_json::from_slice(&bytes).unwrap()
+    }
+}
+
+/// A saved state whose `vel[particle][component]` is replaced by `value`,
+/// loaded into a fresh handle: the solver's own checks then stop the next step.
+fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_result, String) {
+    let mut json = coarse_state_at_1us();
+    // SAFETY: live handle; buffers of the right length.
+    unsafe {
         json["solver"]["Taylor"]["vel"][particle][component] = value.into();
         let bytes = serde_json::to_vec(&json).unwrap();
         let t = new_sim("taylor");
