@@ -25,6 +25,7 @@ pub mod capi;
 pub mod error;
 #[allow(unsafe_code)]
 pub mod fmi;
+pub mod isa;
 pub mod kernel;
 pub mod lanes;
 pub mod material;
@@ -37,6 +38,7 @@ mod sim;
 pub mod solver;
 
 pub use error::{Error, Result};
+pub use isa::Isa;
 pub use observe::{Field, History, NOH_OBSERVABLES, ObservableSpec, Snapshot, TAYLOR_OBSERVABLES};
 pub use scene::params::{ParamSpec, Range};
 pub use scene::table1::Table1Row;

@@ -2,7 +2,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use meshless_impact::{Error, Scene, Simulation, Table1Row, observe};
+use meshless_impact::{Error, Isa, Scene, Simulation, Table1Row, observe};
 use rayon::prelude::*;
 use std::fs::{File, OpenOptions};
 use std::io::{ErrorKind, IsTerminal, Write};
@@ -87,6 +87,11 @@ struct RunArgs {
         allow_hyphen_values = true
     )]
     vtk_times: Vec<f64>,
+    /// Compiled copy of the hot loops: avx512, avx2+fma or baseline (default:
+    /// the best this processor runs). Every copy gives the same bits; this is
+    /// for measuring them.
+    #[arg(long, value_name = "COPY")]
+    isa: Option<String>,
     /// No progress bar and no table on stdout (errors are still reported).
     #[arg(long, short)]
     quiet: bool,
@@ -234,6 +239,9 @@ fn run(a: RunArgs) -> Result<(), Stop> {
     };
     apply_sets(&mut scene, &a.set)?;
     let mut sim = Simulation::new(scene)?;
+    if let Some(name) = &a.isa {
+        sim.set_isa(Isa::named(name).map_err(|e| Stop::failed(format!("--isa: {e}")))?);
+    }
     let end_time = sim.end_time();
     // Every output is checked before the run, so that a typo does not cost
     // the results of a long run.

@@ -11,9 +11,9 @@
 //! of order one whatever the units; the kernel's normalising constant cancels.
 //! A particle (a ring in the axisymmetric case) weighs `V_j = m_j / rho_j`.
 
+use crate::isa::{Isa, hot};
 use crate::kernel::{EXP_M4, SUPPORT};
 use crate::lanes::{Lanes, W};
-use multiversion::multiversion;
 
 /// Largest 1-norm condition number of a scaled moment matrix that is accepted.
 /// Beyond it the particle arrangement cannot support a second-order
@@ -436,7 +436,7 @@ impl Neighbourhood {
     /// order ([`W`] lane partial sums, then [`crate::lanes::total`]), so the
     /// result does not depend on the thread or the instruction set.
     pub fn power_sums(&mut self) -> [f64; POWER_SUMS] {
-        power_sums_of(self)
+        power_sums_of(Isa::best(), self)
     }
 
     /// The [`W`] lane partial sums of each power sum (see
@@ -502,7 +502,7 @@ impl Neighbourhood {
         out: [&mut [f64]; K],
         kernel: &mut [f64],
     ) {
-        weights_with(self, rows, out, kernel);
+        weights_with(Isa::best(), self, rows, out, kernel);
     }
 
     /// [`Neighbourhood::weights`] for rows of the inverse moment matrix
@@ -556,10 +556,10 @@ impl Neighbourhood {
     }
 }
 
-/// [`Neighbourhood::power_sums`], compiled for the instruction sets with
-/// fused multiply-adds and chosen at run time (the baseline compiles them
-/// in software: the same bits, several times slower).
-#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+hot! {
+/// [`Neighbourhood::power_sums`], compiled for each instruction set (the
+/// baseline computes the fused multiply-adds in software: the same bits,
+/// several times slower).
 fn power_sums_of(hood: &mut Neighbourhood) -> [f64; POWER_SUMS] {
     let partials = hood.power_partials();
     let mut out = [0.0; POWER_SUMS];
@@ -568,9 +568,10 @@ fn power_sums_of(hood: &mut Neighbourhood) -> [f64; POWER_SUMS] {
     }
     out
 }
+}
 
-/// [`Neighbourhood::weights`], chosen at run time like [`power_sums_of`].
-#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+hot! {
+/// [`Neighbourhood::weights`], compiled like [`power_sums_of`].
 fn weights_with<const K: usize>(
     hood: &Neighbourhood,
     rows: &Msph2Rows<K>,
@@ -578,6 +579,7 @@ fn weights_with<const K: usize>(
     kernel: &mut [f64],
 ) {
     hood.weights_of(&rows.rows, &rows.scale, out, kernel);
+}
 }
 
 /// Selected rows of the inverse of the scaled 2-D moment matrix of particle

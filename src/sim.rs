@@ -4,6 +4,7 @@
 //! threads.
 
 use crate::error::{Error, Result};
+use crate::isa::Isa;
 use crate::observe::{History, ObservableSpec, Snapshot};
 use crate::scene::{Scene, SceneKind, SceneParams};
 use crate::solver::axisymmetric::TaylorSolver;
@@ -81,6 +82,18 @@ impl Simulation {
         };
         sim.record();
         Ok(sim)
+    }
+
+    /// Runs the hot loops in the compiled copy `isa` from now on (by default
+    /// the best this processor has, [`Isa::best`]). Every copy gives the same
+    /// bits; this is for testing that, and for measuring the copies. A
+    /// restored state starts again with the best copy.
+    pub fn set_isa(&mut self, isa: Isa) {
+        match &mut self.solver {
+            Solver::Taylor(s) => s.set_isa(isa),
+            // The radial solver has no hot copies.
+            Solver::Noh(_) => {}
+        }
     }
 
     /// A built-in scene by name with default parameters.

@@ -5,9 +5,12 @@
 //! refactoring began and are never re-recorded by it.
 //!
 //! Each case is a digest: the bits of every final observable, and an FNV-1a
-//! checksum over the bits of every recorded time and value.
+//! checksum over the bits of every recorded time and value. Every case runs
+//! in each compiled copy of the hot loops this processor has (AVX-512,
+//! AVX2+FMA, baseline; [`Isa`]). With `MI_REQUIRE_AVX512=1` the test fails
+//! where the AVX-512 copy cannot run, rather than leaving it out.
 
-use meshless_impact::{Scene, Simulation};
+use meshless_impact::{Isa, Scene, Simulation};
 
 /// A golden case: scene, settings, and the digest it must reproduce.
 struct Golden {
@@ -40,12 +43,13 @@ fn fnv1a(words: impl IntoIterator<Item = u64>) -> u64 {
 }
 
 /// Runs a case and returns (final observable bits, history checksum, rows).
-fn digest(scene: &str, sets: &[(&str, f64)]) -> (Vec<u64>, u64, usize) {
+fn digest(scene: &str, sets: &[(&str, f64)], isa: Isa) -> (Vec<u64>, u64, usize) {
     let mut scene = Scene::builtin(scene).unwrap();
     for (k, v) in sets {
         scene.set(k, *v).unwrap();
     }
     let mut sim = Simulation::new(scene).unwrap();
+    sim.set_isa(isa);
     sim.run().unwrap();
     let finals = sim.observables().iter().map(|v| v.to_bits()).collect();
     let h = sim.history();
@@ -124,17 +128,41 @@ fn cases() -> Vec<Golden> {
     ]
 }
 
+/// The copies to run: every one this processor has; all three when
+/// `MI_REQUIRE_AVX512=1` (a copy it lacks then fails the test).
+fn copies() -> Vec<Isa> {
+    let required = std::env::var("MI_REQUIRE_AVX512").is_ok_and(|v| v == "1");
+    if required {
+        ["avx512", "avx2+fma", "baseline"]
+            .map(|name| Isa::named(name).expect("MI_REQUIRE_AVX512=1"))
+            .to_vec()
+    } else {
+        let available = Isa::available();
+        if available.len() < 3 {
+            eprintln!(
+                "this processor runs only {:?}: the other copies are not compared",
+                available.iter().map(|i| i.name()).collect::<Vec<_>>()
+            );
+        }
+        available
+    }
+}
+
 #[test]
-fn golden_runs_keep_their_bits() {
+fn golden_runs_keep_their_bits_in_every_copy() {
     let mut failed = Vec::new();
-    for case in cases() {
-        let (finals, history, rows) = digest(case.scene, case.sets);
-        println!(
-            "{}: finals {:#018x?}, history {history:#018x}, rows {rows}",
-            case.name, finals
-        );
-        if finals != case.finals || history != case.history || rows != case.rows {
-            failed.push(case.name);
+    for isa in copies() {
+        for case in cases() {
+            let (finals, history, rows) = digest(case.scene, case.sets, isa);
+            println!(
+                "{} [{}]: finals {:#018x?}, history {history:#018x}, rows {rows}",
+                case.name,
+                isa.name(),
+                finals
+            );
+            if finals != case.finals || history != case.history || rows != case.rows {
+                failed.push(format!("{} [{}]", case.name, isa.name()));
+            }
         }
     }
     assert!(failed.is_empty(), "bits changed in: {failed:?}");

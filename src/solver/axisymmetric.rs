@@ -38,6 +38,7 @@ use super::shift::{Candidates, Freedom, carry, leaving, shifts};
 use super::team::{Chunks, Team};
 use super::{COURANT, check_derived, check_time_step};
 use crate::error::{Error, Result};
+use crate::isa::Isa;
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
 use crate::material::eos::LinearEos;
@@ -122,6 +123,10 @@ pub struct TaylorSolver {
     min_spacing: f64,
     #[serde(skip)]
     ws: Workspace,
+    /// The compiled copy of the hot loops this run uses (not saved: a
+    /// restored run uses the best its processor has).
+    #[serde(skip)]
+    isa: Isa,
 }
 
 /// A value as JSON text, to compare restored state with a fresh build bit
@@ -482,6 +487,7 @@ impl TaylorSolver {
             quiet_since: None,
             min_spacing: 1.0,
             ws: Workspace::default(),
+            isa: Isa::best(),
             p,
         };
         check_derived("wave speed", s.wave_speed(), " m/s")?;
@@ -639,6 +645,12 @@ impl TaylorSolver {
     /// initial spacing, over the run so far.
     pub fn min_spacing_ratio(&self) -> f64 {
         self.min_spacing
+    }
+
+    /// Runs the hot loops in the copy `isa` from now on (the same bits in
+    /// every copy).
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = isa;
     }
 
     /// Longitudinal elastic wave speed sqrt((K + 4 mu / 3) / rho0).
@@ -942,6 +954,7 @@ impl TaylorSolver {
         let n = self.particles();
         let dt = self.dt;
         let alpha = self.p.smoothing_coefficient;
+        let isa = self.isa;
         let on_axis = &self.on_axis;
         let axis = |i: usize| on_axis[i];
         let Workspace {
@@ -1037,7 +1050,7 @@ impl TaylorSolver {
                         part: &mut *part,
                         vel: &mut *vel,
                     };
-                    pair_batch(&inputs, i0, out, &mut scratch);
+                    pair_batch(isa, &inputs, i0, out, &mut scratch);
                     let mut t = BatchTally::default();
                     for (k, (p, v)) in part.iter().zip(vel.iter_mut()).enumerate() {
                         let i = i0 + k;
@@ -1102,7 +1115,7 @@ impl TaylorSolver {
             let parts = Chunks::new(&mut lap[..n], MIN_LEN);
             team.run_parts(&parts, |c, out| {
                 let i0 = c * MIN_LEN;
-                shepard_means(rows, vel, i0, out);
+                shepard_means(isa, rows, vel, i0, out);
                 for (k, l) in out.iter_mut().enumerate() {
                     *l = laplacian(vel[i0 + k], *l);
                 }
@@ -1121,9 +1134,9 @@ impl TaylorSolver {
                 *ke = [0.0; 2];
                 if order2 {
                     // v - alpha L(L v): the mean of L v is taken into `out`.
-                    shepard_means(rows, lap, i0, out);
+                    shepard_means(isa, rows, lap, i0, out);
                 } else {
-                    shepard_means(rows, vel, i0, out);
+                    shepard_means(isa, rows, vel, i0, out);
                 }
                 for (k, v) in out.iter_mut().enumerate() {
                     let i = i0 + k;
@@ -1159,7 +1172,7 @@ impl TaylorSolver {
             team.run_parts(&parts, |c, (grads, rho_out)| {
                 let i0 = c * MIN_LEN;
                 // dU_R/dR, dU_R/dZ, dU_Z/dR, dU_Z/dZ
-                velocity_gradients(rows, vel, i0, grads);
+                velocity_gradients(isa, rows, vel, i0, grads);
                 for (k, (g, rho_out)) in grads.iter().zip(rho_out).enumerate() {
                     let i = i0 + k;
                     let hoop = if axis(i) { g[0] } else { vel[i][0] / pos[i][0] };
@@ -1210,7 +1223,7 @@ impl TaylorSolver {
                     let i0 = c * MIN_LEN;
                     let mut means = [[0.0]; MIN_LEN];
                     let means = &mut means[..dev.len()];
-                    shepard_means(rows, rho_raw, i0, means);
+                    shepard_means(isa, rows, rho_raw, i0, means);
                     let mut t = Tally::default();
                     for k in 0..dev.len() {
                         let i = i0 + k;

@@ -10,13 +10,12 @@
 //! vector width the compiler picks.
 
 use super::boundary::Stress;
+use crate::isa::{hot, on_avx512};
 use crate::kernel::SUPPORT;
 use crate::lanes::{self, Lanes, W};
 use crate::msph::{
     MAX_CONDITION, Neighbourhood, POWER_SUMS, inverse_moments_lanes, moment_matrix_lanes,
 };
-use multiversion::multiversion;
-use multiversion::target::match_target;
 use std::sync::{Mutex, MutexGuard};
 
 // AVX-512 versions of parts of the pair pass, chosen at run time; the only
@@ -215,9 +214,9 @@ fn power_totals(partials: &[[Lanes; POWER_SUMS]; W]) -> [Lanes; POWER_SUMS] {
     sums
 }
 
+hot! {
 /// The pair pass of the particles `i0 .. i0 + out.part.len()` (at most
-/// [`W`]). See the module documentation.
-#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+/// [`W`]), in the copy `isa`. See the module documentation.
 pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch: &mut Scratch) {
     let nb = out.part.len();
     let stride = inp.stride;
@@ -227,10 +226,11 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         let hood = &mut scratch.hoods[p];
         hood.clear();
         let act = &mut out.act[p * stride..(p + 1) * stride];
-        let min_d2 = match_target! {
-            "x86_64+avx512f+avx512vl" => avx512::scan_candidates(inp, i, hood, act),
-            _ => scan_candidates(inp, i, hood, act),
-        };
+        let min_d2 = on_avx512!(
+            ISA,
+            avx512::scan_candidates(inp, i, hood, act),
+            scan_candidates(inp, i, hood, act)
+        );
         let len = hood.len();
         // Padded slots: the particle itself, with zero weight.
         for a in &mut act[len..hood.padded_len()] {
@@ -249,10 +249,7 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         *part = [[0.0; W]; POWER_SUMS];
     }
     // Each power sum of the eight particles at once (unused lanes zero).
-    let sums = match_target! {
-        "x86_64+avx512f+avx512vl" => avx512::power_totals(partials),
-        _ => power_totals(partials),
-    };
+    let sums = on_avx512!(ISA, avx512::power_totals(partials), power_totals(partials));
     let b = moment_matrix_lanes(&sums);
     // The Gram route without pivoting; unused lanes (zero sums) are not read.
     let (mut inv, elsewhere) = inverse_moments_lanes(&sums);
@@ -308,10 +305,11 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
         // Momentum: v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho.
         let si = inp.sbc[i];
         let act = &out.act[row];
-        let [drr_r, drz_r, drz_z, dzz_z] = match_target! {
-            "x86_64+avx512f+avx512vl" => avx512::stress_divergence(act, wr, wz, inp.sbc, si),
-            _ => stress_divergence(act, wr, wz, inp.sbc, si),
-        };
+        let [drr_r, drz_r, drz_z, dzz_z] = on_avx512!(
+            ISA,
+            avx512::stress_divergence(act, wr, wz, inp.sbc, si),
+            stress_divergence(act, wr, wz, inp.sbc, si)
+        );
         let (v, rho, dt) = (inp.vel[i], inp.rho[i], inp.dt);
         out.vel[p] = if inp.on_axis[i] {
             [0.0, v[1] + dt * (2.0 * drz_r + dzz_z) / rho]
@@ -323,6 +321,7 @@ pub(super) fn pair_batch(inp: &PairInputs, i0: usize, out: PairOutputs, scratch:
             ]
         };
     }
+}
 }
 
 /// The padded per-particle rows written by the pair pass, for the passes
@@ -347,8 +346,9 @@ impl Rows<'_> {
     }
 }
 
-/// Shepard means `sum_j s_ij f_j` of the particles `i0 .. i0 + out.len()`.
-#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+hot! {
+/// Shepard means `sum_j s_ij f_j` of the particles `i0 .. i0 + out.len()`,
+/// in the copy `isa`.
 pub(super) fn shepard_means<const K: usize>(
     rows: Rows,
     f: &[[f64; K]],
@@ -370,10 +370,11 @@ pub(super) fn shepard_means<const K: usize>(
         *o = acc.map(lanes::total);
     }
 }
+}
 
+hot! {
 /// Velocity gradients (dU_R/dR, dU_R/dZ, dU_Z/dR, dU_Z/dZ) of the particles
-/// `i0 .. i0 + out.len()`.
-#[multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+/// `i0 .. i0 + out.len()`, in the copy `isa`.
 pub(super) fn velocity_gradients(rows: Rows, vel: &[[f64; 2]], i0: usize, out: &mut [[f64; 4]]) {
     for (k, o) in out.iter_mut().enumerate() {
         let i = i0 + k;
@@ -393,6 +394,7 @@ pub(super) fn velocity_gradients(rows: Rows, vel: &[[f64; 2]], i0: usize, out: &
         }
         *o = acc.map(lanes::total);
     }
+}
 }
 
 /// Conservative smoothing, eq. (3.23): `f_i + alpha (mean - f_i)` with the
@@ -431,6 +433,7 @@ pub(super) fn smooth2<const K: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::isa::Isa;
 
     /// Padded rows of `n` particles on a line, particle `i` with the
     /// neighbours `nb(i)` at equal Shepard weights (no derivative weights).
@@ -491,10 +494,10 @@ mod tests {
             let theta = 2.0 * std::f64::consts::PI * waves as f64 / n as f64;
             let f: Vec<[f64; 1]> = (0..n).map(|i| [(theta * i as f64).cos()]).collect();
             let mut mean = vec![[0.0]; n];
-            shepard_means(rows, &f, 0, &mut mean);
+            shepard_means(Isa::best(), rows, &f, 0, &mut mean);
             let lf: Vec<[f64; 1]> = (0..n).map(|i| laplacian(f[i], mean[i])).collect();
             let mut mean_l = vec![[0.0]; n];
-            shepard_means(rows, &lf, 0, &mut mean_l);
+            shepard_means(Isa::best(), rows, &lf, 0, &mut mean_l);
             let l = (2.0 * theta.cos() - 2.0) / 3.0;
             for i in 0..n {
                 let one = smooth(f[i], mean[i], alpha)[0];
@@ -520,7 +523,7 @@ mod tests {
         let rows = line.rows();
         let smooth_all = |f: &[[f64; 1]], alpha: f64| -> Vec<[f64; 1]> {
             let mut means = vec![[0.0]; n];
-            shepard_means(rows, f, 0, &mut means);
+            shepard_means(Isa::best(), rows, f, 0, &mut means);
             (0..n).map(|i| smooth(f[i], means[i], alpha)).collect()
         };
         let c = vec![[3.0]; n];
@@ -554,9 +557,16 @@ mod avx512_tests {
         x * 10f64.powi((uniform(seed) * 12.0) as i32 - 6)
     }
 
-    /// Whether this CPU runs the AVX-512 code (said on stderr when not).
+    /// Whether this CPU runs the AVX-512 code (said on stderr when not). With
+    /// `MI_REQUIRE_AVX512=1` (the test command sets it where the processor
+    /// has AVX-512) a processor without it fails the test instead.
     fn avx512_here() -> bool {
         let here = is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl");
+        let required = std::env::var("MI_REQUIRE_AVX512").is_ok_and(|v| v == "1");
+        assert!(
+            here || !required,
+            "MI_REQUIRE_AVX512=1 but this processor has no AVX-512 F and VL"
+        );
         if !here {
             eprintln!("no AVX-512 on this machine: nothing to compare");
         }
