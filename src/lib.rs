@@ -29,6 +29,7 @@ pub mod isa;
 pub mod kernel;
 pub mod lanes;
 pub mod material;
+pub mod model;
 pub mod msph;
 pub mod neighbors;
 pub mod observe;
@@ -39,10 +40,11 @@ pub mod solver;
 
 pub use error::{Error, Result};
 pub use isa::Isa;
+pub use model::{Model, ModelState};
 pub use observe::{Field, History, NOH_OBSERVABLES, ObservableSpec, Snapshot, TAYLOR_OBSERVABLES};
 pub use scene::params::{ParamSpec, Range};
 pub use scene::table1::Table1Row;
-pub use scene::{Scene, SceneKind, SceneParams};
+pub use scene::{Scene, SceneKind};
 pub use sim::{Progress, Simulation};
 
 /// The library version (the crate version).

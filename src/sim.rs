@@ -5,32 +5,10 @@
 
 use crate::error::{Error, Result};
 use crate::isa::Isa;
+use crate::model::Model;
 use crate::observe::{History, ObservableSpec, Snapshot};
-use crate::scene::{Scene, SceneKind, SceneParams};
-use crate::solver::axisymmetric::TaylorSolver;
-use crate::solver::radial::NohSolver;
-
-/// The solver a scene composes.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-enum Solver {
-    Taylor(Box<TaylorSolver>),
-    Noh(Box<NohSolver>),
-}
-
-macro_rules! dispatch {
-    ($self:expr, $s:ident => $e:expr) => {
-        match &$self.solver {
-            Solver::Taylor($s) => $e,
-            Solver::Noh($s) => $e,
-        }
-    };
-    (mut $self:expr, $s:ident => $e:expr) => {
-        match &mut $self.solver {
-            Solver::Taylor($s) => $e,
-            Solver::Noh($s) => $e,
-        }
-    };
-}
+use crate::scene::{Scene, SceneKind};
+use std::collections::BTreeMap;
 
 /// Progress of a run, passed to the callback of [`Simulation::run_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,33 +22,102 @@ pub struct Progress {
 }
 
 /// One run of one scene.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[derive(Debug)]
 pub struct Simulation {
     scene: Scene,
-    solver: Solver,
+    solver: Box<dyn Model>,
     history: History,
     record_interval: f64,
     next_record: f64,
-    #[serde(skip)]
     error: Option<Error>,
+}
+
+impl Clone for Simulation {
+    fn clone(&self) -> Self {
+        Simulation {
+            scene: self.scene.clone(),
+            solver: self.solver.boxed_clone(),
+            history: self.history.clone(),
+            record_interval: self.record_interval,
+            next_record: self.next_record,
+            error: self.error.clone(),
+        }
+    }
+}
+
+/// A [`Simulation`] as saved: the solver's state under its kind's key, as
+/// the scene's parameters are (`{"Taylor": {...}}`). A stopped run's error
+/// is not part of the state.
+#[derive(serde::Serialize)]
+struct SavedRef<'a> {
+    scene: &'a Scene,
+    solver: BTreeMap<String, serde_json::Value>,
+    history: &'a History,
+    record_interval: f64,
+    next_record: f64,
+}
+
+/// [`SavedRef`] read back.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Saved {
+    scene: Scene,
+    solver: BTreeMap<String, serde_json::Value>,
+    history: History,
+    record_interval: f64,
+    next_record: f64,
+}
+
+impl serde::Serialize for Simulation {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        SavedRef {
+            scene: &self.scene,
+            solver: BTreeMap::from([(self.scene.kind().saved_key(), self.solver.save())]),
+            history: &self.history,
+            record_interval: self.record_interval,
+            next_record: self.next_record,
+        }
+        .serialize(serializer)
+    }
+}
+
+/// The run as saved, not yet checked: [`Simulation::deserialize_state`]
+/// checks it ([`Simulation::check_restored`]), and so must every other
+/// reader.
+impl<'de> serde::Deserialize<'de> for Simulation {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let saved = Saved::deserialize(deserializer)?;
+        let kind = saved.scene.kind();
+        let mut states = saved.solver.into_iter();
+        let solver = match (states.next(), states.next()) {
+            (Some((key, state)), None) if key == kind.saved_key() => {
+                (kind.row().restore)(state).map_err(D::Error::custom)?
+            }
+            _ => return Err(D::Error::custom("its solver is not its scene's")),
+        };
+        Ok(Simulation {
+            scene: saved.scene,
+            solver,
+            history: saved.history,
+            record_interval: saved.record_interval,
+            next_record: saved.next_record,
+            error: None,
+        })
+    }
 }
 
 impl Simulation {
     /// Validates the scene and sets up the initial state.
     pub fn new(scene: Scene) -> Result<Self> {
         scene.validate()?;
-        let (solver, record_interval) = match scene.params {
-            SceneParams::Taylor(p) => {
-                let s = TaylorSolver::new(p)?;
-                // 64 records per elastic transit of the rod.
-                let dt = p.initial_length / s.wave_speed() / 64.0;
-                (Solver::Taylor(Box::new(s)), dt)
-            }
-            SceneParams::Noh(p) => (
-                Solver::Noh(Box::new(NohSolver::new(p)?)),
-                p.end_time / 600.0,
-            ),
-        };
+        let solver = (scene.kind().row().build)(&scene)?;
+        let record_interval = solver.record_interval();
         crate::solver::check_derived("record interval", record_interval, "")?;
         let mut sim = Simulation {
             history: History::new(scene.kind().observable_specs()),
@@ -89,11 +136,7 @@ impl Simulation {
     /// bits; this is for testing that, and for measuring the copies. A
     /// restored state starts again with the best copy.
     pub fn set_isa(&mut self, isa: Isa) {
-        match &mut self.solver {
-            Solver::Taylor(s) => s.set_isa(isa),
-            // The radial solver has no hot copies.
-            Solver::Noh(_) => {}
-        }
+        self.solver.set_isa(isa);
     }
 
     /// A built-in scene by name with default parameters.
@@ -113,17 +156,17 @@ impl Simulation {
 
     /// Simulated time.
     pub fn time(&self) -> f64 {
-        dispatch!(self, s => s.time())
+        self.solver.time()
     }
 
     /// Steps taken.
     pub fn steps(&self) -> u64 {
-        dispatch!(self, s => s.steps())
+        self.solver.steps()
     }
 
     /// Number of particles.
     pub fn particles(&self) -> usize {
-        dispatch!(self, s => s.particles())
+        self.solver.particles()
     }
 
     /// Latest time the run may reach.
@@ -135,7 +178,7 @@ impl Simulation {
 
     /// Whether the end condition holds (or the run stopped on an error).
     pub fn finished(&self) -> bool {
-        self.error.is_some() || dispatch!(self, s => s.finished())
+        self.error.is_some() || self.solver.finished()
     }
 
     /// The error that stopped the run, if any.
@@ -146,10 +189,7 @@ impl Simulation {
     /// Smallest distance between neighbouring particles over the run so far,
     /// relative to the initial spacing, where the solver tracks it (Taylor).
     pub fn min_spacing_ratio(&self) -> Option<f64> {
-        match &self.solver {
-            Solver::Taylor(s) => Some(s.min_spacing_ratio()),
-            Solver::Noh(_) => None,
-        }
+        self.solver.min_spacing_ratio()
     }
 
     /// Names, units and meanings of this scene's observables.
@@ -159,7 +199,7 @@ impl Simulation {
 
     /// Current values of the observables, in [`Simulation::observable_specs`] order.
     pub fn observables(&self) -> Vec<f64> {
-        dispatch!(self, s => s.observables())
+        self.solver.observables()
     }
 
     /// Current value of one observable.
@@ -178,7 +218,7 @@ impl Simulation {
 
     /// Particle positions and fields now.
     pub fn snapshot(&self) -> Snapshot {
-        dispatch!(self, s => s.snapshot())
+        self.solver.snapshot()
     }
 
     fn record(&mut self) {
@@ -196,7 +236,7 @@ impl Simulation {
         if let Some(e) = &self.error {
             return Err(e.clone());
         }
-        if let Err(e) = dispatch!(mut self, s => s.step()) {
+        if let Err(e) = self.solver.step() {
             self.record();
             self.error = Some(e.clone());
             return Err(e);
@@ -250,11 +290,7 @@ impl Simulation {
     /// finite values at increasing times).
     pub fn check_restored(&self) -> std::result::Result<(), String> {
         let fresh = Simulation::new(self.scene.clone()).map_err(|e| format!("its scene: {e}"))?;
-        match (&self.solver, &fresh.solver) {
-            (Solver::Taylor(a), Solver::Taylor(b)) => a.check_restored(b)?,
-            (Solver::Noh(a), Solver::Noh(b)) => a.check_restored(b)?,
-            _ => return Err("its solver is not its scene's".into()),
-        }
+        self.solver.check_restored(fresh.solver.as_ref())?;
         // After every record the next one is due within one interval.
         let t = self.time();
         if self.record_interval.to_bits() != fresh.record_interval.to_bits()

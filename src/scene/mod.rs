@@ -4,78 +4,152 @@
 
 pub mod noh;
 pub mod params;
+pub mod registry;
 pub mod table1;
 pub mod taylor;
 
 use crate::error::{Error, Result};
-use crate::observe::{NOH_OBSERVABLES, ObservableSpec, TAYLOR_OBSERVABLES};
-use noh::{NOH_PARAMS, NohParams};
+use crate::observe::ObservableSpec;
 use params::ParamSpec;
+use registry::SceneRow;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use taylor::{TAYLOR_PARAMS, TaylorParams};
 
-/// The kinds of scene the solver composes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SceneKind {
-    /// Axisymmetric Taylor rod impact on a rigid anvil.
-    Taylor,
-    /// Cylindrical Noh implosion of an ideal gas (1-D in R).
-    Noh,
+/// A kind of scene: a handle to its row of the scene registry
+/// ([`registry::SCENES`]). Two kinds are equal when they are the same row.
+#[derive(Clone, Copy)]
+pub struct SceneKind(&'static SceneRow);
+
+impl PartialEq for SceneKind {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.0, other.0)
+    }
+}
+
+impl Eq for SceneKind {}
+
+impl std::fmt::Debug for SceneKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "SceneKind({})", self.0.name)
+    }
 }
 
 impl SceneKind {
+    /// The kind called `name` (`taylor`, `noh`, ...), as the registry lists
+    /// it.
+    pub fn named(name: &str) -> Result<SceneKind> {
+        registry::row(name).map(SceneKind)
+    }
+
+    /// The kind's registry row.
+    pub fn row(self) -> &'static SceneRow {
+        self.0
+    }
+
     /// The scene's name as used on the command line and in scene files.
     pub fn name(self) -> &'static str {
-        match self {
-            SceneKind::Taylor => "taylor",
-            SceneKind::Noh => "noh",
-        }
+        self.0.name
     }
 
     /// Parameter table of this kind of scene.
     pub fn param_specs(self) -> &'static [ParamSpec] {
-        match self {
-            SceneKind::Taylor => TAYLOR_PARAMS,
-            SceneKind::Noh => NOH_PARAMS,
-        }
+        self.0.params
     }
 
     /// Observables this kind of scene reports, in output order.
     pub fn observable_specs(self) -> &'static [ObservableSpec] {
-        match self {
-            SceneKind::Taylor => TAYLOR_OBSERVABLES,
-            SceneKind::Noh => NOH_OBSERVABLES,
-        }
+        self.0.observables
+    }
+
+    /// The key of this kind in saved states: its name with a capital
+    /// (`Taylor`).
+    pub(crate) fn saved_key(self) -> String {
+        let mut c = self.name().chars();
+        c.next()
+            .map(|f| f.to_uppercase().chain(c).collect())
+            .unwrap_or_default()
     }
 }
 
-/// Parameter values of a scene, by kind.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum SceneParams {
-    /// Taylor impact parameters.
-    Taylor(TaylorParams),
-    /// Noh parameters.
-    Noh(NohParams),
-}
-
-/// A complete, validated-on-demand description of one run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A complete, validated-on-demand description of one run: a kind of scene
+/// and a value for each parameter of its table.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     /// Human-readable title.
     pub title: String,
-    /// Parameter values.
-    pub params: SceneParams,
+    kind: SceneKind,
+    /// One value per row of the kind's parameter table, in its order.
+    values: Vec<f64>,
     /// Optional reference values (for example experimental results), by name.
     pub reference: BTreeMap<String, f64>,
 }
 
-/// Names of the built-in scenes.
+/// Names of the built-in scenes: the registry rows' own names, then the
+/// named variants they offer (`table1-1` ... `table1-12` of `taylor`).
 pub fn builtin_names() -> Vec<String> {
-    let mut v = vec!["taylor".to_string(), "noh".to_string()];
-    v.extend((1..=12).map(|k| format!("table1-{k}")));
-    v
+    let rows = registry::SCENES.iter();
+    rows.clone()
+        .map(|row| row.name.to_string())
+        .chain(rows.flat_map(|row| (row.variants)().into_iter().map(|(name, _)| name)))
+        .collect()
+}
+
+/// A [`Scene`] as saved: its kind's parameters by name, under the kind's
+/// name with a capital (`{"Taylor": {"impact_speed": 181.0, ...}}`).
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SavedScene {
+    title: String,
+    params: BTreeMap<String, BTreeMap<String, f64>>,
+    reference: BTreeMap<String, f64>,
+}
+
+impl Serialize for Scene {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        let params = self
+            .param_specs()
+            .iter()
+            .zip(&self.values)
+            .map(|(spec, v)| (spec.name.to_string(), *v))
+            .collect();
+        SavedScene {
+            title: self.title.clone(),
+            params: BTreeMap::from([(self.kind.saved_key(), params)]),
+            reference: self.reference.clone(),
+        }
+        .serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for Scene {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let saved = SavedScene::deserialize(deserializer)?;
+        let mut entries = saved.params.into_iter();
+        let (Some((key, params)), None) = (entries.next(), entries.next()) else {
+            return Err(D::Error::custom("a scene has the parameters of one kind"));
+        };
+        let kind = registry::SCENES
+            .iter()
+            .map(|row| SceneKind(row))
+            .find(|k| k.saved_key() == key)
+            .ok_or_else(|| D::Error::custom(format!("unknown kind of scene `{key}`")))?;
+        let mut scene = Scene::default_of(kind);
+        scene.title = saved.title;
+        scene.reference = saved.reference;
+        // Values are put as they are (a restored state is checked whole
+        // afterwards); names must be the kind's.
+        for (name, v) in params {
+            let k = scene.index(&name).map_err(D::Error::custom)?;
+            scene.values[k] = v;
+        }
+        Ok(scene)
+    }
 }
 
 /// The shape of a TOML scene file.
@@ -94,55 +168,38 @@ struct SceneFile {
 impl Scene {
     /// The default scene of a kind, with default parameters.
     pub fn default_of(kind: SceneKind) -> Scene {
-        match kind {
-            SceneKind::Taylor => Scene {
-                title: "Taylor impact, House et al. test 7 (4340 steel, 181 m/s)".into(),
-                params: SceneParams::Taylor(TaylorParams::default()),
-                reference: table1::Table1Row::all()[6].reference(),
-            },
-            SceneKind::Noh => Scene {
-                title: "Cylindrical Noh problem (gamma = 5/3)".into(),
-                params: SceneParams::Noh(NohParams::default()),
-                reference: BTreeMap::from([
-                    ("shock_radius".to_string(), 0.2),
-                    ("post_shock_density".to_string(), 16.0),
-                ]),
-            },
+        let row = kind.row();
+        Scene {
+            title: row.title.to_string(),
+            kind,
+            values: row.params.iter().map(|p| p.default).collect(),
+            reference: (row.reference)(),
         }
     }
 
-    /// A built-in scene by name: `taylor`, `noh`, or `table1-N` for the N-th
-    /// configuration of Table 1 (N = 1..12). Only these exact names are
+    /// A built-in scene by name: a registry row's name (`taylor`, `noh`)
+    /// or one of the named variants a row offers (`table1-N` for the N-th
+    /// configuration of Table 1, N = 1..12). Only these exact names are
     /// accepted (no other case, sign, leading zero or spaces).
     pub fn builtin(name: &str) -> Result<Scene> {
-        match name {
-            "taylor" => Ok(Scene::default_of(SceneKind::Taylor)),
-            "noh" => Ok(Scene::default_of(SceneKind::Noh)),
-            // Compared with the spelled-out names, not parsed as a number,
-            // so `table1-01` or `table1-+1` are not taken for `table1-1`.
-            _ => (1..=12)
-                .find(|k| name == format!("table1-{k}"))
-                .map(|k| table1::Table1Row::all()[k - 1].scene())
-                .ok_or_else(|| Error::UnknownScene {
-                    name: name.to_string(),
-                    allowed: builtin_names().join(", "),
-                }),
+        for row in registry::SCENES {
+            if row.name == name {
+                return Ok(Scene::default_of(SceneKind(row)));
+            }
+            if let Some((_, scene)) = (row.variants)().into_iter().find(|(n, _)| n == name) {
+                return Ok(scene);
+            }
         }
+        Err(Error::UnknownScene {
+            name: name.to_string(),
+            allowed: builtin_names().join(", "),
+        })
     }
 
     /// Parses a TOML scene (see `scenes/` for examples).
     pub fn from_toml_str(text: &str) -> Result<Scene> {
         let file: SceneFile = toml::from_str(text).map_err(|e| Error::SceneFile(e.to_string()))?;
-        let kind = match file.scene.as_str() {
-            "taylor" => SceneKind::Taylor,
-            "noh" => SceneKind::Noh,
-            other => {
-                return Err(Error::UnknownScene {
-                    name: other.to_string(),
-                    allowed: "taylor, noh".into(),
-                });
-            }
-        };
+        let kind = SceneKind::named(&file.scene)?;
         let mut scene = Scene::default_of(kind);
         scene.reference = file.reference;
         if let Some(t) = file.title {
@@ -197,24 +254,28 @@ impl Scene {
 
     /// The kind of this scene.
     pub fn kind(&self) -> SceneKind {
-        match self.params {
-            SceneParams::Taylor(_) => SceneKind::Taylor,
-            SceneParams::Noh(_) => SceneKind::Noh,
-        }
+        self.kind
     }
 
     /// The parameter table of this scene.
     pub fn param_specs(&self) -> &'static [ParamSpec] {
-        self.kind().param_specs()
+        self.kind.param_specs()
     }
 
-    fn spec(&self, name: &str) -> Result<&'static ParamSpec> {
+    /// The values of the parameters, in the order of
+    /// [`Scene::param_specs`].
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Position of the parameter `name` in the table.
+    fn index(&self, name: &str) -> Result<usize> {
         self.param_specs()
             .iter()
-            .find(|s| s.name == name)
+            .position(|s| s.name == name)
             .ok_or_else(|| Error::UnknownParameter {
                 name: name.to_string(),
-                scene: self.kind().name().to_string(),
+                scene: self.kind.name().to_string(),
                 allowed: self
                     .param_specs()
                     .iter()
@@ -226,29 +287,21 @@ impl Scene {
 
     /// Current value of a parameter.
     pub fn get(&self, name: &str) -> Result<f64> {
-        self.spec(name)?;
-        Ok(match &self.params {
-            SceneParams::Taylor(p) => p.get(name),
-            SceneParams::Noh(p) => p.get(name),
-        }
-        .expect("table and struct agree"))
+        Ok(self.values[self.index(name)?])
     }
 
     /// Sets a parameter after checking its name and range. Cross-parameter
     /// constraints are checked by [`Scene::validate`].
     pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
-        self.spec(name)?.check(value)?;
-        let slot = match &mut self.params {
-            SceneParams::Taylor(p) => p.slot(name),
-            SceneParams::Noh(p) => p.slot(name),
-        };
-        *slot.expect("table and struct agree") = value;
+        let k = self.index(name)?;
+        self.param_specs()[k].check(value)?;
+        self.values[k] = value;
         Ok(())
     }
 
     /// Parses `text` as a number and sets the parameter.
     pub fn set_str(&mut self, name: &str, text: &str) -> Result<()> {
-        self.spec(name)?;
+        self.index(name)?;
         let v: f64 = text.trim().parse().map_err(|_| Error::ParseValue {
             name: name.to_string(),
             text: text.to_string(),
@@ -259,13 +312,10 @@ impl Scene {
     /// Checks every parameter against its range and the cross-parameter
     /// constraints.
     pub fn validate(&self) -> Result<()> {
-        for spec in self.param_specs() {
-            spec.check(self.get(spec.name)?)?;
+        for (spec, v) in self.param_specs().iter().zip(&self.values) {
+            spec.check(*v)?;
         }
-        match &self.params {
-            SceneParams::Taylor(p) => p.check_consistency(),
-            SceneParams::Noh(p) => p.check_consistency(),
-        }
+        (self.kind.row().check)(self)
     }
 }
 
@@ -375,8 +425,11 @@ mod tests {
         for (k, name) in builtin_names().iter().enumerate() {
             let scene = Scene::builtin(name).unwrap();
             match k {
-                0 => assert_eq!(scene, Scene::default_of(SceneKind::Taylor)),
-                1 => assert_eq!(scene, Scene::default_of(SceneKind::Noh)),
+                0 => assert_eq!(
+                    scene,
+                    Scene::default_of(SceneKind::named("taylor").unwrap())
+                ),
+                1 => assert_eq!(scene, Scene::default_of(SceneKind::named("noh").unwrap())),
                 _ => assert_eq!(scene, rows[k - 2].scene(), "{name}"),
             }
         }

@@ -2,7 +2,35 @@
 //! streaming toward the axis at unit speed. One-dimensional in R; no strength,
 //! no heating beyond compression and smoothing, no anvil.
 
+use super::Scene;
 use super::params::{Range, param_table};
+use super::registry::{SceneRow, no_variants, restore};
+use crate::observe::NOH_OBSERVABLES;
+use crate::solver::radial::NohSolver;
+use std::collections::BTreeMap;
+
+/// The registry row of the `noh` scene.
+pub static ROW: SceneRow = SceneRow {
+    name: "noh",
+    title: "Cylindrical Noh problem (gamma = 5/3)",
+    params: NOH_PARAMS,
+    observables: NOH_OBSERVABLES,
+    reference: || {
+        BTreeMap::from([
+            ("shock_radius".to_string(), 0.2),
+            ("post_shock_density".to_string(), 16.0),
+        ])
+    },
+    variants: no_variants,
+    check: |s| NohParams::from_values(s.values()).check_consistency(),
+    build: |s: &Scene| {
+        Ok(Box::new(NohSolver::new(NohParams::from_values(
+            s.values(),
+        ))?))
+    },
+    restore: restore::<NohSolver>,
+    fmu: None,
+};
 
 /// Window `(r_min, r_max)` of `post_shock_density`.
 pub const POST_SHOCK_WINDOW: (f64, f64) = (0.1, 0.18);

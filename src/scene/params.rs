@@ -148,18 +148,19 @@ macro_rules! param_table {
         }
 
         impl $name {
+            /// The parameters from one value per row of the table, in its
+            /// order (as [`crate::Scene::values`] holds them).
+            pub fn from_values(values: &[f64]) -> Self {
+                let mut v = values.iter().copied();
+                let p = Self { $( $field: v.next().expect("one value per row of the table"), )* };
+                debug_assert!(v.next().is_none(), "one value per row of the table");
+                p
+            }
+
             /// Value of the parameter called `name`, if it exists.
             pub fn get(&self, name: &str) -> Option<f64> {
                 match name {
                     $( stringify!($field) => Some(self.$field), )*
-                    _ => None,
-                }
-            }
-
-            /// Mutable slot of the parameter called `name`, if it exists.
-            pub(crate) fn slot(&mut self, name: &str) -> Option<&mut f64> {
-                match name {
-                    $( stringify!($field) => Some(&mut self.$field), )*
                     _ => None,
                 }
             }

@@ -3,7 +3,33 @@
 //! EOS, adiabatic heating, a rigid smooth anvil and a traction-free mantle and
 //! top.
 
+use super::Scene;
 use super::params::{Range, param_table};
+use super::registry::{FmuIdentity, SceneRow, restore};
+use crate::observe::TAYLOR_OBSERVABLES;
+use crate::solver::axisymmetric::TaylorSolver;
+
+/// The registry row of the `taylor` scene.
+pub static ROW: SceneRow = SceneRow {
+    name: "taylor",
+    title: "Taylor impact, House et al. test 7 (4340 steel, 181 m/s)",
+    params: TAYLOR_PARAMS,
+    observables: TAYLOR_OBSERVABLES,
+    reference: || super::table1::Table1Row::all()[6].reference(),
+    variants: super::table1::variants,
+    check: |s| TaylorParams::from_values(s.values()).check_consistency(),
+    build: |s: &Scene| {
+        Ok(Box::new(TaylorSolver::new(TaylorParams::from_values(
+            s.values(),
+        ))?))
+    },
+    restore: restore::<TaylorSolver>,
+    fmu: Some(FmuIdentity {
+        model_identifier: "TaylorImpact",
+        model_name: "TaylorImpact",
+        description: "Taylor impact of a rod on a rigid anvil (MSPH, axisymmetric, Johnson-Cook)",
+    }),
+};
 
 param_table! {
     /// Parameters of the Taylor impact scene (SI units). Defaults are House et

@@ -1582,3 +1582,20 @@ impl TaylorSolver {
         }
     }
 }
+
+impl crate::model::Model for TaylorSolver {
+    crate::model::inherent_basics!();
+    /// 64 records per elastic transit of the rod.
+    fn record_interval(&self) -> f64 {
+        self.p.initial_length / self.wave_speed() / 64.0
+    }
+    fn min_spacing_ratio(&self) -> Option<f64> {
+        Some(self.min_spacing_ratio())
+    }
+    fn set_isa(&mut self, isa: Isa) {
+        self.set_isa(isa);
+    }
+    fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
+        self.check_restored(crate::model::same_solver(fresh)?)
+    }
+}

@@ -521,3 +521,14 @@ impl NohSolver {
         }
     }
 }
+
+impl crate::model::Model for NohSolver {
+    crate::model::inherent_basics!();
+    /// 600 records over the run.
+    fn record_interval(&self) -> f64 {
+        self.p.end_time / 600.0
+    }
+    fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
+        self.check_restored(crate::model::same_solver(fresh)?)
+    }
+}

@@ -1,0 +1,118 @@
+//! [`Model`]: what a solver offers to [`crate::Simulation`], whatever its
+//! scene, dimension or method. A scene's registry row
+//! ([`crate::scene::registry`]) builds one; the simulation, the CLI, the C
+//! ABI and the FMUs use it only through this trait.
+
+use crate::error::Result;
+use crate::isa::Isa;
+use crate::observe::Snapshot;
+use std::any::Any;
+
+/// What every solver state offers alike: copies, saving, and its own type
+/// (implemented for every `Clone + Serialize` [`Model`]).
+pub trait ModelState {
+    /// A copy of this run.
+    fn boxed_clone(&self) -> Box<dyn Model>;
+
+    /// The run's state, restored by its registry row's `restore`.
+    fn save(&self) -> serde_json::Value;
+
+    /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s
+    /// own type.
+    fn as_any(&self) -> &dyn Any;
+}
+
+impl<T: Model + Clone + serde::Serialize> ModelState for T {
+    fn boxed_clone(&self) -> Box<dyn Model> {
+        Box::new(self.clone())
+    }
+    fn save(&self) -> serde_json::Value {
+        serde_json::to_value(self).expect("the state holds only finite numbers")
+    }
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+/// One solver's run of one scene.
+pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
+    /// Simulated time.
+    fn time(&self) -> f64;
+
+    /// Steps taken.
+    fn steps(&self) -> u64;
+
+    /// Number of particles (or nodes).
+    fn particles(&self) -> usize;
+
+    /// Whether the scene's end condition holds.
+    fn finished(&self) -> bool;
+
+    /// Takes one step; an error stops the run.
+    fn step(&mut self) -> Result<()>;
+
+    /// Current values of the scene's observables, in the order of its
+    /// observable table.
+    fn observables(&self) -> Vec<f64>;
+
+    /// Particle positions and fields now.
+    fn snapshot(&self) -> Snapshot;
+
+    /// Simulated time between two records of the observables' histories.
+    fn record_interval(&self) -> f64;
+
+    /// Smallest distance between neighbouring particles over the run so
+    /// far, relative to the initial spacing, where the solver tracks it.
+    fn min_spacing_ratio(&self) -> Option<f64> {
+        None
+    }
+
+    /// Runs the hot loops in the compiled copy `isa` from now on; a solver
+    /// without compiled copies ignores it.
+    fn set_isa(&mut self, _isa: Isa) {}
+
+    /// Checks a restored run against `fresh`, a new run of the same scene
+    /// built by the same row: the same lattice, masses and material, bit
+    /// for bit, one finite value per particle in every field, and a clock a
+    /// run of this scene can reach.
+    fn check_restored(&self, fresh: &dyn Model) -> std::result::Result<(), String>;
+}
+
+/// `fresh` as the solver type `T`, or a message saying that the restored
+/// solver is not its scene's.
+pub(crate) fn same_solver<T: 'static>(fresh: &dyn Model) -> std::result::Result<&T, String> {
+    fresh
+        .as_any()
+        .downcast_ref::<T>()
+        .ok_or_else(|| "its solver is not its scene's".to_string())
+}
+
+/// Inside `impl Model for T`: the methods that call `T`'s inherent methods
+/// of the same names (`time`, `steps`, `particles`, `finished`, `step`,
+/// `observables`, `snapshot`).
+macro_rules! inherent_basics {
+    () => {
+        fn time(&self) -> f64 {
+            Self::time(self)
+        }
+        fn steps(&self) -> u64 {
+            Self::steps(self)
+        }
+        fn particles(&self) -> usize {
+            Self::particles(self)
+        }
+        fn finished(&self) -> bool {
+            Self::finished(self)
+        }
+        fn step(&mut self) -> $crate::error::Result<()> {
+            Self::step(self)
+        }
+        fn observables(&self) -> Vec<f64> {
+            Self::observables(self)
+        }
+        fn snapshot(&self) -> $crate::observe::Snapshot {
+            Self::snapshot(self)
+        }
+    };
+}
+pub(crate) use inherent_basics;

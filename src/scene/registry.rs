@@ -1,0 +1,79 @@
+//! The scene registry: one row per kind of scene. The CLI, TOML scene files,
+//! the C ABI, the FMU glue and `cargo xtask fmu` read it, so a new kind of
+//! scene is one new row (in its own module) plus its solver.
+
+use super::Scene;
+use super::params::ParamSpec;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::observe::ObservableSpec;
+use std::collections::BTreeMap;
+
+/// How a scene kind is packaged as an FMU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FmuIdentity {
+    /// The model identifier: the name of the shared library inside the FMU.
+    pub model_identifier: &'static str,
+    /// The model name shown by hosts.
+    pub model_name: &'static str,
+    /// One-line description in the model description.
+    pub description: &'static str,
+}
+
+/// One kind of scene.
+pub struct SceneRow {
+    /// Name on the command line, in scene files and in the C ABI.
+    pub name: &'static str,
+    /// Title of the default scene.
+    pub title: &'static str,
+    /// Parameters, with units, defaults and ranges.
+    pub params: &'static [ParamSpec],
+    /// Observables, in output order.
+    pub observables: &'static [ObservableSpec],
+    /// Reference values of the default scene (experiment or exact solution),
+    /// keyed like the observables they compare with.
+    pub reference: fn() -> BTreeMap<String, f64>,
+    /// Named variants of the default scene that are built in (for example
+    /// `table1-1` ... `table1-12`), in order.
+    pub variants: fn() -> Vec<(String, Scene)>,
+    /// Cross-parameter checks of a scene of this kind (each value is
+    /// already in its range).
+    pub check: fn(&Scene) -> Result<()>,
+    /// Builds the initial state of a run of a valid scene of this kind.
+    pub build: fn(&Scene) -> Result<Box<dyn Model>>,
+    /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked
+    /// afterwards ([`Model::check_restored`]).
+    pub restore: fn(serde_json::Value) -> std::result::Result<Box<dyn Model>, String>,
+    /// The FMU of this kind, if it has one.
+    pub fmu: Option<FmuIdentity>,
+}
+
+/// Every kind of scene, in the order they are listed.
+pub static SCENES: &[&SceneRow] = &[&super::taylor::ROW, &super::noh::ROW];
+
+/// The row called `name`.
+pub fn row(name: &str) -> Result<&'static SceneRow> {
+    SCENES
+        .iter()
+        .copied()
+        .find(|r| r.name == name)
+        .ok_or_else(|| Error::UnknownScene {
+            name: name.to_string(),
+            allowed: SCENES.iter().map(|r| r.name).collect::<Vec<_>>().join(", "),
+        })
+}
+
+/// [`SceneRow::restore`] for a solver type that serde restores whole.
+pub(crate) fn restore<T>(state: serde_json::Value) -> std::result::Result<Box<dyn Model>, String>
+where
+    T: Model + serde::de::DeserializeOwned,
+{
+    serde_json::from_value::<T>(state)
+        .map(|m| Box::new(m) as Box<dyn Model>)
+        .map_err(|e| e.to_string())
+}
+
+/// No named variants.
+pub(crate) fn no_variants() -> Vec<(String, Scene)> {
+    Vec::new()
+}
