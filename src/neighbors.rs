@@ -4,6 +4,9 @@
 //! Every particle is its own neighbour (the MSPH sums include `j = i`). The
 //! neighbours of each particle are listed in increasing index order, so the
 //! list, and everything computed from it, is independent of thread count.
+//!
+//! The search is generic in the dimension `D` of the points (2 for the
+//! axisymmetric solver, 3 for the 3-D one).
 
 use rayon::prelude::*;
 
@@ -37,7 +40,7 @@ impl NeighborList {
 
 /// Naive O(N^2) search: all `j` with `|x_i - x_j| <= radius`. Used as the
 /// oracle in tests.
-pub fn naive(points: &[[f64; 2]], radius: f64) -> NeighborList {
+pub fn naive<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighborList {
     let r2 = radius * radius;
     let mut offsets = Vec::with_capacity(points.len() + 1);
     let mut indices = Vec::new();
@@ -53,24 +56,32 @@ pub fn naive(points: &[[f64; 2]], radius: f64) -> NeighborList {
     NeighborList { offsets, indices }
 }
 
+/// Squared distance, summed over the axes in order.
 #[inline]
-fn dist2(a: &[f64; 2], b: &[f64; 2]) -> f64 {
-    let dx = a[0] - b[0];
-    let dy = a[1] - b[1];
-    dx * dx + dy * dy
+fn dist2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    let mut s = 0.0;
+    for d in 0..D {
+        let x = a[d] - b[d];
+        s += x * x;
+    }
+    s
 }
 
 /// Cell-list search with cells of side `radius`: all `j` with
 /// `|x_i - x_j| <= radius`. Queries run in parallel; the result equals
 /// [`naive`] exactly.
-pub fn cell_list(points: &[[f64; 2]], radius: f64) -> NeighborList {
+pub fn cell_list<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighborList {
     cell_list_first(points, points.len(), radius)
 }
 
 /// Like [`cell_list`], but lists neighbours (among all points) only for the
 /// first `rows` points: the others are mirror images that are neighbours but
 /// need no derivatives of their own.
-pub fn cell_list_first(points: &[[f64; 2]], rows: usize, radius: f64) -> NeighborList {
+pub fn cell_list_first<const D: usize>(
+    points: &[[f64; D]],
+    rows: usize,
+    radius: f64,
+) -> NeighborList {
     let Some(cells) = Cells::new(points, radius) else {
         return NeighborList {
             offsets: vec![0],
@@ -103,8 +114,8 @@ pub fn cell_list_first(points: &[[f64; 2]], rows: usize, radius: f64) -> Neighbo
 /// list rounded up to a multiple of `align`. The buffers are reused; a first
 /// try uses `stride_hint` (the stride of the previous call) and is redone
 /// with the true stride only when a list does not fit.
-pub fn padded_rows(
-    points: &[[f64; 2]],
+pub fn padded_rows<const D: usize>(
+    points: &[[f64; D]],
     first: usize,
     radius: f64,
     align: usize,
@@ -151,12 +162,13 @@ pub fn padded_rows(
 }
 
 /// A uniform grid of cells of side `radius` over a point set, with the
-/// points of each cell in ascending index order.
-struct Cells<'a> {
-    points: &'a [[f64; 2]],
-    lo: [f64; 2],
+/// points of each cell in ascending index order. Cells are numbered with the
+/// first axis fastest.
+struct Cells<'a, const D: usize> {
+    points: &'a [[f64; D]],
+    lo: [f64; D],
     cell: f64,
-    dims: [usize; 2],
+    dims: [usize; D],
     start: Vec<usize>,
     sorted: Vec<usize>,
     r2: f64,
@@ -165,54 +177,51 @@ struct Cells<'a> {
 /// Most cells in the grid (4 Mi: 32 MiB of cell starts).
 const MAX_CELLS: f64 = 4_194_304.0;
 
-impl<'a> Cells<'a> {
+impl<'a, const D: usize> Cells<'a, D> {
     /// The grid, or `None` for no points.
-    fn new(points: &'a [[f64; 2]], radius: f64) -> Option<Self> {
+    fn new(points: &'a [[f64; D]], radius: f64) -> Option<Self> {
         if points.is_empty() {
             return None;
         }
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
         for p in points {
-            for d in 0..2 {
+            for d in 0..D {
                 lo[d] = lo[d].min(p[d]);
                 hi[d] = hi[d].max(p[d]);
             }
         }
-        // Cells no smaller than the radius (so the 3 x 3 block around a
-        // point holds all its neighbours), and no more than MAX_CELLS in
+        // Cells no smaller than the radius (so the block of 3^D cells around
+        // a point holds all its neighbours), and no more than MAX_CELLS in
         // all: one particle flung far away makes the cells coarser (more
         // candidates), not the grid too large to allocate. At most about a
         // thousand doublings, from the smallest positive radius to 1e308.
-        let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         let mut cell = radius.max(f64::MIN_POSITIVE);
-        while (w / cell + 1.0) * (h / cell + 1.0) > MAX_CELLS {
+        let count = |cell: f64| {
+            (0..D)
+                .map(|d| (hi[d] - lo[d]) / cell + 1.0)
+                .product::<f64>()
+        };
+        while count(cell) > MAX_CELLS {
             cell *= 2.0;
         }
-        let dims = [
-            (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1),
-            (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1),
-        ];
+        let dims: [usize; D] =
+            std::array::from_fn(|d| (((hi[d] - lo[d]) / cell).floor() as usize + 1).max(1));
+        let total: usize = dims.iter().product();
         let mut grid = Cells {
             points,
             lo,
             cell,
             dims,
-            start: vec![0; dims[0] * dims[1] + 1],
+            start: vec![0; total + 1],
             sorted: vec![0; points.len()],
             r2: radius * radius,
         };
         // Counting sort of the points into cells, ascending within a cell.
-        let cells: Vec<usize> = points
-            .iter()
-            .map(|p| {
-                let c = grid.cell_of(p);
-                c[1] * dims[0] + c[0]
-            })
-            .collect();
+        let cells: Vec<usize> = points.iter().map(|p| grid.id(grid.cell_of(p))).collect();
         for &c in &cells {
             grid.start[c + 1] += 1;
         }
-        for c in 0..dims[0] * dims[1] {
+        for c in 0..total {
             grid.start[c + 1] += grid.start[c];
         }
         let mut fill = grid.start.clone();
@@ -223,27 +232,44 @@ impl<'a> Cells<'a> {
         Some(grid)
     }
 
-    fn cell_of(&self, p: &[f64; 2]) -> [usize; 2] {
-        [
-            (((p[0] - self.lo[0]) / self.cell) as usize).min(self.dims[0] - 1),
-            (((p[1] - self.lo[1]) / self.cell) as usize).min(self.dims[1] - 1),
-        ]
+    fn cell_of(&self, p: &[f64; D]) -> [usize; D] {
+        std::array::from_fn(|d| (((p[d] - self.lo[d]) / self.cell) as usize).min(self.dims[d] - 1))
+    }
+
+    /// The number of a cell, first axis fastest.
+    fn id(&self, c: [usize; D]) -> usize {
+        (0..D).rev().fold(0, |id, d| id * self.dims[d] + c[d])
     }
 
     /// Calls `f(j)` for every point `j` within the radius of `p`, cell by
-    /// cell (not in index order).
+    /// cell (not in index order). The cells next to each other along the
+    /// first axis are numbered in a row, so their points are one slice.
     #[inline]
-    fn visit(&self, p: &[f64; 2], mut f: impl FnMut(usize)) {
+    fn visit(&self, p: &[f64; D], mut f: impl FnMut(usize)) {
         let c = self.cell_of(p);
-        let dims = self.dims;
-        for cy in c[1].saturating_sub(1)..=(c[1] + 1).min(dims[1] - 1) {
-            for cx in c[0].saturating_sub(1)..=(c[0] + 1).min(dims[0] - 1) {
-                let id = cy * dims[0] + cx;
-                for &j in &self.sorted[self.start[id]..self.start[id + 1]] {
-                    if dist2(p, &self.points[j]) <= self.r2 {
-                        f(j);
-                    }
+        let lo: [usize; D] = std::array::from_fn(|d| c[d].saturating_sub(1));
+        let hi: [usize; D] = std::array::from_fn(|d| (c[d] + 1).min(self.dims[d] - 1));
+        // Odometer over the other axes; the first axis is the run.
+        let mut at = lo;
+        loop {
+            let first = self.id(at);
+            let last = first + (hi[0] - lo[0]);
+            for &j in &self.sorted[self.start[first]..self.start[last + 1]] {
+                if dist2(p, &self.points[j]) <= self.r2 {
+                    f(j);
                 }
+            }
+            let mut d = 1;
+            loop {
+                if d == D {
+                    return;
+                }
+                if at[d] < hi[d] {
+                    at[d] += 1;
+                    break;
+                }
+                at[d] = lo[d];
+                d += 1;
             }
         }
     }
@@ -253,8 +279,9 @@ impl<'a> Cells<'a> {
 mod tests {
     use super::*;
 
-    /// A small deterministic pseudo-random generator (xorshift) for test data.
-    fn points(n: usize, seed: u64) -> Vec<[f64; 2]> {
+    /// `n` deterministic pseudo-random points (xorshift) in a box that is
+    /// longer along some axes than others.
+    fn points<const D: usize>(n: usize, seed: u64) -> Vec<[f64; D]> {
         let mut s = seed;
         let mut next = move || {
             s ^= s << 13;
@@ -262,32 +289,58 @@ mod tests {
             s ^= s << 17;
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
-        (0..n).map(|_| [next() * 3.0, next() * 7.0 - 2.0]).collect()
+        let side = [3.0, 7.0, 2.0];
+        (0..n)
+            .map(|_| std::array::from_fn(|d| next() * side[d % 3] - d as f64))
+            .collect()
+    }
+
+    /// A lattice of spacing 0.1 with `k` points along each axis.
+    fn lattice<const D: usize>(k: usize) -> Vec<[f64; D]> {
+        (0..k.pow(D as u32))
+            .map(|m| std::array::from_fn(|d| ((m / k.pow(d as u32)) % k) as f64 * 0.1))
+            .collect()
     }
 
     #[test]
     fn cell_list_equals_naive_oracle_on_random_points() {
         for (n, r, seed) in [(1, 0.3, 1), (500, 0.3, 7), (2000, 0.17, 99), (300, 5.0, 3)] {
-            let p = points(n, seed);
-            assert_eq!(cell_list(&p, r), naive(&p, r), "n={n} r={r}");
+            let p = points::<2>(n, seed);
+            assert_eq!(cell_list(&p, r), naive(&p, r), "2-D n={n} r={r}");
         }
+        for (n, r, seed) in [(1, 0.3, 1), (800, 0.4, 7), (3000, 0.3, 99), (300, 5.0, 3)] {
+            let p = points::<3>(n, seed);
+            assert_eq!(cell_list(&p, r), naive(&p, r), "3-D n={n} r={r}");
+        }
+        let p = points::<1>(400, 5);
+        assert_eq!(cell_list(&p, 0.02), naive(&p, 0.02), "1-D");
     }
 
     #[test]
     fn cell_list_equals_naive_on_a_lattice_with_points_on_the_radius() {
         // Lattice spacing 0.1, radius exactly 3 spacings: pairs at the radius.
-        let p: Vec<[f64; 2]> = (0..400)
-            .map(|k| [(k % 20) as f64 * 0.1, (k / 20) as f64 * 0.1])
-            .collect();
+        let p = lattice::<2>(20);
         assert_eq!(cell_list(&p, 0.3), naive(&p, 0.3));
+        let p = lattice::<3>(9);
+        assert_eq!(cell_list(&p, 0.3), naive(&p, 0.3));
+        // In 3-D the centre of the lattice has the 179 lattice points of the
+        // ball of radius 3.5 spacings as neighbours (none on its surface).
+        let centre = 4 + 9 * 4 + 81 * 4;
+        assert_eq!(cell_list(&p, 0.35).of(centre).len(), 179);
     }
 
     #[test]
     fn first_rows_only_equal_the_oracle_rows() {
-        let p = points(700, 11);
+        let p = points::<2>(700, 11);
         let full = naive(&p, 0.25);
         let part = cell_list_first(&p, 300, 0.25);
         assert_eq!(part.len(), 300);
+        for i in 0..300 {
+            assert_eq!(part.of(i), full.of(i));
+        }
+        let p = points::<3>(700, 11);
+        let full = naive(&p, 0.5);
+        let part = cell_list_first(&p, 300, 0.5);
         for i in 0..300 {
             assert_eq!(part.of(i), full.of(i));
         }
@@ -305,24 +358,29 @@ mod tests {
     fn a_point_flung_far_away_coarsens_the_grid_and_the_lists_stay_exact() {
         // At the radius the grid would need 1e22 cells; capped, it is
         // coarser and the lists still equal the oracle's.
-        let mut p = points(200, 7);
+        let mut p = points::<2>(200, 7);
         p.push([1e8, -1e8]);
         p.push([f64::MAX / 4.0, 0.0]);
         let nl = cell_list(&p, 0.05);
         assert_eq!(nl, naive(&p, 0.05));
+        let mut p = points::<3>(300, 7);
+        p.push([1e8, -1e8, 1e8]);
+        p.push([0.0, f64::MAX / 4.0, -f64::MAX / 4.0]);
+        let nl = cell_list(&p, 0.1);
+        assert_eq!(nl, naive(&p, 0.1));
     }
 
-    #[test]
-    fn padded_rows_equal_the_cell_list_rows() {
-        let p = points(900, 5);
-        let want = cell_list_first(&p, 600, 0.3);
+    /// [`padded_rows`] against [`cell_list_first`] for points of any
+    /// dimension.
+    fn padded_rows_match<const D: usize>(p: &[[f64; D]], r: f64) {
+        let want = cell_list_first(p, 600, r);
         let (mut rows, mut len) = (Vec::new(), Vec::new());
         // No rows at all.
-        assert_eq!(padded_rows(&p, 0, 0.3, 8, 64, &mut rows, &mut len), 8);
+        assert_eq!(padded_rows(p, 0, r, 8, 64, &mut rows, &mut len), 8);
         assert!(rows.is_empty() && len.is_empty());
         // Too short a hint, too long a hint, and the right one.
         for hint in [1, 200, 0] {
-            let stride = padded_rows(&p, 600, 0.3, 8, hint, &mut rows, &mut len);
+            let stride = padded_rows(p, 600, r, 8, hint, &mut rows, &mut len);
             let longest = (0..600).map(|i| want.of(i).len()).max().unwrap();
             assert_eq!(stride, longest.next_multiple_of(8), "hint {hint}");
             for i in 0..600 {
@@ -333,5 +391,11 @@ mod tests {
                 assert_eq!(got, want.of(i), "hint {hint}, point {i}");
             }
         }
+    }
+
+    #[test]
+    fn padded_rows_equal_the_cell_list_rows() {
+        padded_rows_match(&points::<2>(900, 5), 0.3);
+        padded_rows_match(&points::<3>(900, 5), 0.6);
     }
 }
