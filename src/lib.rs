@@ -34,6 +34,7 @@ pub mod msph;
 pub mod neighbors;
 pub mod observe;
 pub mod report;
+pub mod rod;
 pub mod scene;
 mod sim;
 pub mod solver;

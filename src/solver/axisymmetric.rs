@@ -45,10 +45,8 @@ use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
 use crate::neighbors::padded_rows;
 use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
+use crate::rod::{RodObservables, RodSets};
 use crate::scene::taylor::TaylorParams;
-
-/// Radial strain below which the rod counts as undeformed (0.2 %).
-pub const UNDEFORMED_STRAIN: f64 = 0.002;
 
 /// Smallest distance between two neighbouring particles (every pair, mirror
 /// images included), relative to the initial spacing, below which a run
@@ -1475,41 +1473,25 @@ impl TaylorSolver {
         mv / m
     }
 
+    /// The rod's particle sets: the face row, the mantle column from the
+    /// face up, and the tail on the axis.
+    pub fn rod_sets(&self) -> RodSets {
+        let (nr, nz) = (self.nr, self.nz);
+        RodSets {
+            face: self.face.particles.clone(),
+            mantle: (0..nz).map(|k| k * nr + nr - 1).collect(),
+            tail: (nz - 1) * nr,
+        }
+    }
+
     /// Current values of [`TAYLOR_OBSERVABLES`], in that order.
     pub fn observables(&self) -> Vec<f64> {
-        let (nr, nz) = (self.nr, self.nz);
-        let (zmin, zmax) = self
-            .pos
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(x[1]), hi.max(x[1]))
-            });
-        let mushroom = self
-            .face
-            .particles
-            .iter()
-            .map(|&i| self.pos[i][0])
-            .fold(0.0, f64::max);
-        // Undeformed length: walk down the mantle from the free end.
-        let strain = |k: usize| self.pos[k * nr + nr - 1][0] / self.r0 - 1.0;
-        let z_of = |k: usize| self.pos[k * nr + nr - 1][1];
-        let z_top = z_of(nz - 1);
-        let mut undeformed = z_top - z_of(0);
-        for k in (0..nz - 1).rev() {
-            if strain(k) >= UNDEFORMED_STRAIN {
-                let (s0, s1) = (strain(k + 1), strain(k));
-                let frac = ((UNDEFORMED_STRAIN - s0) / (s1 - s0)).clamp(0.0, 1.0);
-                let z = z_of(k + 1) + frac * (z_of(k) - z_of(k + 1));
-                undeformed = z_top - z;
-                break;
-            }
-        }
-        let tail = (nz - 1) * nr;
+        let rod = RodObservables::of(&self.rod_sets(), &self.pos, &self.vel, self.r0);
         let values = [
-            zmax - zmin,
-            mushroom,
-            undeformed,
-            -self.vel[tail][1],
+            rod.rod_length,
+            rod.mushroom_radius,
+            rod.undeformed_length,
+            rod.tail_velocity,
             self.pos[0][1],
             self.eps_p.iter().copied().fold(0.0, f64::max),
             self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max),
