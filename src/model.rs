@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::isa::Isa;
-use crate::observe::Snapshot;
+use crate::observe::FieldSpec;
 use std::any::Any;
 
 /// What every solver state offers alike: copies, saving, and its own type
@@ -55,8 +55,13 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// observable table.
     fn observables(&self) -> Vec<f64>;
 
-    /// Particle positions and fields now.
-    fn snapshot(&self) -> Snapshot;
+    /// The particle fields this run offers, `position` first.
+    fn field_specs(&self) -> &'static [FieldSpec];
+
+    /// The current values of the particle field `name`, interleaved per
+    /// particle (`particles * components`), or `None` for a name not in
+    /// [`Model::field_specs`]. Only that field is computed.
+    fn field(&self, name: &str) -> Option<Vec<f64>>;
 
     /// Simulated time between two records of the observables' histories.
     fn record_interval(&self) -> f64;
@@ -89,7 +94,7 @@ pub(crate) fn same_solver<T: 'static>(fresh: &dyn Model) -> std::result::Result<
 
 /// Inside `impl Model for T`: the methods that call `T`'s inherent methods
 /// of the same names (`time`, `steps`, `particles`, `finished`, `step`,
-/// `observables`, `snapshot`).
+/// `observables`, `field`).
 macro_rules! inherent_basics {
     () => {
         fn time(&self) -> f64 {
@@ -110,8 +115,8 @@ macro_rules! inherent_basics {
         fn observables(&self) -> Vec<f64> {
             Self::observables(self)
         }
-        fn snapshot(&self) -> $crate::observe::Snapshot {
-            Self::snapshot(self)
+        fn field(&self, name: &str) -> Option<Vec<f64>> {
+            Self::field(self, name)
         }
     };
 }

@@ -126,6 +126,18 @@ impl History {
     }
 }
 
+/// Name, unit and components of a particle field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FieldSpec {
+    /// Field name (for example `stress`); the first field of every scene is
+    /// `position`.
+    pub name: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// Names of the components, in storage order.
+    pub components: &'static [&'static str],
+}
+
 /// One named particle field of a snapshot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Field {
@@ -151,6 +163,31 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
+    /// Every field of a run now: `position` as the positions (R, Z; a
+    /// position of one component gets Z = 0), the others as fields.
+    pub fn of(model: &dyn crate::model::Model) -> Snapshot {
+        let specs = model.field_specs();
+        let value = |name| model.field(name).expect("a field the model lists");
+        let (position, rest) = specs.split_first().expect("every scene has positions");
+        let k = position.components.len();
+        Snapshot {
+            time: model.time(),
+            positions: value(position.name)
+                .chunks(k)
+                .map(|c| [c[0], c.get(1).copied().unwrap_or(0.0)])
+                .collect(),
+            fields: rest
+                .iter()
+                .map(|f| Field {
+                    name: f.name,
+                    components: f.components,
+                    unit: f.unit,
+                    data: value(f.name),
+                })
+                .collect(),
+        }
+    }
+
     /// The field called `name`.
     pub fn field(&self, name: &str) -> Option<&Field> {
         self.fields.iter().find(|f| f.name == name)

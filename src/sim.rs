@@ -6,7 +6,7 @@
 use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::model::Model;
-use crate::observe::{History, ObservableSpec, Snapshot};
+use crate::observe::{FieldSpec, History, ObservableSpec, Snapshot};
 use crate::scene::{Scene, SceneKind};
 use std::collections::BTreeMap;
 
@@ -211,6 +211,17 @@ impl Simulation {
         Some(self.observables()[k])
     }
 
+    /// The particle fields of this run, `position` first.
+    pub fn field_specs(&self) -> &'static [FieldSpec] {
+        self.solver.field_specs()
+    }
+
+    /// The current values of one particle field, interleaved per particle;
+    /// only that field is computed.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        self.solver.field(name)
+    }
+
     /// Recorded time histories of the observables.
     pub fn history(&self) -> &History {
         &self.history
@@ -218,7 +229,7 @@ impl Simulation {
 
     /// Particle positions and fields now.
     pub fn snapshot(&self) -> Snapshot {
-        self.solver.snapshot()
+        Snapshot::of(self.solver.as_ref())
     }
 
     fn record(&mut self) {

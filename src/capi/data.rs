@@ -269,19 +269,15 @@ pub struct mi_field_info {
     pub component_names: *const *const c_char,
 }
 
-/// The position pseudo-field, first of every scene's fields.
-const POSITION: (&str, &str, &[&str]) = ("position", "m", &["R", "Z"]);
-
 fn field_meta(s: &mut mi_sim) -> Result<&[FieldMeta], Fail> {
     if s.meta.fields.is_none() {
-        let snap = s.sim()?.snapshot();
-        let mut v = vec![meta(POSITION.0, POSITION.1, POSITION.2)];
-        v.extend(
-            snap.fields
+        let specs = s.sim()?.field_specs();
+        s.meta.fields = Some(
+            specs
                 .iter()
-                .map(|f| meta(f.name, f.unit, f.components)),
+                .map(|f| meta(f.name, f.unit, f.components))
+                .collect(),
         );
-        s.meta.fields = Some(v);
     }
     Ok(s.meta.fields.as_deref().expect("set above"))
 }
@@ -343,17 +339,6 @@ pub unsafe extern "C" fn mi_sim_field_info(
     })
 }
 
-fn field_values(sim: &Simulation, name: &str) -> Option<Vec<f64>> {
-    let snap = sim.snapshot();
-    if name == POSITION.0 {
-        return Some(snap.positions.iter().flatten().copied().collect());
-    }
-    snap.fields
-        .into_iter()
-        .find(|f| f.name == name)
-        .map(|f| f.data)
-}
-
 /// Copies the current values of the particle field `name` by the buffer
 /// convention: `particles * components` doubles, interleaved per particle
 /// (for `"stress"`: RR, ZZ, TT, RZ of particle 0, then of particle 1, ...).
@@ -372,7 +357,7 @@ pub unsafe extern "C" fn mi_sim_field(
         // SAFETY: forwarded contract on `name`.
         let n = unsafe { text(name, "name") }?;
         check_buf(buf, len, "buf")?;
-        let Some(v) = field_values(s.sim()?, n) else {
+        let Some(v) = s.sim()?.field(n) else {
             let names: Vec<String> = field_meta(s)?
                 .iter()
                 .map(|f| f.name.to_string_lossy().into_owned())

@@ -44,7 +44,7 @@ use crate::lanes::W;
 use crate::material::eos::LinearEos;
 use crate::material::johnson_cook::{JohnsonCook, radial_return};
 use crate::neighbors::padded_rows;
-use crate::observe::{Field, Snapshot, TAYLOR_OBSERVABLES};
+use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{RodObservables, RodSets};
 use crate::scene::taylor::TaylorParams;
 
@@ -1506,67 +1506,77 @@ impl TaylorSolver {
         values.to_vec()
     }
 
-    /// Particle positions and fields.
-    pub fn snapshot(&self) -> Snapshot {
-        let stress: Vec<f64> = self
-            .dev
-            .iter()
-            .zip(&self.pressure)
-            .flat_map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3]])
-            .collect();
-        Snapshot {
-            time: self.time,
-            positions: self.pos.clone(),
-            fields: vec![
-                Field {
-                    name: "density",
-                    components: &["rho"],
-                    unit: "kg/m3",
-                    data: self.rho.clone(),
-                },
-                Field {
-                    name: "velocity",
-                    components: &["R", "Z"],
-                    unit: "m/s",
-                    data: self.vel.iter().flat_map(|v| *v).collect(),
-                },
-                Field {
-                    name: "pressure",
-                    components: &["P"],
-                    unit: "Pa",
-                    data: self.pressure.clone(),
-                },
-                Field {
-                    name: "stress",
-                    components: &["RR", "ZZ", "TT", "RZ"],
-                    unit: "Pa",
-                    data: stress,
-                },
-                Field {
-                    name: "plastic_strain",
-                    components: &["eps_p"],
-                    unit: "1",
-                    data: self.eps_p.clone(),
-                },
-                Field {
-                    name: "temperature",
-                    components: &["T"],
-                    unit: "K",
-                    data: self.temp.clone(),
-                },
-                Field {
-                    name: "in_contact",
-                    components: &["contact"],
-                    unit: "bool",
-                    data: self.contact.iter().map(|&c| c as u8 as f64).collect(),
-                },
-            ],
-        }
+    /// The values of the particle field `name` (one of [`TAYLOR_FIELDS`]),
+    /// interleaved per particle.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        Some(match name {
+            "position" => self.pos.iter().flatten().copied().collect(),
+            "density" => self.rho.clone(),
+            "velocity" => self.vel.iter().flatten().copied().collect(),
+            "pressure" => self.pressure.clone(),
+            "stress" => self
+                .dev
+                .iter()
+                .zip(&self.pressure)
+                .flat_map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3]])
+                .collect(),
+            "plastic_strain" => self.eps_p.clone(),
+            "temperature" => self.temp.clone(),
+            "in_contact" => self.contact.iter().map(|&c| c as u8 as f64).collect(),
+            _ => return None,
+        })
     }
 }
 
+/// The particle fields of the Taylor solver.
+pub const TAYLOR_FIELDS: &[FieldSpec] = &[
+    FieldSpec {
+        name: "position",
+        unit: "m",
+        components: &["R", "Z"],
+    },
+    FieldSpec {
+        name: "density",
+        unit: "kg/m3",
+        components: &["rho"],
+    },
+    FieldSpec {
+        name: "velocity",
+        unit: "m/s",
+        components: &["R", "Z"],
+    },
+    FieldSpec {
+        name: "pressure",
+        unit: "Pa",
+        components: &["P"],
+    },
+    FieldSpec {
+        name: "stress",
+        unit: "Pa",
+        components: &["RR", "ZZ", "TT", "RZ"],
+    },
+    FieldSpec {
+        name: "plastic_strain",
+        unit: "1",
+        components: &["eps_p"],
+    },
+    FieldSpec {
+        name: "temperature",
+        unit: "K",
+        components: &["T"],
+    },
+    FieldSpec {
+        name: "in_contact",
+        unit: "bool",
+        components: &["contact"],
+    },
+];
+
 impl crate::model::Model for TaylorSolver {
     crate::model::inherent_basics!();
+    fn field_specs(&self) -> &'static [FieldSpec] {
+        TAYLOR_FIELDS
+    }
     /// 64 records per elastic transit of the rod.
     fn record_interval(&self) -> f64 {
         self.p.initial_length / self.wave_speed() / 64.0

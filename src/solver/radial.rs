@@ -44,7 +44,7 @@ use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
 use crate::msph::{Msph1Rows, Row1};
 use crate::neighbors::{NeighborList, cell_list};
-use crate::observe::{Field, NOH_OBSERVABLES, Snapshot};
+use crate::observe::{FieldSpec, NOH_OBSERVABLES};
 use crate::scene::noh::{NohParams, POST_SHOCK_WINDOW, PRE_SHOCK_WINDOW};
 use rayon::prelude::*;
 
@@ -487,43 +487,54 @@ impl NohSolver {
         values
     }
 
-    /// Particle positions and fields.
-    pub fn snapshot(&self) -> Snapshot {
-        Snapshot {
-            time: self.time,
-            positions: self.r.iter().map(|&r| [r, 0.0]).collect(),
-            fields: vec![
-                Field {
-                    name: "density",
-                    components: &["rho"],
-                    unit: "1",
-                    data: self.rho.clone(),
-                },
-                Field {
-                    name: "velocity",
-                    components: &["R"],
-                    unit: "1",
-                    data: self.v.clone(),
-                },
-                Field {
-                    name: "pressure",
-                    components: &["P"],
-                    unit: "1",
-                    data: self.pres.clone(),
-                },
-                Field {
-                    name: "specific_energy",
-                    components: &["e"],
-                    unit: "1",
-                    data: self.e.clone(),
-                },
-            ],
-        }
+    /// The values of the particle field `name` (one of [`NOH_FIELDS`]),
+    /// interleaved per particle.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        Some(match name {
+            "position" => self.r.iter().flat_map(|&r| [r, 0.0]).collect(),
+            "density" => self.rho.clone(),
+            "velocity" => self.v.clone(),
+            "pressure" => self.pres.clone(),
+            "specific_energy" => self.e.clone(),
+            _ => return None,
+        })
     }
 }
 
+/// The particle fields of the Noh solver (positions in the R-Z plane, Z = 0).
+pub const NOH_FIELDS: &[FieldSpec] = &[
+    FieldSpec {
+        name: "position",
+        unit: "1",
+        components: &["R", "Z"],
+    },
+    FieldSpec {
+        name: "density",
+        unit: "1",
+        components: &["rho"],
+    },
+    FieldSpec {
+        name: "velocity",
+        unit: "1",
+        components: &["R"],
+    },
+    FieldSpec {
+        name: "pressure",
+        unit: "1",
+        components: &["P"],
+    },
+    FieldSpec {
+        name: "specific_energy",
+        unit: "1",
+        components: &["e"],
+    },
+];
+
 impl crate::model::Model for NohSolver {
     crate::model::inherent_basics!();
+    fn field_specs(&self) -> &'static [FieldSpec] {
+        NOH_FIELDS
+    }
     /// 600 records over the run.
     fn record_interval(&self) -> f64 {
         self.p.end_time / 600.0
