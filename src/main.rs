@@ -51,14 +51,16 @@ enum Command {
     },
     /// Print a built-in scene as a TOML scene file.
     Scene {
-        /// Scene name (`taylor`, `noh`, `table1-1` ... `table1-12`).
+        /// Scene name (`meshless-impact scenes` lists them).
         name: String,
     },
+    /// List the built-in scenes with their titles.
+    Scenes,
 }
 
 #[derive(Args, Default)]
 struct RunArgs {
-    /// Built-in scene: taylor, noh, table1-1 ... table1-12.
+    /// Built-in scene (`meshless-impact scenes` lists them).
     #[arg(default_value = "taylor", conflicts_with = "scene_file")]
     scene: String,
     /// Read the scene from a TOML file instead.
@@ -186,6 +188,7 @@ fn try_main() -> Result<(), Stop> {
         Some(Command::Report { out, quick }) => report(out, quick)?,
         Some(Command::Params { scene }) => params(&scene)?,
         Some(Command::Observables { scene }) => observables(&scene)?,
+        Some(Command::Scenes) => scenes()?,
         Some(Command::Scene { name }) => {
             let toml = Scene::builtin(&name)?.to_toml();
             write!(std::io::stdout(), "{toml}").map_err(|e| Stop::write("stdout", e))?;
@@ -510,6 +513,13 @@ fn params(scene: &str) -> Result<(), Stop> {
             p.range.to_string(),
             p.description
         )?;
+    }
+    Ok(())
+}
+
+fn scenes() -> Result<(), Stop> {
+    for name in meshless_impact::scene::builtin_names() {
+        outln!("{:<12} {}", name, Scene::builtin(&name)?.title)?;
     }
     Ok(())
 }

@@ -182,6 +182,22 @@ fn params_lists_units_defaults_and_ranges() {
     assert!(!text.contains("jc_a"), "Noh takes no strength parameters");
 }
 
+#[test]
+fn scenes_lists_every_built_in_scene_once_with_its_title() {
+    let out = bin().arg("scenes").output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let names: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert_eq!(names, meshless_impact::scene::builtin_names());
+    assert!(
+        text.lines().next().unwrap().contains("House et al. test 7"),
+        "{text}"
+    );
+}
+
 /// Every subcommand that prints to stdout, with the small run and sweep.
 fn printing_commands(dir: &Path) -> Vec<Vec<String>> {
     let strings = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
@@ -192,6 +208,7 @@ fn printing_commands(dir: &Path) -> Vec<Vec<String>> {
         strings(&["params", "taylor"]),
         strings(&["observables", "taylor"]),
         strings(&["scene", "taylor"]),
+        strings(&["scenes"]),
         strings(&SMALL_RUN),
         sweep,
         strings(&["--help"]),
