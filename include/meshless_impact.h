@@ -137,6 +137,11 @@ typedef enum {
      */
     MI_SPACING_COLLAPSE = 26,
     /**
+     * The run stopped: a particle was compressed to the singular point of
+     * its equation of state (Mie-Grüneisen, `1 / (eos_s - 1)`).
+     */
+    MI_COMPRESSION_LIMIT = 27,
+    /**
      * A panic inside the library was caught at the boundary. The handle is
      * unusable afterwards (every call but `mi_sim_last_error` and
      * `mi_sim_free` returns `MI_PANIC`).

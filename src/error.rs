@@ -120,6 +120,22 @@ pub enum Error {
         /// What to try, or empty.
         hint: &'static str,
     },
+    /// A particle was compressed to or past the singular point of its
+    /// equation of state (Mie-Grüneisen: `1 - (s - 1) mu = 0`).
+    #[error(
+        "compression mu = {compression:.4e} at particle {particle} reached the limit {limit:.4e} \
+         of the Mie-Grüneisen equation of state, 1 / (eos_s - 1) (t = {time:.4e} s)"
+    )]
+    CompressionLimit {
+        /// Particle index.
+        particle: usize,
+        /// Simulated time.
+        time: f64,
+        /// The compression `rho / rho0 - 1` reached.
+        compression: f64,
+        /// The singular compression.
+        limit: f64,
+    },
     /// The caller cancelled the run from a progress callback.
     #[error("run cancelled by the caller at t = {time:.4e} s")]
     Cancelled {
@@ -156,6 +172,7 @@ impl Error {
             Error::TimeStepCollapse { .. } => "TimeStepCollapse",
             Error::EnergyDrift { .. } => "EnergyDrift",
             Error::SpacingCollapse { .. } => "SpacingCollapse",
+            Error::CompressionLimit { .. } => "CompressionLimit",
             Error::Cancelled { .. } => "Cancelled",
             Error::InvalidState(_) => "InvalidState",
             Error::Io { .. } => "Io",

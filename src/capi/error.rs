@@ -61,6 +61,9 @@ pub enum mi_result {
     /// The run stopped: two neighbouring particles came closer than the
     /// bound on their spacing (a fraction of the initial spacing).
     MI_SPACING_COLLAPSE = 26,
+    /// The run stopped: a particle was compressed to the singular point of
+    /// its equation of state (Mie-Grüneisen, `1 / (eos_s - 1)`).
+    MI_COMPRESSION_LIMIT = 27,
     /// A panic inside the library was caught at the boundary. The handle is
     /// unusable afterwards (every call but `mi_sim_last_error` and
     /// `mi_sim_free` returns `MI_PANIC`).
@@ -172,6 +175,11 @@ pub(crate) const RESULTS: &[(mi_result, &str, &str)] = &[
         "the particle spacing collapsed\0",
     ),
     (
+        mi_result::MI_COMPRESSION_LIMIT,
+        "MI_COMPRESSION_LIMIT\0",
+        "a compression reached the limit of the equation of state\0",
+    ),
+    (
         mi_result::MI_PANIC,
         "MI_PANIC\0",
         "a panic inside the library was caught\0",
@@ -211,6 +219,7 @@ pub(crate) fn code_of(e: &Error) -> mi_result {
         Error::TimeStepCollapse { .. } => MI_TIME_STEP_COLLAPSE,
         Error::EnergyDrift { .. } => MI_ENERGY_DRIFT,
         Error::SpacingCollapse { .. } => MI_SPACING_COLLAPSE,
+        Error::CompressionLimit { .. } => MI_COMPRESSION_LIMIT,
         Error::Cancelled { .. } => MI_CANCELLED,
         Error::InvalidState(_) => MI_INVALID_STATE,
         Error::Io { .. } => MI_IO,
@@ -255,6 +264,6 @@ mod tests {
             assert!(name.ends_with('\0') && desc.ends_with('\0'));
             assert_eq!(format!("{code:?}\0"), *name);
         }
-        assert_eq!(RESULTS.len(), 23);
+        assert_eq!(RESULTS.len(), 24);
     }
 }

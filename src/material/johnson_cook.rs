@@ -1,5 +1,5 @@
-//! Johnson-Cook thermo-viscoplasticity, eq. (3.7), with the radial return of
-//! eqs. (3.11)-(3.21).
+//! Johnson-Cook thermo-viscoplasticity, eq. (3.7); its radial return, eqs.
+//! (3.11)-(3.21), is [`super::tensor::radial_return`].
 //!
 //! Conventions (the usual ones of Johnson-Cook users, and documented in the
 //! README): the rate term uses `max(eps_dot / eps_dot0, 1)`, so strain rates
@@ -83,46 +83,6 @@ impl JohnsonCook {
     }
 }
 
-/// Deviatoric stress in cylindrical components (RR, ZZ, theta-theta, RZ).
-pub type Deviator = [f64; 4];
-
-/// `sqrt(3/2 S:S)` for a deviator stored as (RR, ZZ, TT, RZ).
-#[inline]
-pub fn von_mises(s: &Deviator) -> f64 {
-    (1.5 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + 2.0 * s[3] * s[3])).sqrt()
-}
-
-/// Result of a radial return.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Return {
-    /// Deviatoric stress after the return.
-    pub stress: Deviator,
-    /// Effective plastic strain increment, eq. (3.21).
-    pub plastic_strain: f64,
-    /// Plastic work per unit volume, `S : d eps_p = sigma_y d eps_p`.
-    pub plastic_work: f64,
-}
-
-/// Scales the trial deviator back to the yield surface, eqs. (3.12)-(3.21).
-#[inline]
-pub fn radial_return(trial: &Deviator, yield_stress: f64, shear_modulus: f64) -> Return {
-    let s_eq = von_mises(trial);
-    if s_eq <= yield_stress || s_eq == 0.0 {
-        return Return {
-            stress: *trial,
-            plastic_strain: 0.0,
-            plastic_work: 0.0,
-        };
-    }
-    let f = yield_stress / s_eq;
-    let deps = (1.0 - f) * s_eq / (3.0 * shear_modulus);
-    Return {
-        stress: trial.map(|x| f * x),
-        plastic_strain: deps,
-        plastic_work: yield_stress * deps,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -155,26 +115,5 @@ mod tests {
         // At and above melt: zero strength, no NaN.
         assert_eq!(jc.flow_stress(0.3, 1e5, 1293.0), 0.0);
         assert_eq!(jc.flow_stress(0.3, 1e5, 5000.0), 0.0);
-    }
-
-    #[test]
-    fn radial_return_lands_on_the_yield_surface() {
-        let mu = 82.9e9;
-        let trial = [1.2e9, -0.7e9, -0.5e9, 0.4e9];
-        let sy = 0.9e9;
-        let r = radial_return(&trial, sy, mu);
-        assert!((von_mises(&r.stress) - sy).abs() < 1e-6 * sy);
-        // Direction preserved, deviator stays traceless.
-        assert!((r.stress[0] / r.stress[3] - trial[0] / trial[3]).abs() < 1e-12);
-        assert!((r.stress[0] + r.stress[1] + r.stress[2]).abs() < 1e-3);
-        // eq. (3.21): d eps_p = (1 - f) S*/(3 mu), and the work is sigma_y d eps_p.
-        let s_eq = von_mises(&trial);
-        let expected = (1.0 - sy / s_eq) * s_eq / (3.0 * mu);
-        assert!((r.plastic_strain - expected).abs() < 1e-15);
-        assert!((r.plastic_work - sy * expected).abs() < 1e-6);
-        // Inside the surface nothing changes.
-        let e = radial_return(&[1e8, -1e8, 0.0, 0.0], sy, mu);
-        assert_eq!(e.plastic_strain, 0.0);
-        assert_eq!(e.stress, [1e8, -1e8, 0.0, 0.0]);
     }
 }

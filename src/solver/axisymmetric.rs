@@ -23,8 +23,9 @@
 //!    `v - alpha L(L v)`, `L v` = Shepard mean minus value, which damps the
 //!    particle-scale waves as (3.23) does and the resolved flow far less;
 //! 4. velocity gradients, continuity, conservative smoothing of the density;
-//! 5. stress update (Jaumann rate, trial deviator, Johnson-Cook radial return,
-//!    linear EOS), heating from plastic work, internal energy from stress power;
+//! 5. stress update by the material ([`Material::update`]: Jaumann rate, trial
+//!    deviator, radial return of its strength model, heating from plastic
+//!    work, its EOS), internal energy from stress power;
 //! 6. `x^{n+1} = x^n + dt v^{n+1/2}`, contact with the anvil (touch on reaching
 //!    Z = 0, release when sigma_ZZ turns tensile), traction-free stresses on
 //!    the free surfaces, next time step.
@@ -42,7 +43,8 @@ use crate::isa::Isa;
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
 use crate::material::eos::LinearEos;
-use crate::material::johnson_cook::{JohnsonCook, radial_return};
+use crate::material::johnson_cook::JohnsonCook;
+use crate::material::{Damage, Eos, Loading, Material, MaterialState, Point, Strength};
 use crate::neighbors::padded_rows;
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{RodObservables, RodSets};
@@ -78,8 +80,11 @@ pub const ENERGY_ERROR_BOUND: f64 = 0.5;
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct TaylorSolver {
     p: TaylorParams,
-    jc: JohnsonCook,
-    eos: LinearEos,
+    material: Material,
+    /// Per-particle state of the material's models (caches only today: not
+    /// saved, rebuilt after a restore).
+    #[serde(skip)]
+    material_state: MaterialState,
     nr: usize,
     nz: usize,
     h: f64,
@@ -197,6 +202,9 @@ struct Tally {
     through: Option<(usize, &'static str, f64)>,
     /// First particle with a non-finite field: (particle, field).
     non_finite: Option<(usize, &'static str)>,
+    /// First particle compressed past the limit of the equation of state:
+    /// (particle, compression, limit).
+    compression: Option<(usize, f64, f64)>,
 }
 
 /// Buffers reused from step to step (no allocation in the time loop but when
@@ -254,34 +262,8 @@ struct Workspace {
     batches: Vec<BatchTally>,
     smoothing: Vec<[f64; 2]>,
     tallies: Vec<Tally>,
-    /// Johnson-Cook hardening and thermal factors of each particle with the
-    /// plastic strain and temperature they were computed for: reused while
-    /// both stay the same (a particle that does not yield), which spares two
-    /// `powf` and gives the same bits.
-    strength: Vec<Strength>,
     /// Neighbourhoods of the pair pass, one set per thread.
     scratch: ScratchPool,
-}
-
-/// A particle's Johnson-Cook factors and the state they belong to.
-#[derive(Debug, Clone, Copy)]
-struct Strength {
-    eps_p: f64,
-    temp: f64,
-    hardening: f64,
-    thermal: f64,
-}
-
-impl Default for Strength {
-    /// Matches no state (NaN equals nothing).
-    fn default() -> Self {
-        Strength {
-            eps_p: f64::NAN,
-            temp: f64::NAN,
-            hardening: 0.0,
-            thermal: 0.0,
-        }
-    }
 }
 
 /// The plane or planes a mirror image is reflected across: the axis R = 0,
@@ -401,8 +383,53 @@ fn non_finite(x: [f64; 2], v: [f64; 2], rho: f64, dev: Stress, temp: f64) -> Opt
 }
 
 impl TaylorSolver {
-    /// Sets up the rod at the instant of impact. `p` must be validated.
+    /// Sets up the rod at the instant of impact, of the material the
+    /// parameters describe ([`TaylorSolver::material_of`]). `p` must be
+    /// validated.
     pub fn new(p: TaylorParams) -> Result<Self> {
+        Self::with_material(p, Self::material_of(&p))
+    }
+
+    /// The material of the parameters: Johnson-Cook strength, the linear
+    /// equation of state, no damage.
+    pub fn material_of(p: &TaylorParams) -> Material {
+        Material {
+            eos: Eos::Linear(LinearEos {
+                bulk_modulus: p.bulk_modulus,
+                density: p.density,
+            }),
+            strength: Strength::JohnsonCook(JohnsonCook {
+                a: p.jc_a,
+                b: p.jc_b,
+                n: p.jc_n,
+                c: p.jc_c,
+                m: p.jc_m,
+                melt_temperature: p.melt_temperature,
+                room_temperature: p.room_temperature,
+                ref_strain_rate: p.ref_strain_rate,
+            }),
+            damage: Damage::None,
+            shear_modulus: p.shear_modulus,
+            specific_heat: p.specific_heat,
+            taylor_quinney: p.taylor_quinney,
+            reference_temperature: p.initial_temperature,
+        }
+    }
+
+    /// Sets up the rod at the instant of impact, of `material`: its
+    /// constants take the place of the material parameters of `p` (all but
+    /// `density`, which must be the reference density of its equation of
+    /// state, as the lattice masses use it). `p` must be validated.
+    pub fn with_material(p: TaylorParams, material: Material) -> Result<Self> {
+        material.validate()?;
+        if material.eos.reference_density() != Some(p.density) {
+            return Err(Error::Inconsistent(format!(
+                "the reference density of the equation of state ({:?} kg/m3) is not the rod's \
+                 density {} kg/m3",
+                material.eos.reference_density(),
+                p.density
+            )));
+        }
         let nr = p.particles_radial as usize;
         let r0 = 0.5 * p.initial_diameter;
         let d = r0 / (nr - 1) as f64;
@@ -438,23 +465,9 @@ impl TaylorSolver {
         let vel = vec![[0.0, -p.impact_speed]; n];
         let contact = (0..n).map(|i| i < nr).collect();
         let total_mass: f64 = mass.iter().sum();
-        let eos = LinearEos {
-            bulk_modulus: p.bulk_modulus,
-            density: p.density,
-        };
-        let jc = JohnsonCook {
-            a: p.jc_a,
-            b: p.jc_b,
-            n: p.jc_n,
-            c: p.jc_c,
-            m: p.jc_m,
-            melt_temperature: p.melt_temperature,
-            room_temperature: p.room_temperature,
-            ref_strain_rate: p.ref_strain_rate,
-        };
         let mut s = TaylorSolver {
-            jc,
-            eos,
+            material,
+            material_state: MaterialState::default(),
             nr,
             nz,
             h,
@@ -515,8 +528,7 @@ impl TaylorSolver {
             }
         };
         same("parameters", json(&self.p), json(&fresh.p))?;
-        same("material", json(&self.jc), json(&fresh.jc))?;
-        same("equation of state", json(&self.eos), json(&fresh.eos))?;
+        same("material", json(&self.material), json(&fresh.material))?;
         same(
             "lattice",
             json(&(self.nr, self.nz, self.h, self.r0)),
@@ -653,16 +665,16 @@ impl TaylorSolver {
 
     /// Longitudinal elastic wave speed sqrt((K + 4 mu / 3) / rho0).
     pub fn wave_speed(&self) -> f64 {
-        ((self.p.bulk_modulus + 4.0 / 3.0 * self.p.shear_modulus) / self.p.density).sqrt()
+        (self.material.longitudinal_modulus(self.p.density, 0.0) / self.p.density).sqrt()
     }
 
     fn stable_dt(&self) -> f64 {
-        let m = self.p.bulk_modulus + 4.0 / 3.0 * self.p.shear_modulus;
-        let worst = self
-            .rho
-            .iter()
-            .zip(&self.vel)
-            .map(|(rho, v)| wave_and_flow_speed(m, *rho, *v))
+        let m = &self.material;
+        let worst = (0..self.particles())
+            .map(|i| {
+                let (rho, p) = (self.rho[i], self.pressure[i]);
+                wave_and_flow_speed(m.longitudinal_modulus(rho, p), rho, self.vel[i])
+            })
             .fold(0.0, f64::max);
         COURANT * self.h / worst
     }
@@ -759,7 +771,6 @@ impl TaylorSolver {
         ws.batches.resize(n.div_ceil(W), BatchTally::default());
         ws.smoothing.resize(n.div_ceil(MIN_LEN), [0.0; 2]);
         ws.tallies.resize(n.div_ceil(MIN_LEN), Tally::default());
-        ws.strength.resize(n, Strength::default());
     }
 
     /// Whether a particle moved more than half the skin since the lists were
@@ -811,7 +822,7 @@ impl TaylorSolver {
             }
             // New lists may bring new mirror images, and pairs with them.
             let margin = if rebuilt { None } else { ws.shift_margin };
-            if self.p.shifting > 0.0 && self.shift(&mut ws, margin) && self.needs_rebuild(&ws) {
+            if self.p.shifting > 0.0 && self.shift(&mut ws, margin)? && self.needs_rebuild(&ws) {
                 self.rebuild_neighbours(&mut ws);
             }
             Team::lead(|team| self.step_in(&mut ws, team))
@@ -849,8 +860,9 @@ impl TaylorSolver {
     /// along. The kinetic energy the carrying changes is booked with the
     /// smoothing. With a `margin` ([`Workspace::shift_margin`]) only the
     /// particles that may have a neighbour within the range are looked at.
-    /// Returns whether a particle moved.
-    fn shift(&mut self, ws: &mut Workspace, margin: Option<f64>) -> bool {
+    /// Returns whether a particle moved, or the compression limit of the
+    /// equation of state at a moved particle.
+    fn shift(&mut self, ws: &mut Workspace, margin: Option<f64>) -> Result<bool> {
         let n = self.particles();
         let spacing = self.spacing();
         let mut free = self.freedoms();
@@ -862,7 +874,7 @@ impl TaylorSolver {
                 }
             }
             if free.iter().all(|f| *f == Freedom::Fixed) {
-                return false;
+                return Ok(false);
             }
         }
         ws.pos[..n].copy_from_slice(&self.pos);
@@ -883,7 +895,7 @@ impl TaylorSolver {
         );
         self.leave_axis(&free, spacing, &mut d);
         if d.iter().all(|d| *d == [0.0; 2]) {
-            return false;
+            return Ok(false);
         }
         let mut f: Vec<[f64; 9]> = (0..n)
             .map(|i| {
@@ -914,7 +926,15 @@ impl TaylorSolver {
             self.rho[i] = fi[6];
             self.eps_p[i] = fi[7].max(0.0);
             self.temp[i] = fi[8];
-            let p = self.eos.pressure(fi[6]);
+            let p = self
+                .material
+                .pressure(fi[6], fi[8])
+                .map_err(|l| Error::CompressionLimit {
+                    particle: i,
+                    time: self.time,
+                    compression: l.compression,
+                    limit: l.limit,
+                })?;
             self.pressure[i] = p;
             let s = self.dev[i];
             self.stress_bc[i] = [s[0] - p, s[1] - p, s[2] - p, s[3]];
@@ -924,7 +944,7 @@ impl TaylorSolver {
             self.pos[i] = [self.pos[i][0] + di[0], self.pos[i][1] + di[1]];
         }
         self.smoothing_dissipation += ke[0] - ke[1];
-        true
+        Ok(true)
     }
 
     /// Moves crowded particles off the axis ([`leaving`]): each leaves by
@@ -976,12 +996,12 @@ impl TaylorSolver {
             batches,
             smoothing,
             tallies,
-            strength,
             scratch,
             rate,
             ..
         } = ws;
         rate.resize(n, [0.0; 4]);
+        self.material_state.fit(n);
         scratch.fit();
         let stride = (*stride).max(1);
         // Mirror images across the axis and the anvil of the particles near
@@ -1185,14 +1205,7 @@ impl TaylorSolver {
         // constitutive update, positions x^{n+1} = x^n + dt v^{n+1/2}, anvil
         // contact, the generic stress boundary condition, and the sums of the
         // step, MIN_LEN particles at a time.
-        let (jc, eos, mu, cap, heat) = (
-            self.jc,
-            self.eos,
-            self.p.shear_modulus,
-            self.p.specific_heat,
-            self.p.taylor_quinney,
-        );
-        let modulus = self.p.bulk_modulus + 4.0 / 3.0 * self.p.shear_modulus;
+        let material = self.material;
         let (grads, rho_raw) = (&*grads, &*rho_raw);
         let (h, mass) = (self.h, &self.mass);
         {
@@ -1203,7 +1216,7 @@ impl TaylorSolver {
                     Chunks::new(&mut self.eps_p, MIN_LEN),
                     Chunks::new(&mut self.temp, MIN_LEN),
                     Chunks::new(&mut self.rho, MIN_LEN),
-                    Chunks::new(strength, MIN_LEN),
+                    Chunks::new(self.material_state.points_mut(), MIN_LEN),
                 ),
                 (
                     Chunks::new(&mut self.pos, MIN_LEN),
@@ -1216,7 +1229,7 @@ impl TaylorSolver {
             );
             team.run_parts(
                 &parts,
-                |c, ((dev, pressure, eps_p, temp, rho, memo), (x, v, touch, sbc, tally, work))| {
+                |c, ((dev, pressure, eps_p, temp, rho, models), (x, v, touch, sbc, tally, work))| {
                     let tally = &mut tally[0];
                     let i0 = c * MIN_LEN;
                     let mut means = [[0.0]; MIN_LEN];
@@ -1237,45 +1250,46 @@ impl TaylorSolver {
                         } else {
                             (0.5 * (g[1] + g[2]), 0.5 * (g[1] - g[2]))
                         };
-                        let dvol = (d_rr + d_zz + d_tt) / 3.0;
-                        let s = dev[k];
-                        let trial = [
-                            s[0] + dt * (2.0 * omega * s[3] + 2.0 * mu * (d_rr - dvol)),
-                            s[1] + dt * (-2.0 * omega * s[3] + 2.0 * mu * (d_zz - dvol)),
-                            s[2] + dt * (2.0 * mu * (d_tt - dvol)),
-                            s[3] + dt * (omega * (s[1] - s[0]) + 2.0 * mu * d_rz),
-                        ];
-                        let rate =
-                            (d_rr * d_rr + d_zz * d_zz + d_tt * d_tt + 2.0 * d_rz * d_rz).sqrt();
-                        let f = &mut memo[k];
-                        if f.eps_p != eps_p[k] || f.temp != temp[k] {
-                            *f = Strength {
-                                eps_p: eps_p[k],
-                                temp: temp[k],
-                                hardening: jc.hardening(eps_p[k]),
-                                thermal: jc.thermal(temp[k]),
-                            };
-                        }
-                        let sy = jc.strength(f.hardening, rate, f.thermal);
-                        let ret = radial_return(&trial, sy, mu);
-                        let p_new = eos.pressure(rho_new);
+                        let load = Loading {
+                            dt,
+                            rate: [d_rr, d_zz, d_tt, d_rz],
+                            spin: omega,
+                            density: rho_new,
+                        };
+                        let before = Point {
+                            deviator: dev[k],
+                            pressure: pressure[k],
+                            plastic_strain: eps_p[k],
+                            temperature: temp[k],
+                        };
+                        let new = match material.update(&load, &before, &mut models[k]) {
+                            Ok(new) => new,
+                            Err(l) => {
+                                // The step stops with the named error.
+                                t.compression =
+                                    t.compression.or(Some((i, l.compression, l.limit)));
+                                continue;
+                            }
+                        };
+                        let p_new = new.pressure;
                         // Stress power with the mid-step stress: the mean of
                         // the stress the momentum equation used (boundary
                         // conditions applied) and the new one (whose
                         // conditions the end of the step books), per unit
                         // mass.
                         let old = sbc[k];
-                        let sm = |k: usize, p: f64| 0.5 * (old[k] + ret.stress[k] - p);
+                        let s = new.deviator;
+                        let sm = |k: usize, p: f64| 0.5 * (old[k] + s[k] - p);
                         let power = sm(0, p_new) * d_rr
                             + sm(1, p_new) * d_zz
                             + sm(2, p_new) * d_tt
-                            + 2.0 * 0.5 * (old[3] + ret.stress[3]) * d_rz;
+                            + 2.0 * 0.5 * (old[3] + s[3]) * d_rz;
                         let w = 0.5 * dt * mass[i] / rho_new;
                         work[k] = [w * d_rr, w * d_zz, w * d_tt, w * 2.0 * d_rz];
-                        dev[k] = ret.stress;
+                        dev[k] = s;
                         pressure[k] = p_new;
-                        eps_p[k] += ret.plastic_strain;
-                        temp[k] += heat * ret.plastic_work / (rho_new * cap);
+                        eps_p[k] = new.plastic_strain;
+                        temp[k] = new.temperature;
                         rho[k] = rho_new;
                         t.internal += dt * power * mass[i] / rho_new;
 
@@ -1314,6 +1328,7 @@ impl TaylorSolver {
                         t.momentum += mass[i] * vi[1];
                         t.mass += mass[i];
                         t.touching |= touch[k];
+                        let modulus = material.longitudinal_modulus(rho_new, p_new);
                         t.worst_speed =
                             t.worst_speed.max(wave_and_flow_speed(modulus, rho_new, vi));
                         // The velocity the particle moved with (before
@@ -1337,6 +1352,7 @@ impl TaylorSolver {
             t.touching |= c.touching;
             t.through = t.through.or(c.through);
             t.non_finite = t.non_finite.or(c.non_finite);
+            t.compression = t.compression.or(c.compression);
         }
         self.internal_energy += t.internal;
         self.contact_dissipation += t.contact_lost;
@@ -1349,6 +1365,14 @@ impl TaylorSolver {
                 boundary,
                 time: self.time,
                 position,
+            });
+        }
+        if let Some((particle, compression, limit)) = t.compression {
+            return Err(Error::CompressionLimit {
+                particle,
+                time: self.time,
+                compression,
+                limit,
             });
         }
         if let Some((field, particle)) = t.non_finite.map(|(i, f)| (f, i)) {
