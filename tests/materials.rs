@@ -7,7 +7,7 @@ use meshless_impact::material::mie_gruneisen::MieGruneisen;
 use meshless_impact::material::{Eos, Material, Strength};
 use meshless_impact::scene::taylor::TaylorParams;
 use meshless_impact::solver::axisymmetric::TaylorSolver;
-use meshless_impact::{Error, Scene, SceneParams, TAYLOR_OBSERVABLES};
+use meshless_impact::{Error, Scene, TAYLOR_OBSERVABLES};
 
 /// The Wilkins copper bar of scenes/wilkins_copper.toml (its large-strain
 /// scheme, to rest) at `particles_radial` across.
@@ -19,10 +19,8 @@ fn wilkins(particles_radial: f64) -> TaylorParams {
     .unwrap();
     scene.set("particles_radial", particles_radial).unwrap();
     scene.validate().unwrap();
-    match scene.params {
-        SceneParams::Taylor(p) => p,
-        other => panic!("not a Taylor scene: {other:?}"),
-    }
+    assert_eq!(scene.kind().name(), "taylor");
+    TaylorParams::from_values(scene.values())
 }
 
 /// Runs to the end condition; the observable `name` at the end.
