@@ -368,7 +368,7 @@ pub unsafe extern "C" fn fmi2GetString(
     _value: *mut *const c_char,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { no_strings(c, "fmi2GetString", vr, nvr) }
+    unsafe { no_strings(c, "fmi2GetString", mask::GET, vr, nvr) }
 }
 
 /// `fmi2SetReal`: Real parameters, before the end of initialization.
@@ -436,24 +436,29 @@ pub unsafe extern "C" fn fmi2SetString(
     _value: *const *const c_char,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { no_strings(c, "fmi2SetString", vr, nvr) }
+    unsafe { no_strings(c, "fmi2SetString", mask::SET, vr, nvr) }
 }
 
+/// See [`Instance::no_variables`].
+///
 /// # Safety
 /// FMI 2.0 contract.
-unsafe fn no_strings(c: Component, function: &str, vr: *const Vr, nvr: usize) -> Fmi2Status {
+unsafe fn no_strings(
+    c: Component,
+    function: &str,
+    mask: u32,
+    vr: *const Vr,
+    nvr: usize,
+) -> Fmi2Status {
     // SAFETY: forwarded.
     (unsafe {
         with_instance(c, |inst| {
-            if nvr == 0 {
-                return Status::Ok;
-            }
-            match slice(vr, nvr).and_then(|v| v.first().copied()) {
-                Some(r) => inst.fail(&format!(
-                    "{function}: value reference {r} is not a String variable (this FMU has none)"
-                )),
-                None => inst.fail(&format!("{function}: vr is NULL")),
-            }
+            inst.no_variables(
+                function,
+                mask,
+                slice(vr, nvr),
+                "a String variable (this FMU has none)",
+            )
         })
     }) as c_int
 }
@@ -767,5 +772,49 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
         status_query(c, "fmi2GetStringStatus", kind, value, |inst, k| {
             (k == FMI2_PENDING_STATUS).then(|| inst.status_string.as_ptr())
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A new Co-Simulation instance with the right GUID and no logger.
+    fn instance() -> Component {
+        let guid = std::ffi::CString::new(instantiation_token()).unwrap();
+        // SAFETY: NUL-terminated strings or NULL; no callbacks.
+        let c = unsafe {
+            fmi2Instantiate(
+                std::ptr::null(),
+                FMI2_COSIMULATION,
+                guid.as_ptr(),
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                0,
+            )
+        };
+        assert!(!c.is_null());
+        c
+    }
+
+    /// Found by the fuzzer: fmi2GetString returned OK for an empty list in
+    /// Instantiated, fmi2SetString in Terminated.
+    #[test]
+    fn empty_string_lists_follow_the_state_machine() {
+        let c = instance();
+        let vr = [1u32];
+        let mut out = [std::ptr::null::<c_char>()];
+        let error = Status::Error as c_int;
+        // SAFETY: a live instance; empty lists.
+        unsafe {
+            assert_eq!(fmi2GetString(c, vr.as_ptr(), 0, out.as_mut_ptr()), error);
+            assert_eq!(fmi2Reset(c), 0);
+            assert_eq!(fmi2SetString(c, vr.as_ptr(), 0, out.as_ptr()), 0);
+            assert_eq!(fmi2Terminate(c), error, "not allowed in Instantiated");
+            assert_eq!(fmi2GetString(c, vr.as_ptr(), 0, out.as_mut_ptr()), 0);
+            assert_eq!(fmi2SetString(c, vr.as_ptr(), 0, out.as_ptr()), error);
+            fmi2FreeInstance(c);
+        }
     }
 }

@@ -472,9 +472,10 @@ pub unsafe extern "C" fn fmi3SetBoolean(
 }
 
 /// Getters and setters of types this FMU has no variables of: OK for an
-/// empty list, otherwise an error naming the value reference.
+/// empty list in a state that allows the getters (setters), otherwise an
+/// error.
 macro_rules! no_variables_of_type {
-    ($( $fname:ident, $t:ty, $ptr:ident; )*) => {$(
+    ($( $fname:ident, $t:ty, $ptr:ident, $mask:ident; )*) => {$(
         #[doc = concat!("`", stringify!($fname), "`: this FMU has no variables of this type.")]
         ///
         /// # Safety
@@ -488,55 +489,54 @@ macro_rules! no_variables_of_type {
             _n_values: usize,
         ) -> Fmi3Status {
             // SAFETY: FMI 3.0 contract.
-            unsafe { no_such_type(instance, stringify!($fname), vrs, nvr) }
+            unsafe { no_such_type(instance, stringify!($fname), mask::$mask, vrs, nvr) }
         }
     )*};
 }
 
+/// See [`Instance::no_variables`].
+///
 /// # Safety
 /// FMI 3.0 contract.
 unsafe fn no_such_type(
     instance: Instance3,
     function: &str,
+    mask: u32,
     vrs: *const Vr,
     nvr: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
     unsafe {
         with_instance(instance, |inst| {
-            if nvr == 0 {
-                return Status::Ok;
-            }
-            let first = slice(vrs, nvr).and_then(|v| v.first().copied());
-            match first {
-                Some(vr) => inst.fail(&format!(
-                    "{function}: value reference {vr} is not a variable of this type (this FMU has Float64, Int32 and Boolean variables)"
-                )),
-                None => inst.fail(&format!("{function}: valueReferences is NULL")),
-            }
+            inst.no_variables(
+                function,
+                mask,
+                slice(vrs, nvr),
+                "a variable of this type (this FMU has Float64, Int32 and Boolean variables)",
+            )
         }) as c_int
     }
 }
 
 no_variables_of_type! {
-    fmi3GetFloat32, f32, mut;
-    fmi3GetInt8, i8, mut;
-    fmi3GetUInt8, u8, mut;
-    fmi3GetInt16, i16, mut;
-    fmi3GetUInt16, u16, mut;
-    fmi3GetUInt32, u32, mut;
-    fmi3GetInt64, i64, mut;
-    fmi3GetUInt64, u64, mut;
-    fmi3GetString, *const c_char, mut;
-    fmi3SetFloat32, f32, const;
-    fmi3SetInt8, i8, const;
-    fmi3SetUInt8, u8, const;
-    fmi3SetInt16, i16, const;
-    fmi3SetUInt16, u16, const;
-    fmi3SetUInt32, u32, const;
-    fmi3SetInt64, i64, const;
-    fmi3SetUInt64, u64, const;
-    fmi3SetString, *const c_char, const;
+    fmi3GetFloat32, f32, mut, GET;
+    fmi3GetInt8, i8, mut, GET;
+    fmi3GetUInt8, u8, mut, GET;
+    fmi3GetInt16, i16, mut, GET;
+    fmi3GetUInt16, u16, mut, GET;
+    fmi3GetUInt32, u32, mut, GET;
+    fmi3GetInt64, i64, mut, GET;
+    fmi3GetUInt64, u64, mut, GET;
+    fmi3GetString, *const c_char, mut, GET;
+    fmi3SetFloat32, f32, const, SET;
+    fmi3SetInt8, i8, const, SET;
+    fmi3SetUInt8, u8, const, SET;
+    fmi3SetInt16, i16, const, SET;
+    fmi3SetUInt16, u16, const, SET;
+    fmi3SetUInt32, u32, const, SET;
+    fmi3SetInt64, i64, const, SET;
+    fmi3SetUInt64, u64, const, SET;
+    fmi3SetString, *const c_char, const, SET;
 }
 
 /// `fmi3GetBinary`: no Binary variables.
@@ -553,7 +553,7 @@ pub unsafe extern "C" fn fmi3GetBinary(
     _n_values: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3GetBinary", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3GetBinary", mask::GET, vrs, nvr) }
 }
 
 /// `fmi3SetBinary`: no Binary variables.
@@ -570,7 +570,7 @@ pub unsafe extern "C" fn fmi3SetBinary(
     _n_values: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3SetBinary", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3SetBinary", mask::SET, vrs, nvr) }
 }
 
 /// `fmi3GetClock`: no clocks.
@@ -585,7 +585,7 @@ pub unsafe extern "C" fn fmi3GetClock(
     _values: *mut u8,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3GetClock", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3GetClock", mask::GET, vrs, nvr) }
 }
 
 /// `fmi3SetClock`: no clocks.
@@ -600,7 +600,7 @@ pub unsafe extern "C" fn fmi3SetClock(
     _values: *const u8,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3SetClock", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3SetClock", mask::SET, vrs, nvr) }
 }
 
 /// Functions this Co-Simulation FMU does not provide: an error naming them.
@@ -973,6 +973,67 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A new instance with the right token and no logger.
+    fn instance() -> Instance3 {
+        let token = std::ffi::CString::new(instantiation_token()).unwrap();
+        // SAFETY: NUL-terminated strings or NULL, no logger.
+        let inst = unsafe {
+            fmi3InstantiateCoSimulation(
+                std::ptr::null(),
+                token.as_ptr(),
+                std::ptr::null(),
+                0,
+                0,
+                0,
+                0,
+                std::ptr::null(),
+                0,
+                std::ptr::null_mut(),
+                None,
+                std::ptr::null_mut(),
+            )
+        };
+        assert!(!inst.is_null());
+        inst
+    }
+
+    /// Found by the fuzzer: a getter of a type without variables returned OK
+    /// for an empty list in Instantiated, a setter in Terminated.
+    #[test]
+    fn empty_lists_of_absent_types_follow_the_state_machine() {
+        let inst = instance();
+        let vrs = [0u32; 1];
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        let get = |inst| {
+            let mut out = [0f32; 1];
+            // SAFETY: a live instance; an empty list.
+            unsafe { fmi3GetFloat32(inst, vrs.as_ptr(), 0, out.as_mut_ptr(), 0) }
+        };
+        let set = |inst| {
+            // SAFETY: a live instance; an empty list.
+            unsafe { fmi3SetString(inst, vrs.as_ptr(), 0, std::ptr::null(), 0) }
+        };
+        let error = Status::Error as c_int;
+        assert_eq!(get(inst), error, "no getter in Instantiated");
+        // SAFETY: a live instance; one value reference and one value.
+        unsafe {
+            assert_eq!(fmi3Reset(inst), 0);
+            assert_eq!(set(inst), 0, "setters are allowed in Instantiated");
+            assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
+            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(get(inst), 0, "getters are allowed in InitializationMode");
+            assert_eq!(fmi3ExitInitializationMode(inst), 0);
+            assert_eq!(fmi3Terminate(inst), 0);
+            assert_eq!(get(inst), 0, "getters are allowed in Terminated");
+            assert_eq!(set(inst), error, "no setter in Terminated");
+            fmi3FreeInstance(inst);
+        }
+    }
 
     #[test]
     fn version_and_null_instance() {

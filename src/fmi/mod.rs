@@ -410,6 +410,28 @@ impl Instance {
         Ok(())
     }
 
+    /// A getter or setter of a type this FMU has no variables of (FMI 3
+    /// Float32, Int8, ..., String, Binary, Clock; FMI 2 String). In a state
+    /// that allows `function` (`mask`, that of the getters or the setters)
+    /// an empty list is OK and anything else an Error naming the first value
+    /// reference, which is not `what`; in any other state, Error.
+    pub(crate) fn no_variables(
+        &mut self,
+        function: &str,
+        mask: u32,
+        vrs: Option<&[u32]>,
+        what: &str,
+    ) -> Status {
+        if let Err(s) = self.check_state(function, mask) {
+            return s;
+        }
+        match vrs {
+            Some([]) => Status::Ok,
+            Some([vr, ..]) => self.fail(&format!("{function}: value reference {vr} is not {what}")),
+            None => self.fail(&format!("{function}: the value references are NULL")),
+        }
+    }
+
     /// `fmi3SetDebugLogging` / `fmi2SetDebugLogging`.
     pub(crate) fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Status {
         if categories.is_empty() {
