@@ -159,7 +159,8 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
 }
 
 /// `fmi2SetupExperiment`: records the start time and, if defined, the stop
-/// time (a later `fmi2DoStep` past it returns `fmi2Error`).
+/// time (a later `fmi2DoStep` past it returns `fmi2Error`); a non-finite
+/// time or a stop time before the start time is an Error.
 ///
 /// # Safety
 /// A live instance.
@@ -175,14 +176,8 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     // SAFETY: FMI 2.0 contract.
     unsafe {
         call(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
-            if !start_time.is_finite() {
-                return inst.fail(&format!(
-                    "fmi2SetupExperiment: startTime = {start_time} must be finite"
-                ));
-            }
-            inst.start_time = start_time;
-            inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
-            Status::Ok
+            let stop = (stop_time_defined != 0).then_some(stop_time);
+            inst.set_experiment("fmi2SetupExperiment", start_time, stop)
         })
     }
 }
@@ -199,10 +194,7 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: Component) -> Fmi2Status
             c,
             "fmi2EnterInitializationMode",
             mask::ENTER_INITIALIZATION_MODE,
-            |inst| {
-                let t = inst.start_time;
-                inst.enter_initialization_mode(t)
-            },
+            |inst| inst.enter_initialization_mode(),
         )
     }
 }
@@ -796,6 +788,31 @@ mod tests {
         };
         assert!(!c.is_null());
         c
+    }
+
+    /// A NaN stopTime disabled the check of every step against it; now it
+    /// is refused, as are infinite ones and one before startTime. An
+    /// undefined stopTime is not looked at; one equal to startTime is fine.
+    #[test]
+    fn bad_stop_times_are_refused() {
+        let error = Status::Error as c_int;
+        for (start, stop) in [(0.0, f64::NAN), (0.0, f64::NEG_INFINITY), (1.0, 0.5)] {
+            let c = instance();
+            // SAFETY: a live instance, freed once.
+            unsafe {
+                assert_eq!(fmi2SetupExperiment(c, 0, 0.0, start, 1, stop), error);
+                assert_eq!(fmi2EnterInitializationMode(c), error, "left Terminated");
+                fmi2FreeInstance(c);
+            }
+        }
+        let c = instance();
+        // SAFETY: a live instance, freed once.
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 1.0, 0, f64::NAN), 0);
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 1.0, 1, 1.0), 0);
+            assert_eq!(fmi2EnterInitializationMode(c), 0);
+            fmi2FreeInstance(c);
+        }
     }
 
     /// Found by the fuzzer: fmi2GetString returned OK for an empty list in

@@ -164,7 +164,9 @@ pub unsafe extern "C" fn fmi3FreeInstance(instance: Instance3) {
     })
 }
 
-/// `fmi3EnterInitializationMode`.
+/// `fmi3EnterInitializationMode`: records the start time and, if defined,
+/// the stop time (a later `fmi3DoStep` past it returns `fmi3Error`); a
+/// non-finite time or a stop time before the start time is an Error.
 ///
 /// # Safety
 /// A live instance.
@@ -184,8 +186,11 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
             "fmi3EnterInitializationMode",
             mask::ENTER_INITIALIZATION_MODE,
             |inst| {
-                inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
-                inst.enter_initialization_mode(start_time)
+                let stop = (stop_time_defined != 0).then_some(stop_time);
+                match inst.set_experiment("fmi3EnterInitializationMode", start_time, stop) {
+                    Status::Ok => inst.enter_initialization_mode(),
+                    s => s,
+                }
             },
         )
     }
@@ -996,6 +1001,35 @@ mod tests {
         };
         assert!(!inst.is_null());
         inst
+    }
+
+    /// A NaN stopTime disabled the check of every step against it; now it
+    /// is refused, as are infinite ones and one before startTime. An
+    /// undefined stopTime is not looked at.
+    #[test]
+    fn bad_stop_times_are_refused() {
+        let error = Status::Error as c_int;
+        for (start, stop) in [(0.0, f64::NAN), (0.0, f64::INFINITY), (1.0, 0.5)] {
+            let inst = instance();
+            // SAFETY: a live instance, freed once.
+            unsafe {
+                assert_eq!(
+                    fmi3EnterInitializationMode(inst, 0, 0.0, start, 1, stop),
+                    error
+                );
+                assert_eq!(fmi3ExitInitializationMode(inst), error, "left Terminated");
+                fmi3FreeInstance(inst);
+            }
+        }
+        let inst = instance();
+        // SAFETY: a live instance, freed once.
+        unsafe {
+            assert_eq!(
+                fmi3EnterInitializationMode(inst, 0, 0.0, 1.0, 0, f64::NAN),
+                0
+            );
+            fmi3FreeInstance(inst);
+        }
     }
 
     /// Found by the fuzzer: a getter of a type without variables returned OK

@@ -453,13 +453,36 @@ impl Instance {
         Status::Ok
     }
 
-    pub(crate) fn enter_initialization_mode(&mut self, start_time: f64) -> Status {
-        if !start_time.is_finite() {
-            return self.fail(&format!("startTime = {start_time} must be finite"));
+    /// Records the experiment (`fmi2SetupExperiment`, the times given to
+    /// `fmi3EnterInitializationMode`): startTime must be finite and a
+    /// defined stopTime finite and not before it. A NaN stopTime would
+    /// disable the check of every step against it, one before startTime
+    /// would refuse every step: both are Errors naming the value.
+    pub(crate) fn set_experiment(
+        &mut self,
+        function: &str,
+        start: f64,
+        stop: Option<f64>,
+    ) -> Status {
+        if !start.is_finite() {
+            return self.fail(&format!("{function}: startTime = {start} must be finite"));
         }
-        self.start_time = start_time;
-        self.time = start_time;
-        self.last_successful_time = start_time;
+        if let Some(stop) = stop
+            && !(stop.is_finite() && stop >= start)
+        {
+            return self.fail(&format!(
+                "{function}: stopTime = {stop} must be finite and not before startTime = {start}"
+            ));
+        }
+        self.start_time = start;
+        self.stop_time = stop;
+        Status::Ok
+    }
+
+    /// Enters initialization mode at the experiment's start time.
+    pub(crate) fn enter_initialization_mode(&mut self) -> Status {
+        self.time = self.start_time;
+        self.last_successful_time = self.start_time;
         self.state = INITIALIZATION_MODE;
         Status::Ok
     }
@@ -929,13 +952,66 @@ mod tests {
             inst.set("fmi3SetInt32", &[pr], &[5.0], VarType::Int32),
             Status::Ok
         );
-        assert_eq!(inst.enter_initialization_mode(0.0), Status::Ok);
+        assert_eq!(inst.enter_initialization_mode(), Status::Ok);
         assert_eq!(inst.exit_initialization_mode(), Status::Ok);
         assert_eq!(
             inst.set("fmi3SetFloat64", &[density], &[7000.0], VarType::Float64),
             Status::Error
         );
         assert_eq!(inst.state, TERMINATED);
+    }
+
+    /// A logger that keeps the messages (environment: a `Vec<String>`).
+    unsafe extern "C" fn keep(
+        env: *mut c_void,
+        _status: c_int,
+        _category: *const c_char,
+        message: *const c_char,
+    ) {
+        // SAFETY: the test's vector, not otherwise borrowed during the call;
+        // a NUL-terminated message.
+        unsafe {
+            (*(env as *mut Vec<String>)).push(
+                std::ffi::CStr::from_ptr(message)
+                    .to_string_lossy()
+                    .into_owned(),
+            )
+        }
+    }
+
+    #[test]
+    fn experiment_times_are_checked_and_named() {
+        let bad = [
+            (0.0, Some(f64::NAN), "stopTime = NaN"),
+            (0.0, Some(f64::INFINITY), "stopTime = inf"),
+            (0.0, Some(f64::NEG_INFINITY), "stopTime = -inf"),
+            (
+                2e-6,
+                Some(1e-6),
+                "stopTime = 0.000001 must be finite and not before startTime = 0.000002",
+            ),
+            (f64::NAN, None, "startTime = NaN"),
+        ];
+        for (start, stop, named) in bad {
+            let mut messages: Vec<String> = Vec::new();
+            let log = LogSink::Fmi3 {
+                callback: keep,
+                environment: &mut messages as *mut Vec<String> as *mut c_void,
+            };
+            let mut inst = Instance::new(Standard::Fmi3, "t", log, false);
+            assert_eq!(inst.set_experiment("f", start, stop), Status::Error);
+            assert_eq!(inst.state, TERMINATED);
+            assert_eq!(inst.stop_time, None, "{named}: not recorded");
+            drop(inst);
+            assert_eq!(messages.len(), 1);
+            assert!(
+                messages[0].contains(named),
+                "{messages:?} should name {named}"
+            );
+        }
+        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
+        assert_eq!(inst.set_experiment("f", 1e-6, Some(1e-6)), Status::Ok);
+        assert_eq!((inst.start_time, inst.stop_time), (1e-6, Some(1e-6)));
     }
 
     #[test]
@@ -949,7 +1025,7 @@ mod tests {
             let mut inst = Instance::new(Standard::Fmi2, "t", LogSink::None, false);
             inst.set("fmi2SetInteger", &[pr], &[4.0], VarType::Int32);
             inst.stop_time = stop;
-            assert_eq!(inst.enter_initialization_mode(0.0), Status::Ok);
+            assert_eq!(inst.enter_initialization_mode(), Status::Ok);
             assert_eq!(inst.exit_initialization_mode(), Status::Ok);
             inst
         };
@@ -986,7 +1062,7 @@ mod tests {
             .unwrap()
             .vr;
         inst.set("fmi3SetInt32", &[pr], &[4.0], VarType::Int32);
-        inst.enter_initialization_mode(0.0);
+        inst.enter_initialization_mode();
         inst.exit_initialization_mode();
         inst.do_step("doStep", 0.0, 1e-6).unwrap();
         let bytes = inst.save().serialize();
