@@ -26,7 +26,7 @@ pub mod model_description;
 use crate::observe::{ObservableSpec, TAYLOR_OBSERVABLES};
 use crate::scene::params::ParamSpec;
 use crate::scene::taylor::TAYLOR_PARAMS;
-use crate::{Scene, Simulation};
+use crate::{Scene, SceneKind, Simulation};
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -801,6 +801,25 @@ impl Saved {
         if !times.iter().all(|t| t.is_finite()) || saved.time < saved.start_time {
             return Err("invalid serialized state: its communication times are not valid".into());
         }
+        if saved.scene.kind() != SceneKind::Taylor {
+            return Err(
+                "invalid serialized state: its parameters are not the Taylor scene's".into(),
+            );
+        }
+        // The run is there exactly when an instance in that state has one,
+        // and it is the run of the instance's parameters (those it reports).
+        let run = match (&saved.sim, saved.state) {
+            (None, STEP_MODE | STEP_DISCARDED) => Err("it is past initialization but holds no run"),
+            (Some(_), INSTANTIATED) => Err("it holds a run before initialization"),
+            (Some(sim), _) if sim.scene() != &saved.scene => {
+                Err("its run is not one of its parameters")
+            }
+            (Some(sim), INITIALIZATION_MODE) if sim.steps() != 0 => {
+                Err("its run has stepped before the end of initialization")
+            }
+            _ => Ok(()),
+        };
+        run.map_err(|e| format!("invalid serialized state: {e}"))?;
         if let Some(sim) = &saved.sim {
             sim.check_restored()
                 .map_err(|e| format!("invalid serialized state: {e}"))?;
@@ -933,21 +952,30 @@ mod tests {
         assert!(t.starts_with('{') && t.ends_with('}'));
     }
 
+    /// The value reference of a variable.
+    fn vr_of(name: &str) -> u32 {
+        variables().iter().find(|v| v.name == name).unwrap().vr
+    }
+
+    /// A new instance at 4 particles across the radius (cheap steps).
+    fn coarse(standard: Standard) -> Instance {
+        let mut inst = Instance::new(standard, "t", LogSink::None, false);
+        let pr = vr_of("particles_radial");
+        assert_eq!(inst.set("set", &[pr], &[4.0], VarType::Int32), Status::Ok);
+        inst
+    }
+
     #[test]
     fn fixed_parameter_refused_after_initialization_and_bad_values_named() {
         let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
-        let density = variables().iter().find(|v| v.name == "density").unwrap().vr;
+        let density = vr_of("density");
         assert_eq!(
             inst.set("fmi3SetFloat64", &[density], &[-5.0], VarType::Float64),
             Status::Error
         );
         assert_eq!(inst.state, TERMINATED);
         inst.reset();
-        let pr = variables()
-            .iter()
-            .find(|v| v.name == "particles_radial")
-            .unwrap()
-            .vr;
+        let pr = vr_of("particles_radial");
         assert_eq!(
             inst.set("fmi3SetInt32", &[pr], &[5.0], VarType::Int32),
             Status::Ok
@@ -1016,14 +1044,8 @@ mod tests {
 
     #[test]
     fn step_past_stop_time_is_an_error() {
-        let pr = variables()
-            .iter()
-            .find(|v| v.name == "particles_radial")
-            .unwrap()
-            .vr;
         let start = |stop: Option<f64>| {
-            let mut inst = Instance::new(Standard::Fmi2, "t", LogSink::None, false);
-            inst.set("fmi2SetInteger", &[pr], &[4.0], VarType::Int32);
+            let mut inst = coarse(Standard::Fmi2);
             inst.stop_time = stop;
             assert_eq!(inst.enter_initialization_mode(), Status::Ok);
             assert_eq!(inst.exit_initialization_mode(), Status::Ok);
@@ -1053,15 +1075,88 @@ mod tests {
         assert!(inst.do_step("doStep", 0.0, 1.8e-6 * (1.0 + 1e-6)).is_ok());
     }
 
+    /// Serialized state bytes with their JSON edited by `edit`.
+    fn forge(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+        let header = bytes
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| **b == b'\n')
+            .nth(1)
+            .unwrap()
+            .0
+            + 1;
+        let mut json: serde_json::Value = serde_json::from_slice(&bytes[header..]).unwrap();
+        edit(&mut json);
+        let mut out = bytes[..header].to_vec();
+        out.extend(serde_json::to_vec(&json).unwrap());
+        out
+    }
+
+    /// Found by the FMU call-order fuzzer: a state in step mode without its
+    /// run was accepted, and the next doStep panicked (Fatal). A run and
+    /// parameters that do not belong together are refused as well: the
+    /// outputs would not be those of the parameters, and a Noh run or scene
+    /// has none of the Taylor variables.
+    #[test]
+    fn states_whose_run_does_not_fit_are_refused() {
+        let mut inst = coarse(Standard::Fmi3);
+        inst.enter_initialization_mode();
+        let init = inst.save().serialize();
+        inst.exit_initialization_mode();
+        inst.do_step("doStep", 0.0, 1e-6).unwrap();
+        let stepped = inst.save().serialize();
+        let mut other = Scene::builtin("taylor").unwrap();
+        other.set("particles_radial", 5.0).unwrap();
+        let other = serde_json::to_value(Simulation::new(other).unwrap()).unwrap();
+        let mut noh = Scene::builtin("noh").unwrap();
+        noh.set("particles_radial", 100.0).unwrap();
+        let noh = serde_json::to_value(Simulation::new(noh).unwrap()).unwrap();
+        let refused = |bytes: &[u8], why: &str| {
+            let e = Saved::deserialize(bytes).unwrap_err();
+            assert!(e.contains(why), "{e} should say {why}");
+        };
+        refused(
+            &forge(&stepped, |j| j["sim"] = serde_json::Value::Null),
+            "holds no run",
+        );
+        let mut done = forge(&stepped, |j| j["sim"] = serde_json::Value::Null);
+        done = forge(&done, |j| j["state"] = serde_json::json!(STEP_DISCARDED));
+        refused(&done, "holds no run");
+        refused(
+            &forge(&stepped, |j| j["state"] = serde_json::json!(INSTANTIATED)),
+            "before initialization",
+        );
+        refused(
+            &forge(&stepped, |j| {
+                j["state"] = serde_json::json!(INITIALIZATION_MODE)
+            }),
+            "stepped",
+        );
+        refused(
+            &forge(&stepped, |j| j["sim"] = other.clone()),
+            "not one of its parameters",
+        );
+        refused(
+            &forge(&stepped, |j| j["sim"] = noh.clone()),
+            "not one of its parameters",
+        );
+        refused(
+            &forge(&init, |j| j["scene"] = noh["scene"].clone()),
+            "not the Taylor scene's",
+        );
+        // The honest states load, and one without a run where that is right.
+        assert!(Saved::deserialize(&stepped).is_ok());
+        assert!(Saved::deserialize(&init).is_ok());
+        let ended = forge(&stepped, |j| {
+            j["sim"] = serde_json::Value::Null;
+            j["state"] = serde_json::json!(TERMINATED);
+        });
+        assert!(Saved::deserialize(&ended).is_ok());
+    }
+
     #[test]
     fn state_round_trips_through_bytes() {
-        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
-        let pr = variables()
-            .iter()
-            .find(|v| v.name == "particles_radial")
-            .unwrap()
-            .vr;
-        inst.set("fmi3SetInt32", &[pr], &[4.0], VarType::Int32);
+        let mut inst = coarse(Standard::Fmi3);
         inst.enter_initialization_mode();
         inst.exit_initialization_mode();
         inst.do_step("doStep", 0.0, 1e-6).unwrap();
