@@ -1032,6 +1032,58 @@ mod tests {
         }
     }
 
+    /// Found by the FMU call-order fuzzer: a step from a huge time ended at
+    /// infinity (OK, lastSuccessfulTime = inf and the time variable inf
+    /// from then on) or was lost in rounding (OK, time unchanged).
+    #[test]
+    fn a_step_must_end_at_a_finite_later_time() {
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        let error = Status::Error as c_int;
+        let inst = instance();
+        // Status, terminateSimulation and lastSuccessfulTime of a doStep.
+        let step = |t: f64, h: f64| {
+            let (mut event, mut terminate, mut early, mut last) = (0, 0, 0, f64::NAN);
+            // SAFETY: a live instance; writable outputs.
+            let s = unsafe {
+                fmi3DoStep(
+                    inst,
+                    t,
+                    h,
+                    0,
+                    &mut event,
+                    &mut terminate,
+                    &mut early,
+                    &mut last,
+                )
+            };
+            (s, terminate, last)
+        };
+        // SAFETY: a live instance; one value reference and one value.
+        unsafe {
+            assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
+            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi3ExitInitializationMode(inst), 0);
+            // To the end of the run and far beyond: the outputs hold.
+            assert_eq!(step(0.0, f64::MAX), (0, 1, f64::MAX));
+            assert_eq!(step(f64::MAX, f64::MAX).0, error);
+            let mut time = f64::NAN;
+            // Values may be read after an Error.
+            assert_eq!(fmi3GetFloat64(inst, &VR_TIME, 1, &mut time, 1), 0);
+            assert_eq!(time, f64::MAX);
+            // From a huge start time a small step is lost in rounding.
+            assert_eq!(fmi3Reset(inst), 0);
+            assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
+            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, 1e300, 0, 0.0), 0);
+            assert_eq!(fmi3ExitInitializationMode(inst), 0);
+            assert_eq!(step(1e300, 1e-6).0, error);
+            fmi3FreeInstance(inst);
+        }
+    }
+
     /// Found by the fuzzer: a getter of a type without variables returned OK
     /// for an empty list in Instantiated, a setter in Terminated.
     #[test]

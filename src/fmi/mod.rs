@@ -658,6 +658,14 @@ impl Instance {
             )));
         }
         let target = current + h;
+        // A step must end at a finite time after the current one: not at
+        // infinity (a huge step from a huge time), not lost in rounding (a
+        // small step from a huge time).
+        if !target.is_finite() || target <= current {
+            return Err(self.fail(&format!(
+                "{function}: the step would end at t = {target} s (currentCommunicationPoint = {current} s + communicationStepSize = {h} s), not a finite time after the current one"
+            )));
+        }
         // FMI 2.0 (fmi2SetupExperiment) and FMI 3.0
         // (fmi3EnterInitializationMode): computing past a defined stopTime
         // is an error. Rounding slack: 1e-9 of |stopTime| + step size.
