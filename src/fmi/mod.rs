@@ -286,6 +286,22 @@ pub(crate) struct StepOutcome {
     pub last_successful_time: f64,
 }
 
+/// Why a startTime and stopTime are not an experiment: startTime must be
+/// finite, and a defined stopTime finite and not before it. A NaN stopTime
+/// would disable the check of every step against it, one before startTime
+/// would refuse every step.
+fn experiment_error(start: f64, stop: Option<f64>) -> Option<String> {
+    if !start.is_finite() {
+        return Some(format!("startTime = {start} must be finite"));
+    }
+    match stop {
+        Some(stop) if !(stop.is_finite() && stop >= start) => Some(format!(
+            "stopTime = {stop} must be finite and not before startTime = {start}"
+        )),
+        _ => None,
+    }
+}
+
 /// The part of an instance that a host saves and restores (FMU state).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Saved {
@@ -293,6 +309,11 @@ pub(crate) struct Saved {
     scene: Scene,
     sim: Option<Simulation>,
     start_time: f64,
+    /// The experiment's stopTime goes with its startTime: a host that
+    /// restores a state after Reset, or in another instance, gets the
+    /// experiment the run belongs to. (Absent in bytes from before: none.)
+    #[serde(default)]
+    stop_time: Option<f64>,
     time: f64,
     at_end: bool,
     last_successful_time: f64,
@@ -454,25 +475,16 @@ impl Instance {
     }
 
     /// Records the experiment (`fmi2SetupExperiment`, the times given to
-    /// `fmi3EnterInitializationMode`): startTime must be finite and a
-    /// defined stopTime finite and not before it. A NaN stopTime would
-    /// disable the check of every step against it, one before startTime
-    /// would refuse every step: both are Errors naming the value.
+    /// `fmi3EnterInitializationMode`), or refuses it with Error naming the
+    /// value: see [`experiment_error`].
     pub(crate) fn set_experiment(
         &mut self,
         function: &str,
         start: f64,
         stop: Option<f64>,
     ) -> Status {
-        if !start.is_finite() {
-            return self.fail(&format!("{function}: startTime = {start} must be finite"));
-        }
-        if let Some(stop) = stop
-            && !(stop.is_finite() && stop >= start)
-        {
-            return self.fail(&format!(
-                "{function}: stopTime = {stop} must be finite and not before startTime = {start}"
-            ));
+        if let Some(e) = experiment_error(start, stop) {
+            return self.fail(&format!("{function}: {e}"));
         }
         self.start_time = start;
         self.stop_time = stop;
@@ -752,6 +764,7 @@ impl Instance {
             scene: self.scene.clone(),
             sim: self.sim.clone(),
             start_time: self.start_time,
+            stop_time: self.stop_time,
             time: self.time,
             at_end: self.at_end,
             last_successful_time: self.last_successful_time,
@@ -763,6 +776,7 @@ impl Instance {
         self.scene = s.scene.clone();
         self.sim = s.sim.clone();
         self.start_time = s.start_time;
+        self.stop_time = s.stop_time;
         self.time = s.time;
         self.at_end = s.at_end;
         self.last_successful_time = s.last_successful_time;
@@ -808,6 +822,9 @@ impl Saved {
         let times = [saved.start_time, saved.time, saved.last_successful_time];
         if !times.iter().all(|t| t.is_finite()) || saved.time < saved.start_time {
             return Err("invalid serialized state: its communication times are not valid".into());
+        }
+        if let Some(e) = experiment_error(saved.start_time, saved.stop_time) {
+            return Err(format!("invalid serialized state: its experiment: {e}"));
         }
         if saved.scene.kind() != SceneKind::Taylor {
             return Err(
@@ -1160,6 +1177,51 @@ mod tests {
             j["state"] = serde_json::json!(TERMINATED);
         });
         assert!(Saved::deserialize(&ended).is_ok());
+    }
+
+    /// Found by the FMU call-order fuzzer: the stopTime was not part of the
+    /// FMU state, so a state restored after Reset (or deserialized into a
+    /// new instance) stepped past the stopTime of its experiment.
+    #[test]
+    fn the_stop_time_is_part_of_the_state() {
+        let mut inst = coarse(Standard::Fmi3);
+        assert_eq!(inst.set_experiment("f", 0.0, Some(2e-6)), Status::Ok);
+        inst.enter_initialization_mode();
+        inst.exit_initialization_mode();
+        inst.do_step("doStep", 0.0, 1e-6).unwrap();
+        let saved = inst.save();
+        let bytes = saved.serialize();
+        inst.reset();
+        assert_eq!(inst.stop_time, None);
+        inst.restore(&saved);
+        assert_eq!(inst.stop_time, Some(2e-6));
+        assert_eq!(
+            inst.do_step("doStep", 1e-6, 2e-6).unwrap_err(),
+            Status::Error
+        );
+        let mut other = Instance::new(Standard::Fmi2, "u", LogSink::None, false);
+        other.restore(&Saved::deserialize(&bytes).unwrap());
+        assert_eq!(other.stop_time, Some(2e-6));
+        assert!(
+            other.do_step("doStep", 1e-6, 1e-6).is_ok(),
+            "up to stopTime"
+        );
+        assert_eq!(
+            other.do_step("doStep", 2e-6, 1e-6).unwrap_err(),
+            Status::Error
+        );
+        // A forged experiment is refused; bytes without a stopTime (as
+        // before) load without one.
+        let before = forge(&bytes, |j| j["stop_time"] = serde_json::json!(-1e-6));
+        let e = Saved::deserialize(&before).unwrap_err();
+        assert!(
+            e.contains("stopTime = -0.000001 must be finite and not before"),
+            "{e}"
+        );
+        let old = forge(&bytes, |j| {
+            j.as_object_mut().unwrap().remove("stop_time");
+        });
+        assert_eq!(Saved::deserialize(&old).unwrap().stop_time, None);
     }
 
     #[test]
