@@ -1032,56 +1032,92 @@ mod tests {
         }
     }
 
-    /// Found by the FMU call-order fuzzer: a step from a huge time ended at
-    /// infinity (OK, lastSuccessfulTime = inf and the time variable inf
-    /// from then on) or was lost in rounding (OK, time unchanged).
-    #[test]
-    fn a_step_must_end_at_a_finite_later_time() {
+    /// Status, terminateSimulation and lastSuccessfulTime of a doStep.
+    fn step(inst: Instance3, t: f64, h: f64) -> (c_int, u8, f64) {
+        let (mut event, mut terminate, mut early, mut last) = (0, 0, 0, f64::NAN);
+        // SAFETY: a live instance; writable outputs.
+        let s = unsafe {
+            fmi3DoStep(
+                inst,
+                t,
+                h,
+                0,
+                &mut event,
+                &mut terminate,
+                &mut early,
+                &mut last,
+            )
+        };
+        (s, terminate, last)
+    }
+
+    /// A coarse instance (4 particles across) in step mode from `start`.
+    fn stepping(start: f64) -> Instance3 {
+        let inst = instance();
         let pr = variables()
             .iter()
             .find(|v| v.name == "particles_radial")
             .unwrap()
             .vr;
-        let error = Status::Error as c_int;
-        let inst = instance();
-        // Status, terminateSimulation and lastSuccessfulTime of a doStep.
-        let step = |t: f64, h: f64| {
-            let (mut event, mut terminate, mut early, mut last) = (0, 0, 0, f64::NAN);
-            // SAFETY: a live instance; writable outputs.
-            let s = unsafe {
-                fmi3DoStep(
-                    inst,
-                    t,
-                    h,
-                    0,
-                    &mut event,
-                    &mut terminate,
-                    &mut early,
-                    &mut last,
-                )
-            };
-            (s, terminate, last)
-        };
         // SAFETY: a live instance; one value reference and one value.
         unsafe {
             assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
-            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, start, 0, 0.0), 0);
             assert_eq!(fmi3ExitInitializationMode(inst), 0);
-            // To the end of the run and far beyond: the outputs hold.
-            assert_eq!(step(0.0, f64::MAX), (0, 1, f64::MAX));
-            assert_eq!(step(f64::MAX, f64::MAX).0, error);
-            let mut time = f64::NAN;
+        }
+        inst
+    }
+
+    /// Found by the FMU call-order fuzzer: a step from a huge time ended at
+    /// infinity (OK, lastSuccessfulTime = inf and the time variable inf
+    /// from then on) or was lost in rounding (OK, time unchanged).
+    #[test]
+    fn a_step_must_end_at_a_finite_later_time() {
+        let error = Status::Error as c_int;
+        let inst = stepping(0.0);
+        // To the end of the run and far beyond: the outputs hold.
+        assert_eq!(step(inst, 0.0, f64::MAX), (0, 1, f64::MAX));
+        assert_eq!(step(inst, f64::MAX, f64::MAX).0, error);
+        let mut time = f64::NAN;
+        // SAFETY: a live instance, freed once; one value reference and value.
+        unsafe {
             // Values may be read after an Error.
             assert_eq!(fmi3GetFloat64(inst, &VR_TIME, 1, &mut time, 1), 0);
             assert_eq!(time, f64::MAX);
-            // From a huge start time a small step is lost in rounding.
-            assert_eq!(fmi3Reset(inst), 0);
-            assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
-            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, 1e300, 0, 0.0), 0);
-            assert_eq!(fmi3ExitInitializationMode(inst), 0);
-            assert_eq!(step(1e300, 1e-6).0, error);
             fmi3FreeInstance(inst);
         }
+        // From a huge start time a small step is lost in rounding.
+        let inst = stepping(1e300);
+        assert_eq!(step(inst, 1e300, 1e-6).0, error);
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
+    }
+
+    /// Found by the FMU call-order fuzzer: the tolerance on the current time
+    /// grew with the step size, so a step of 1e300 s accepted a current time
+    /// of 2.8e30 s at an FMU time of microseconds (and returned, with early
+    /// return, a lastSuccessfulTime before the current time). Rounding of
+    /// the times a host adds up is still accepted.
+    #[test]
+    fn a_huge_step_does_not_excuse_a_wrong_current_time() {
+        let error = Status::Error as c_int;
+        let inst = stepping(0.0);
+        assert_eq!(step(inst, 0.0, 1e-6).0, 0);
+        assert_eq!(step(inst, 1e-6 * (1.0 + 1e-12), 1e-6).0, 0, "rounding");
+        assert_eq!(step(inst, 1e30, 1e300).0, error);
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
+        let inst = stepping(-1.0);
+        // Near t = 0 from startTime = -1 s, a host's sums carry the rounding
+        // of 1 s.
+        assert_eq!(step(inst, -1.0, 1.0 - 1e-12).0, 0);
+        assert_eq!(
+            step(inst, -1e-12 + 1e-16, 1e-6).0,
+            0,
+            "rounding of |startTime|"
+        );
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
     }
 
     /// Found by the fuzzer: a getter of a type without variables returned OK
