@@ -93,7 +93,10 @@ typedef enum {
      */
     MI_IO = 11,
     /**
-     * Bytes that are not a saved simulation state of this scene kind.
+     * Bytes that are not a valid saved simulation state of this scene kind:
+     * not a saved state at all, a state of another scene kind, or a forged
+     * or damaged one (parameters out of range, or a solver state that a run
+     * of its parameters cannot reach).
      */
     MI_INVALID_STATE = 12,
     /**
@@ -588,9 +591,11 @@ mi_result mi_sim_field(mi_sim *sim, const char *name, double *buf, size_t len, s
 mi_result mi_sim_state_save(mi_sim *sim, uint8_t *buf, size_t len, size_t *needed);
 
 /**
- * Replaces the run by a state saved with `mi_sim_state_save` (of the same
- * scene kind; else `MI_INVALID_STATE`, as for bytes that are not a state).
- * The run then continues from the saved time, with the saved parameters.
+ * Replaces the run by a state saved with `mi_sim_state_save` of the same
+ * scene kind. The run then continues from the saved time, with the saved
+ * parameters. Anything else is `MI_INVALID_STATE` and the handle keeps its
+ * run: bytes that are not a state, a state of another scene kind, or a
+ * forged or inconsistent one (checked as a new run is).
  *
  * # Safety
  * `sim` must be NULL or a live handle; `buf` NULL or valid for reads of

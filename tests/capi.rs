@@ -491,6 +491,13 @@ fn forged_states_are_refused_and_the_handle_keeps_its_run() {
         }
         assert_eq!(mi_sim_steps_of(&t), before);
         assert_eq!(t.run(), mi_result::MI_OK);
+        // The code's description covers forged states too (it said "not a
+        // saved state of this scene kind").
+        let d = CStr::from_ptr(mi_result_description(mi_result::MI_INVALID_STATE as i32));
+        assert_eq!(
+            d.to_str().unwrap(),
+            "not a valid saved state of this scene kind (not a state, another kind, forged or inconsistent)"
+        );
     }
 }
 

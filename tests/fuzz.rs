@@ -1,7 +1,9 @@
 //! A seeded fuzzer over the boundaries: parameters, TOML scene texts, saved
-//! states and call orders through the C ABI. Each case runs under a time
-//! limit; the run passes only with no panic, no hang, no NaN observable on
-//! success and no error outside the documented tables.
+//! states, call orders through the C ABI, and call orders through the FMI
+//! 3.0 and FMI 2.0 functions of the FMUs ([`fmu`]). Each case runs under a
+//! time limit; the run passes only with no panic, no hang, no NaN observable
+//! on success, no error or status outside the documented tables, and (FMU)
+//! Error wherever the standard requires it.
 //!
 //! The test command runs it for `MI_FUZZ_SECONDS` (default 60) from seed
 //! `MI_FUZZ_SEED` (default 1); `scripts/fuzz.sh` runs it longer.
@@ -10,8 +12,13 @@ use meshless_impact::capi::*;
 use meshless_impact::{Scene, Simulation};
 use std::ffi::CString;
 use std::ptr::null_mut;
+use std::sync::Arc;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
+
+// The FMU call orders, beside this file (tests/fmu/ holds the pytest suite).
+#[path = "fuzz/fmu.rs"]
+mod fmu;
 
 /// Longest a single case may take before it counts as a hang.
 const CASE_LIMIT: Duration = Duration::from_secs(30);
@@ -233,28 +240,34 @@ fn leaf<'a>(rng: &mut Rng, v: &'a mut serde_json::Value) -> &'a mut serde_json::
     }
 }
 
+/// Replaces a random leaf of `v` by a hostile value (a number, a count, -1,
+/// a cut array, a boolean); returns the edit for the case's name.
+fn edit_leaf(rng: &mut Rng, v: &mut serde_json::Value) -> String {
+    let target = leaf(rng, v);
+    let new = match rng.below(5) {
+        0 => serde_json::json!(rng.number(-1e6, 1e6)),
+        1 => serde_json::json!(rng.below(1_000_000)),
+        2 => serde_json::json!(-1),
+        3 => match target {
+            serde_json::Value::Array(a) if !a.is_empty() => {
+                let mut a = a.clone();
+                a.truncate(rng.below(a.len()));
+                serde_json::Value::Array(a)
+            }
+            _ => serde_json::json!(0.0),
+        },
+        _ => serde_json::json!(true),
+    };
+    let edit = format!("{target} -> {new}");
+    *target = new;
+    edit
+}
+
 fn fuzz_state(rng: &mut Rng, saved: &[serde_json::Value]) -> String {
     let mut state = rng.pick(saved).clone();
-    let mut edits = Vec::new();
-    for _ in 0..1 + rng.below(3) {
-        let target = leaf(rng, &mut state);
-        let new = match rng.below(5) {
-            0 => serde_json::json!(rng.number(-1e6, 1e6)),
-            1 => serde_json::json!(rng.below(1_000_000)),
-            2 => serde_json::json!(-1),
-            3 => match target {
-                serde_json::Value::Array(a) if !a.is_empty() => {
-                    let mut a = a.clone();
-                    a.truncate(rng.below(a.len()));
-                    serde_json::Value::Array(a)
-                }
-                _ => serde_json::json!(0.0),
-            },
-            _ => serde_json::json!(true),
-        };
-        edits.push(format!("{target} -> {new}"));
-        *target = new;
-    }
+    let edits: Vec<String> = (0..1 + rng.below(3))
+        .map(|_| edit_leaf(rng, &mut state))
+        .collect();
     let bytes = serde_json::to_vec(&state).unwrap();
     let what = format!("state edits {edits:?}");
     let w = what.clone();
@@ -380,27 +393,38 @@ fn fuzz_the_boundaries() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
     let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    fmu::count_panics();
     let saved = states();
+    let pool = Arc::new(fmu::Pool {
+        sims: saved.clone(),
+        reference: fmu::reference_state(),
+    });
     let start = Instant::now();
-    let mut counts = [0usize; 4];
+    let mut counts = [0usize; 6];
     while start.elapsed().as_secs_f64() < seconds {
-        let k = rng.below(4);
+        let k = rng.below(6);
         match k {
             0 => fuzz_params(&mut rng),
             1 => fuzz_toml(&mut rng),
             2 => fuzz_state(&mut rng, &saved),
-            _ => fuzz_capi(&mut rng),
+            3 => fuzz_capi(&mut rng),
+            4 => fmu::fuzz(&mut rng, &pool, false),
+            _ => fmu::fuzz(&mut rng, &pool, true),
         };
         counts[k] += 1;
     }
     println!(
         "fuzz: seed {seed}, {:.0} s: {} parameter sets, {} TOML texts, {} saved states, \
-         {} C ABI call orders; 0 crashes, 0 hangs, 0 NaN on success",
+         {} C ABI call orders, {} FMI 3.0 call orders, {} FMI 2.0 call orders; \
+         0 crashes, 0 hangs, 0 NaN on success, 0 undocumented errors or statuses, \
+         0 forbidden FMU calls answered OK",
         start.elapsed().as_secs_f64(),
         counts[0],
         counts[1],
         counts[2],
-        counts[3]
+        counts[3],
+        counts[4],
+        counts[5]
     );
     assert!(counts.iter().all(|&c| c > 0), "{counts:?}");
 }

@@ -398,9 +398,11 @@ pub unsafe extern "C" fn mi_sim_state_save(
     })
 }
 
-/// Replaces the run by a state saved with `mi_sim_state_save` (of the same
-/// scene kind; else `MI_INVALID_STATE`, as for bytes that are not a state).
-/// The run then continues from the saved time, with the saved parameters.
+/// Replaces the run by a state saved with `mi_sim_state_save` of the same
+/// scene kind. The run then continues from the saved time, with the saved
+/// parameters. Anything else is `MI_INVALID_STATE` and the handle keeps its
+/// run: bytes that are not a state, a state of another scene kind, or a
+/// forged or inconsistent one (checked as a new run is).
 ///
 /// # Safety
 /// `sim` must be NULL or a live handle; `buf` NULL or valid for reads of

@@ -37,7 +37,10 @@ pub enum mi_result {
     MI_SCENE_FILE = 10,
     /// A file could not be read.
     MI_IO = 11,
-    /// Bytes that are not a saved simulation state of this scene kind.
+    /// Bytes that are not a valid saved simulation state of this scene kind:
+    /// not a saved state at all, a state of another scene kind, or a forged
+    /// or damaged one (parameters out of range, or a solver state that a run
+    /// of its parameters cannot reach).
     MI_INVALID_STATE = 12,
     /// The caller's buffer is too small; the required length was written to
     /// the length output.
@@ -127,7 +130,7 @@ pub(crate) const RESULTS: &[(mi_result, &str, &str)] = &[
     (
         mi_result::MI_INVALID_STATE,
         "MI_INVALID_STATE\0",
-        "not a saved state of this scene kind\0",
+        "not a valid saved state of this scene kind (not a state, another kind, forged or inconsistent)\0",
     ),
     (
         mi_result::MI_BUFFER_TOO_SMALL,

@@ -159,7 +159,8 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
 }
 
 /// `fmi2SetupExperiment`: records the start time and, if defined, the stop
-/// time (a later `fmi2DoStep` past it returns `fmi2Error`).
+/// time (a later `fmi2DoStep` past it returns `fmi2Error`); a non-finite
+/// time or a stop time before the start time is an Error.
 ///
 /// # Safety
 /// A live instance.
@@ -175,14 +176,8 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     // SAFETY: FMI 2.0 contract.
     unsafe {
         call(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
-            if !start_time.is_finite() {
-                return inst.fail(&format!(
-                    "fmi2SetupExperiment: startTime = {start_time} must be finite"
-                ));
-            }
-            inst.start_time = start_time;
-            inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
-            Status::Ok
+            let stop = (stop_time_defined != 0).then_some(stop_time);
+            inst.set_experiment("fmi2SetupExperiment", start_time, stop)
         })
     }
 }
@@ -199,10 +194,7 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: Component) -> Fmi2Status
             c,
             "fmi2EnterInitializationMode",
             mask::ENTER_INITIALIZATION_MODE,
-            |inst| {
-                let t = inst.start_time;
-                inst.enter_initialization_mode(t)
-            },
+            |inst| inst.enter_initialization_mode(),
         )
     }
 }
@@ -368,7 +360,7 @@ pub unsafe extern "C" fn fmi2GetString(
     _value: *mut *const c_char,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { no_strings(c, "fmi2GetString", vr, nvr) }
+    unsafe { no_strings(c, "fmi2GetString", mask::GET, vr, nvr) }
 }
 
 /// `fmi2SetReal`: Real parameters, before the end of initialization.
@@ -436,24 +428,29 @@ pub unsafe extern "C" fn fmi2SetString(
     _value: *const *const c_char,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { no_strings(c, "fmi2SetString", vr, nvr) }
+    unsafe { no_strings(c, "fmi2SetString", mask::SET, vr, nvr) }
 }
 
+/// See [`Instance::no_variables`].
+///
 /// # Safety
 /// FMI 2.0 contract.
-unsafe fn no_strings(c: Component, function: &str, vr: *const Vr, nvr: usize) -> Fmi2Status {
+unsafe fn no_strings(
+    c: Component,
+    function: &str,
+    mask: u32,
+    vr: *const Vr,
+    nvr: usize,
+) -> Fmi2Status {
     // SAFETY: forwarded.
     (unsafe {
         with_instance(c, |inst| {
-            if nvr == 0 {
-                return Status::Ok;
-            }
-            match slice(vr, nvr).and_then(|v| v.first().copied()) {
-                Some(r) => inst.fail(&format!(
-                    "{function}: value reference {r} is not a String variable (this FMU has none)"
-                )),
-                None => inst.fail(&format!("{function}: vr is NULL")),
-            }
+            inst.no_variables(
+                function,
+                mask,
+                slice(vr, nvr),
+                "a String variable (this FMU has none)",
+            )
         })
     }) as c_int
 }
@@ -767,5 +764,74 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
         status_query(c, "fmi2GetStringStatus", kind, value, |inst, k| {
             (k == FMI2_PENDING_STATUS).then(|| inst.status_string.as_ptr())
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A new Co-Simulation instance with the right GUID and no logger.
+    fn instance() -> Component {
+        let guid = std::ffi::CString::new(instantiation_token()).unwrap();
+        // SAFETY: NUL-terminated strings or NULL; no callbacks.
+        let c = unsafe {
+            fmi2Instantiate(
+                std::ptr::null(),
+                FMI2_COSIMULATION,
+                guid.as_ptr(),
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                0,
+            )
+        };
+        assert!(!c.is_null());
+        c
+    }
+
+    /// A NaN stopTime disabled the check of every step against it; now it
+    /// is refused, as are infinite ones and one before startTime. An
+    /// undefined stopTime is not looked at; one equal to startTime is fine.
+    #[test]
+    fn bad_stop_times_are_refused() {
+        let error = Status::Error as c_int;
+        for (start, stop) in [(0.0, f64::NAN), (0.0, f64::NEG_INFINITY), (1.0, 0.5)] {
+            let c = instance();
+            // SAFETY: a live instance, freed once.
+            unsafe {
+                assert_eq!(fmi2SetupExperiment(c, 0, 0.0, start, 1, stop), error);
+                assert_eq!(fmi2EnterInitializationMode(c), error, "left Terminated");
+                fmi2FreeInstance(c);
+            }
+        }
+        let c = instance();
+        // SAFETY: a live instance, freed once.
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 1.0, 0, f64::NAN), 0);
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 1.0, 1, 1.0), 0);
+            assert_eq!(fmi2EnterInitializationMode(c), 0);
+            fmi2FreeInstance(c);
+        }
+    }
+
+    /// Found by the fuzzer: fmi2GetString returned OK for an empty list in
+    /// Instantiated, fmi2SetString in Terminated.
+    #[test]
+    fn empty_string_lists_follow_the_state_machine() {
+        let c = instance();
+        let vr = [1u32];
+        let mut out = [std::ptr::null::<c_char>()];
+        let error = Status::Error as c_int;
+        // SAFETY: a live instance; empty lists.
+        unsafe {
+            assert_eq!(fmi2GetString(c, vr.as_ptr(), 0, out.as_mut_ptr()), error);
+            assert_eq!(fmi2Reset(c), 0);
+            assert_eq!(fmi2SetString(c, vr.as_ptr(), 0, out.as_ptr()), 0);
+            assert_eq!(fmi2Terminate(c), error, "not allowed in Instantiated");
+            assert_eq!(fmi2GetString(c, vr.as_ptr(), 0, out.as_mut_ptr()), 0);
+            assert_eq!(fmi2SetString(c, vr.as_ptr(), 0, out.as_ptr()), error);
+            fmi2FreeInstance(c);
+        }
     }
 }

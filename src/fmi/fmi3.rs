@@ -164,7 +164,9 @@ pub unsafe extern "C" fn fmi3FreeInstance(instance: Instance3) {
     })
 }
 
-/// `fmi3EnterInitializationMode`.
+/// `fmi3EnterInitializationMode`: records the start time and, if defined,
+/// the stop time (a later `fmi3DoStep` past it returns `fmi3Error`); a
+/// non-finite time or a stop time before the start time is an Error.
 ///
 /// # Safety
 /// A live instance.
@@ -184,8 +186,11 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
             "fmi3EnterInitializationMode",
             mask::ENTER_INITIALIZATION_MODE,
             |inst| {
-                inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
-                inst.enter_initialization_mode(start_time)
+                let stop = (stop_time_defined != 0).then_some(stop_time);
+                match inst.set_experiment("fmi3EnterInitializationMode", start_time, stop) {
+                    Status::Ok => inst.enter_initialization_mode(),
+                    s => s,
+                }
             },
         )
     }
@@ -472,9 +477,10 @@ pub unsafe extern "C" fn fmi3SetBoolean(
 }
 
 /// Getters and setters of types this FMU has no variables of: OK for an
-/// empty list, otherwise an error naming the value reference.
+/// empty list in a state that allows the getters (setters), otherwise an
+/// error.
 macro_rules! no_variables_of_type {
-    ($( $fname:ident, $t:ty, $ptr:ident; )*) => {$(
+    ($( $fname:ident, $t:ty, $ptr:ident, $mask:ident; )*) => {$(
         #[doc = concat!("`", stringify!($fname), "`: this FMU has no variables of this type.")]
         ///
         /// # Safety
@@ -488,55 +494,54 @@ macro_rules! no_variables_of_type {
             _n_values: usize,
         ) -> Fmi3Status {
             // SAFETY: FMI 3.0 contract.
-            unsafe { no_such_type(instance, stringify!($fname), vrs, nvr) }
+            unsafe { no_such_type(instance, stringify!($fname), mask::$mask, vrs, nvr) }
         }
     )*};
 }
 
+/// See [`Instance::no_variables`].
+///
 /// # Safety
 /// FMI 3.0 contract.
 unsafe fn no_such_type(
     instance: Instance3,
     function: &str,
+    mask: u32,
     vrs: *const Vr,
     nvr: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
     unsafe {
         with_instance(instance, |inst| {
-            if nvr == 0 {
-                return Status::Ok;
-            }
-            let first = slice(vrs, nvr).and_then(|v| v.first().copied());
-            match first {
-                Some(vr) => inst.fail(&format!(
-                    "{function}: value reference {vr} is not a variable of this type (this FMU has Float64, Int32 and Boolean variables)"
-                )),
-                None => inst.fail(&format!("{function}: valueReferences is NULL")),
-            }
+            inst.no_variables(
+                function,
+                mask,
+                slice(vrs, nvr),
+                "a variable of this type (this FMU has Float64, Int32 and Boolean variables)",
+            )
         }) as c_int
     }
 }
 
 no_variables_of_type! {
-    fmi3GetFloat32, f32, mut;
-    fmi3GetInt8, i8, mut;
-    fmi3GetUInt8, u8, mut;
-    fmi3GetInt16, i16, mut;
-    fmi3GetUInt16, u16, mut;
-    fmi3GetUInt32, u32, mut;
-    fmi3GetInt64, i64, mut;
-    fmi3GetUInt64, u64, mut;
-    fmi3GetString, *const c_char, mut;
-    fmi3SetFloat32, f32, const;
-    fmi3SetInt8, i8, const;
-    fmi3SetUInt8, u8, const;
-    fmi3SetInt16, i16, const;
-    fmi3SetUInt16, u16, const;
-    fmi3SetUInt32, u32, const;
-    fmi3SetInt64, i64, const;
-    fmi3SetUInt64, u64, const;
-    fmi3SetString, *const c_char, const;
+    fmi3GetFloat32, f32, mut, GET;
+    fmi3GetInt8, i8, mut, GET;
+    fmi3GetUInt8, u8, mut, GET;
+    fmi3GetInt16, i16, mut, GET;
+    fmi3GetUInt16, u16, mut, GET;
+    fmi3GetUInt32, u32, mut, GET;
+    fmi3GetInt64, i64, mut, GET;
+    fmi3GetUInt64, u64, mut, GET;
+    fmi3GetString, *const c_char, mut, GET;
+    fmi3SetFloat32, f32, const, SET;
+    fmi3SetInt8, i8, const, SET;
+    fmi3SetUInt8, u8, const, SET;
+    fmi3SetInt16, i16, const, SET;
+    fmi3SetUInt16, u16, const, SET;
+    fmi3SetUInt32, u32, const, SET;
+    fmi3SetInt64, i64, const, SET;
+    fmi3SetUInt64, u64, const, SET;
+    fmi3SetString, *const c_char, const, SET;
 }
 
 /// `fmi3GetBinary`: no Binary variables.
@@ -553,7 +558,7 @@ pub unsafe extern "C" fn fmi3GetBinary(
     _n_values: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3GetBinary", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3GetBinary", mask::GET, vrs, nvr) }
 }
 
 /// `fmi3SetBinary`: no Binary variables.
@@ -570,7 +575,7 @@ pub unsafe extern "C" fn fmi3SetBinary(
     _n_values: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3SetBinary", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3SetBinary", mask::SET, vrs, nvr) }
 }
 
 /// `fmi3GetClock`: no clocks.
@@ -585,7 +590,7 @@ pub unsafe extern "C" fn fmi3GetClock(
     _values: *mut u8,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3GetClock", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3GetClock", mask::GET, vrs, nvr) }
 }
 
 /// `fmi3SetClock`: no clocks.
@@ -600,7 +605,7 @@ pub unsafe extern "C" fn fmi3SetClock(
     _values: *const u8,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3SetClock", vrs, nvr) }
+    unsafe { no_such_type(instance, "fmi3SetClock", mask::SET, vrs, nvr) }
 }
 
 /// Functions this Co-Simulation FMU does not provide: an error naming them.
@@ -973,6 +978,184 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A new instance with the right token and no logger.
+    fn instance() -> Instance3 {
+        let token = std::ffi::CString::new(instantiation_token()).unwrap();
+        // SAFETY: NUL-terminated strings or NULL, no logger.
+        let inst = unsafe {
+            fmi3InstantiateCoSimulation(
+                std::ptr::null(),
+                token.as_ptr(),
+                std::ptr::null(),
+                0,
+                0,
+                0,
+                0,
+                std::ptr::null(),
+                0,
+                std::ptr::null_mut(),
+                None,
+                std::ptr::null_mut(),
+            )
+        };
+        assert!(!inst.is_null());
+        inst
+    }
+
+    /// A NaN stopTime disabled the check of every step against it; now it
+    /// is refused, as are infinite ones and one before startTime. An
+    /// undefined stopTime is not looked at.
+    #[test]
+    fn bad_stop_times_are_refused() {
+        let error = Status::Error as c_int;
+        for (start, stop) in [(0.0, f64::NAN), (0.0, f64::INFINITY), (1.0, 0.5)] {
+            let inst = instance();
+            // SAFETY: a live instance, freed once.
+            unsafe {
+                assert_eq!(
+                    fmi3EnterInitializationMode(inst, 0, 0.0, start, 1, stop),
+                    error
+                );
+                assert_eq!(fmi3ExitInitializationMode(inst), error, "left Terminated");
+                fmi3FreeInstance(inst);
+            }
+        }
+        let inst = instance();
+        // SAFETY: a live instance, freed once.
+        unsafe {
+            assert_eq!(
+                fmi3EnterInitializationMode(inst, 0, 0.0, 1.0, 0, f64::NAN),
+                0
+            );
+            fmi3FreeInstance(inst);
+        }
+    }
+
+    /// Status, terminateSimulation and lastSuccessfulTime of a doStep.
+    fn step(inst: Instance3, t: f64, h: f64) -> (c_int, u8, f64) {
+        let (mut event, mut terminate, mut early, mut last) = (0, 0, 0, f64::NAN);
+        // SAFETY: a live instance; writable outputs.
+        let s = unsafe {
+            fmi3DoStep(
+                inst,
+                t,
+                h,
+                0,
+                &mut event,
+                &mut terminate,
+                &mut early,
+                &mut last,
+            )
+        };
+        (s, terminate, last)
+    }
+
+    /// A coarse instance (4 particles across) in step mode from `start`.
+    fn stepping(start: f64) -> Instance3 {
+        let inst = instance();
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        // SAFETY: a live instance; one value reference and one value.
+        unsafe {
+            assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
+            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, start, 0, 0.0), 0);
+            assert_eq!(fmi3ExitInitializationMode(inst), 0);
+        }
+        inst
+    }
+
+    /// Found by the FMU call-order fuzzer: a step from a huge time ended at
+    /// infinity (OK, lastSuccessfulTime = inf and the time variable inf
+    /// from then on) or was lost in rounding (OK, time unchanged).
+    #[test]
+    fn a_step_must_end_at_a_finite_later_time() {
+        let error = Status::Error as c_int;
+        let inst = stepping(0.0);
+        // To the end of the run and far beyond: the outputs hold.
+        assert_eq!(step(inst, 0.0, f64::MAX), (0, 1, f64::MAX));
+        assert_eq!(step(inst, f64::MAX, f64::MAX).0, error);
+        let mut time = f64::NAN;
+        // SAFETY: a live instance, freed once; one value reference and value.
+        unsafe {
+            // Values may be read after an Error.
+            assert_eq!(fmi3GetFloat64(inst, &VR_TIME, 1, &mut time, 1), 0);
+            assert_eq!(time, f64::MAX);
+            fmi3FreeInstance(inst);
+        }
+        // From a huge start time a small step is lost in rounding.
+        let inst = stepping(1e300);
+        assert_eq!(step(inst, 1e300, 1e-6).0, error);
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
+    }
+
+    /// Found by the FMU call-order fuzzer: the tolerance on the current time
+    /// grew with the step size, so a step of 1e300 s accepted a current time
+    /// of 2.8e30 s at an FMU time of microseconds (and returned, with early
+    /// return, a lastSuccessfulTime before the current time). Rounding of
+    /// the times a host adds up is still accepted.
+    #[test]
+    fn a_huge_step_does_not_excuse_a_wrong_current_time() {
+        let error = Status::Error as c_int;
+        let inst = stepping(0.0);
+        assert_eq!(step(inst, 0.0, 1e-6).0, 0);
+        assert_eq!(step(inst, 1e-6 * (1.0 + 1e-12), 1e-6).0, 0, "rounding");
+        assert_eq!(step(inst, 1e30, 1e300).0, error);
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
+        let inst = stepping(-1.0);
+        // Near t = 0 from startTime = -1 s, a host's sums carry the rounding
+        // of 1 s.
+        assert_eq!(step(inst, -1.0, 1.0 - 1e-12).0, 0);
+        assert_eq!(
+            step(inst, -1e-12 + 1e-16, 1e-6).0,
+            0,
+            "rounding of |startTime|"
+        );
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
+    }
+
+    /// Found by the fuzzer: a getter of a type without variables returned OK
+    /// for an empty list in Instantiated, a setter in Terminated.
+    #[test]
+    fn empty_lists_of_absent_types_follow_the_state_machine() {
+        let inst = instance();
+        let vrs = [0u32; 1];
+        let pr = variables()
+            .iter()
+            .find(|v| v.name == "particles_radial")
+            .unwrap()
+            .vr;
+        let get = |inst| {
+            let mut out = [0f32; 1];
+            // SAFETY: a live instance; an empty list.
+            unsafe { fmi3GetFloat32(inst, vrs.as_ptr(), 0, out.as_mut_ptr(), 0) }
+        };
+        let set = |inst| {
+            // SAFETY: a live instance; an empty list.
+            unsafe { fmi3SetString(inst, vrs.as_ptr(), 0, std::ptr::null(), 0) }
+        };
+        let error = Status::Error as c_int;
+        assert_eq!(get(inst), error, "no getter in Instantiated");
+        // SAFETY: a live instance; one value reference and one value.
+        unsafe {
+            assert_eq!(fmi3Reset(inst), 0);
+            assert_eq!(set(inst), 0, "setters are allowed in Instantiated");
+            assert_eq!(fmi3SetInt32(inst, &pr, 1, &4, 1), 0);
+            assert_eq!(fmi3EnterInitializationMode(inst, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(get(inst), 0, "getters are allowed in InitializationMode");
+            assert_eq!(fmi3ExitInitializationMode(inst), 0);
+            assert_eq!(fmi3Terminate(inst), 0);
+            assert_eq!(get(inst), 0, "getters are allowed in Terminated");
+            assert_eq!(set(inst), error, "no setter in Terminated");
+            fmi3FreeInstance(inst);
+        }
+    }
 
     #[test]
     fn version_and_null_instance() {

@@ -26,7 +26,7 @@ pub mod model_description;
 use crate::observe::{ObservableSpec, TAYLOR_OBSERVABLES};
 use crate::scene::params::ParamSpec;
 use crate::scene::taylor::TAYLOR_PARAMS;
-use crate::{Scene, Simulation};
+use crate::{Scene, SceneKind, Simulation};
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -286,6 +286,22 @@ pub(crate) struct StepOutcome {
     pub last_successful_time: f64,
 }
 
+/// Why a startTime and stopTime are not an experiment: startTime must be
+/// finite, and a defined stopTime finite and not before it. A NaN stopTime
+/// would disable the check of every step against it, one before startTime
+/// would refuse every step.
+fn experiment_error(start: f64, stop: Option<f64>) -> Option<String> {
+    if !start.is_finite() {
+        return Some(format!("startTime = {start} must be finite"));
+    }
+    match stop {
+        Some(stop) if !(stop.is_finite() && stop >= start) => Some(format!(
+            "stopTime = {stop} must be finite and not before startTime = {start}"
+        )),
+        _ => None,
+    }
+}
+
 /// The part of an instance that a host saves and restores (FMU state).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Saved {
@@ -293,6 +309,11 @@ pub(crate) struct Saved {
     scene: Scene,
     sim: Option<Simulation>,
     start_time: f64,
+    /// The experiment's stopTime goes with its startTime: a host that
+    /// restores a state after Reset, or in another instance, gets the
+    /// experiment the run belongs to. (Absent in bytes from before: none.)
+    #[serde(default)]
+    stop_time: Option<f64>,
     time: f64,
     at_end: bool,
     last_successful_time: f64,
@@ -410,6 +431,28 @@ impl Instance {
         Ok(())
     }
 
+    /// A getter or setter of a type this FMU has no variables of (FMI 3
+    /// Float32, Int8, ..., String, Binary, Clock; FMI 2 String). In a state
+    /// that allows `function` (`mask`, that of the getters or the setters)
+    /// an empty list is OK and anything else an Error naming the first value
+    /// reference, which is not `what`; in any other state, Error.
+    pub(crate) fn no_variables(
+        &mut self,
+        function: &str,
+        mask: u32,
+        vrs: Option<&[u32]>,
+        what: &str,
+    ) -> Status {
+        if let Err(s) = self.check_state(function, mask) {
+            return s;
+        }
+        match vrs {
+            Some([]) => Status::Ok,
+            Some([vr, ..]) => self.fail(&format!("{function}: value reference {vr} is not {what}")),
+            None => self.fail(&format!("{function}: the value references are NULL")),
+        }
+    }
+
     /// `fmi3SetDebugLogging` / `fmi2SetDebugLogging`.
     pub(crate) fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Status {
         if categories.is_empty() {
@@ -431,13 +474,27 @@ impl Instance {
         Status::Ok
     }
 
-    pub(crate) fn enter_initialization_mode(&mut self, start_time: f64) -> Status {
-        if !start_time.is_finite() {
-            return self.fail(&format!("startTime = {start_time} must be finite"));
+    /// Records the experiment (`fmi2SetupExperiment`, the times given to
+    /// `fmi3EnterInitializationMode`), or refuses it with Error naming the
+    /// value: see [`experiment_error`].
+    pub(crate) fn set_experiment(
+        &mut self,
+        function: &str,
+        start: f64,
+        stop: Option<f64>,
+    ) -> Status {
+        if let Some(e) = experiment_error(start, stop) {
+            return self.fail(&format!("{function}: {e}"));
         }
-        self.start_time = start_time;
-        self.time = start_time;
-        self.last_successful_time = start_time;
+        self.start_time = start;
+        self.stop_time = stop;
+        Status::Ok
+    }
+
+    /// Enters initialization mode at the experiment's start time.
+    pub(crate) fn enter_initialization_mode(&mut self) -> Status {
+        self.time = self.start_time;
+        self.last_successful_time = self.start_time;
         self.state = INITIALIZATION_MODE;
         Status::Ok
     }
@@ -604,8 +661,11 @@ impl Instance {
                 "{function}: communicationStepSize = {h} must be positive and finite"
             )));
         }
-        // Hosts' step sizes vary in the last ulp: compare with a tolerance.
-        let tol = 1e-9 * (self.time.abs() + h.abs());
+        // Hosts add up communication times in floating point: the current
+        // time may differ from the FMU's in the last digits of the times
+        // added (the start and the steps so far, not this step's size: a
+        // huge step must not excuse any current time).
+        let tol = 1e-9 * (self.time.abs() + self.start_time.abs());
         if !current.is_finite() || (current - self.time).abs() > tol {
             return Err(self.fail(&format!(
                 "{function}: currentCommunicationPoint = {current} s does not match the FMU's time {} s",
@@ -613,6 +673,14 @@ impl Instance {
             )));
         }
         let target = current + h;
+        // A step must end at a finite time after the current one: not at
+        // infinity (a huge step from a huge time), not lost in rounding (a
+        // small step from a huge time).
+        if !target.is_finite() || target <= current {
+            return Err(self.fail(&format!(
+                "{function}: the step would end at t = {target} s (currentCommunicationPoint = {current} s + communicationStepSize = {h} s), not a finite time after the current one"
+            )));
+        }
         // FMI 2.0 (fmi2SetupExperiment) and FMI 3.0
         // (fmi3EnterInitializationMode): computing past a defined stopTime
         // is an error. Rounding slack: 1e-9 of |stopTime| + step size.
@@ -672,7 +740,8 @@ impl Instance {
                 "{why} at t = {sim_time:.6e} s after {steps} steps; outputs hold their final values"
             ),
         );
-        let early = sim_time < target - tol;
+        // The run ended before the end of the step (beyond rounding).
+        let early = sim_time < target - 1e-9 * (current.abs() + h);
         let last = if early { sim_time } else { target };
         self.last_successful_time = last;
         Ok(StepOutcome {
@@ -699,6 +768,7 @@ impl Instance {
             scene: self.scene.clone(),
             sim: self.sim.clone(),
             start_time: self.start_time,
+            stop_time: self.stop_time,
             time: self.time,
             at_end: self.at_end,
             last_successful_time: self.last_successful_time,
@@ -710,6 +780,7 @@ impl Instance {
         self.scene = s.scene.clone();
         self.sim = s.sim.clone();
         self.start_time = s.start_time;
+        self.stop_time = s.stop_time;
         self.time = s.time;
         self.at_end = s.at_end;
         self.last_successful_time = s.last_successful_time;
@@ -756,6 +827,28 @@ impl Saved {
         if !times.iter().all(|t| t.is_finite()) || saved.time < saved.start_time {
             return Err("invalid serialized state: its communication times are not valid".into());
         }
+        if let Some(e) = experiment_error(saved.start_time, saved.stop_time) {
+            return Err(format!("invalid serialized state: its experiment: {e}"));
+        }
+        if saved.scene.kind() != SceneKind::Taylor {
+            return Err(
+                "invalid serialized state: its parameters are not the Taylor scene's".into(),
+            );
+        }
+        // The run is there exactly when an instance in that state has one,
+        // and it is the run of the instance's parameters (those it reports).
+        let run = match (&saved.sim, saved.state) {
+            (None, STEP_MODE | STEP_DISCARDED) => Err("it is past initialization but holds no run"),
+            (Some(_), INSTANTIATED) => Err("it holds a run before initialization"),
+            (Some(sim), _) if sim.scene() != &saved.scene => {
+                Err("its run is not one of its parameters")
+            }
+            (Some(sim), INITIALIZATION_MODE) if sim.steps() != 0 => {
+                Err("its run has stepped before the end of initialization")
+            }
+            _ => Ok(()),
+        };
+        run.map_err(|e| format!("invalid serialized state: {e}"))?;
         if let Some(sim) = &saved.sim {
             sim.check_restored()
                 .map_err(|e| format!("invalid serialized state: {e}"))?;
@@ -888,26 +981,35 @@ mod tests {
         assert!(t.starts_with('{') && t.ends_with('}'));
     }
 
+    /// The value reference of a variable.
+    fn vr_of(name: &str) -> u32 {
+        variables().iter().find(|v| v.name == name).unwrap().vr
+    }
+
+    /// A new instance at 4 particles across the radius (cheap steps).
+    fn coarse(standard: Standard) -> Instance {
+        let mut inst = Instance::new(standard, "t", LogSink::None, false);
+        let pr = vr_of("particles_radial");
+        assert_eq!(inst.set("set", &[pr], &[4.0], VarType::Int32), Status::Ok);
+        inst
+    }
+
     #[test]
     fn fixed_parameter_refused_after_initialization_and_bad_values_named() {
         let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
-        let density = variables().iter().find(|v| v.name == "density").unwrap().vr;
+        let density = vr_of("density");
         assert_eq!(
             inst.set("fmi3SetFloat64", &[density], &[-5.0], VarType::Float64),
             Status::Error
         );
         assert_eq!(inst.state, TERMINATED);
         inst.reset();
-        let pr = variables()
-            .iter()
-            .find(|v| v.name == "particles_radial")
-            .unwrap()
-            .vr;
+        let pr = vr_of("particles_radial");
         assert_eq!(
             inst.set("fmi3SetInt32", &[pr], &[5.0], VarType::Int32),
             Status::Ok
         );
-        assert_eq!(inst.enter_initialization_mode(0.0), Status::Ok);
+        assert_eq!(inst.enter_initialization_mode(), Status::Ok);
         assert_eq!(inst.exit_initialization_mode(), Status::Ok);
         assert_eq!(
             inst.set("fmi3SetFloat64", &[density], &[7000.0], VarType::Float64),
@@ -916,18 +1018,65 @@ mod tests {
         assert_eq!(inst.state, TERMINATED);
     }
 
+    /// A logger that keeps the messages (environment: a `Vec<String>`).
+    unsafe extern "C" fn keep(
+        env: *mut c_void,
+        _status: c_int,
+        _category: *const c_char,
+        message: *const c_char,
+    ) {
+        // SAFETY: the test's vector, not otherwise borrowed during the call;
+        // a NUL-terminated message.
+        unsafe {
+            (*(env as *mut Vec<String>)).push(
+                std::ffi::CStr::from_ptr(message)
+                    .to_string_lossy()
+                    .into_owned(),
+            )
+        }
+    }
+
+    #[test]
+    fn experiment_times_are_checked_and_named() {
+        let bad = [
+            (0.0, Some(f64::NAN), "stopTime = NaN"),
+            (0.0, Some(f64::INFINITY), "stopTime = inf"),
+            (0.0, Some(f64::NEG_INFINITY), "stopTime = -inf"),
+            (
+                2e-6,
+                Some(1e-6),
+                "stopTime = 0.000001 must be finite and not before startTime = 0.000002",
+            ),
+            (f64::NAN, None, "startTime = NaN"),
+        ];
+        for (start, stop, named) in bad {
+            let mut messages: Vec<String> = Vec::new();
+            let log = LogSink::Fmi3 {
+                callback: keep,
+                environment: &mut messages as *mut Vec<String> as *mut c_void,
+            };
+            let mut inst = Instance::new(Standard::Fmi3, "t", log, false);
+            assert_eq!(inst.set_experiment("f", start, stop), Status::Error);
+            assert_eq!(inst.state, TERMINATED);
+            assert_eq!(inst.stop_time, None, "{named}: not recorded");
+            drop(inst);
+            assert_eq!(messages.len(), 1);
+            assert!(
+                messages[0].contains(named),
+                "{messages:?} should name {named}"
+            );
+        }
+        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
+        assert_eq!(inst.set_experiment("f", 1e-6, Some(1e-6)), Status::Ok);
+        assert_eq!((inst.start_time, inst.stop_time), (1e-6, Some(1e-6)));
+    }
+
     #[test]
     fn step_past_stop_time_is_an_error() {
-        let pr = variables()
-            .iter()
-            .find(|v| v.name == "particles_radial")
-            .unwrap()
-            .vr;
         let start = |stop: Option<f64>| {
-            let mut inst = Instance::new(Standard::Fmi2, "t", LogSink::None, false);
-            inst.set("fmi2SetInteger", &[pr], &[4.0], VarType::Int32);
+            let mut inst = coarse(Standard::Fmi2);
             inst.stop_time = stop;
-            assert_eq!(inst.enter_initialization_mode(0.0), Status::Ok);
+            assert_eq!(inst.enter_initialization_mode(), Status::Ok);
             assert_eq!(inst.exit_initialization_mode(), Status::Ok);
             inst
         };
@@ -955,16 +1104,134 @@ mod tests {
         assert!(inst.do_step("doStep", 0.0, 1.8e-6 * (1.0 + 1e-6)).is_ok());
     }
 
+    /// Serialized state bytes with their JSON edited by `edit`.
+    fn forge(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+        let header = bytes
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| **b == b'\n')
+            .nth(1)
+            .unwrap()
+            .0
+            + 1;
+        let mut json: serde_json::Value = serde_json::from_slice(&bytes[header..]).unwrap();
+        edit(&mut json);
+        let mut out = bytes[..header].to_vec();
+        out.extend(serde_json::to_vec(&json).unwrap());
+        out
+    }
+
+    /// Found by the FMU call-order fuzzer: a state in step mode without its
+    /// run was accepted, and the next doStep panicked (Fatal). A run and
+    /// parameters that do not belong together are refused as well: the
+    /// outputs would not be those of the parameters, and a Noh run or scene
+    /// has none of the Taylor variables.
+    #[test]
+    fn states_whose_run_does_not_fit_are_refused() {
+        let mut inst = coarse(Standard::Fmi3);
+        inst.enter_initialization_mode();
+        let init = inst.save().serialize();
+        inst.exit_initialization_mode();
+        inst.do_step("doStep", 0.0, 1e-6).unwrap();
+        let stepped = inst.save().serialize();
+        let mut other = Scene::builtin("taylor").unwrap();
+        other.set("particles_radial", 5.0).unwrap();
+        let other = serde_json::to_value(Simulation::new(other).unwrap()).unwrap();
+        let mut noh = Scene::builtin("noh").unwrap();
+        noh.set("particles_radial", 100.0).unwrap();
+        let noh = serde_json::to_value(Simulation::new(noh).unwrap()).unwrap();
+        let refused = |bytes: &[u8], why: &str| {
+            let e = Saved::deserialize(bytes).unwrap_err();
+            assert!(e.contains(why), "{e} should say {why}");
+        };
+        refused(
+            &forge(&stepped, |j| j["sim"] = serde_json::Value::Null),
+            "holds no run",
+        );
+        let mut done = forge(&stepped, |j| j["sim"] = serde_json::Value::Null);
+        done = forge(&done, |j| j["state"] = serde_json::json!(STEP_DISCARDED));
+        refused(&done, "holds no run");
+        refused(
+            &forge(&stepped, |j| j["state"] = serde_json::json!(INSTANTIATED)),
+            "before initialization",
+        );
+        refused(
+            &forge(&stepped, |j| {
+                j["state"] = serde_json::json!(INITIALIZATION_MODE)
+            }),
+            "stepped",
+        );
+        refused(
+            &forge(&stepped, |j| j["sim"] = other.clone()),
+            "not one of its parameters",
+        );
+        refused(
+            &forge(&stepped, |j| j["sim"] = noh.clone()),
+            "not one of its parameters",
+        );
+        refused(
+            &forge(&init, |j| j["scene"] = noh["scene"].clone()),
+            "not the Taylor scene's",
+        );
+        // The honest states load, and one without a run where that is right.
+        assert!(Saved::deserialize(&stepped).is_ok());
+        assert!(Saved::deserialize(&init).is_ok());
+        let ended = forge(&stepped, |j| {
+            j["sim"] = serde_json::Value::Null;
+            j["state"] = serde_json::json!(TERMINATED);
+        });
+        assert!(Saved::deserialize(&ended).is_ok());
+    }
+
+    /// Found by the FMU call-order fuzzer: the stopTime was not part of the
+    /// FMU state, so a state restored after Reset (or deserialized into a
+    /// new instance) stepped past the stopTime of its experiment.
+    #[test]
+    fn the_stop_time_is_part_of_the_state() {
+        let mut inst = coarse(Standard::Fmi3);
+        assert_eq!(inst.set_experiment("f", 0.0, Some(2e-6)), Status::Ok);
+        inst.enter_initialization_mode();
+        inst.exit_initialization_mode();
+        inst.do_step("doStep", 0.0, 1e-6).unwrap();
+        let saved = inst.save();
+        let bytes = saved.serialize();
+        inst.reset();
+        assert_eq!(inst.stop_time, None);
+        inst.restore(&saved);
+        assert_eq!(inst.stop_time, Some(2e-6));
+        assert_eq!(
+            inst.do_step("doStep", 1e-6, 2e-6).unwrap_err(),
+            Status::Error
+        );
+        let mut other = Instance::new(Standard::Fmi2, "u", LogSink::None, false);
+        other.restore(&Saved::deserialize(&bytes).unwrap());
+        assert_eq!(other.stop_time, Some(2e-6));
+        assert!(
+            other.do_step("doStep", 1e-6, 1e-6).is_ok(),
+            "up to stopTime"
+        );
+        assert_eq!(
+            other.do_step("doStep", 2e-6, 1e-6).unwrap_err(),
+            Status::Error
+        );
+        // A forged experiment is refused; bytes without a stopTime (as
+        // before) load without one.
+        let before = forge(&bytes, |j| j["stop_time"] = serde_json::json!(-1e-6));
+        let e = Saved::deserialize(&before).unwrap_err();
+        assert!(
+            e.contains("stopTime = -0.000001 must be finite and not before"),
+            "{e}"
+        );
+        let old = forge(&bytes, |j| {
+            j.as_object_mut().unwrap().remove("stop_time");
+        });
+        assert_eq!(Saved::deserialize(&old).unwrap().stop_time, None);
+    }
+
     #[test]
     fn state_round_trips_through_bytes() {
-        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
-        let pr = variables()
-            .iter()
-            .find(|v| v.name == "particles_radial")
-            .unwrap()
-            .vr;
-        inst.set("fmi3SetInt32", &[pr], &[4.0], VarType::Int32);
-        inst.enter_initialization_mode(0.0);
+        let mut inst = coarse(Standard::Fmi3);
+        inst.enter_initialization_mode();
         inst.exit_initialization_mode();
         inst.do_step("doStep", 0.0, 1e-6).unwrap();
         let bytes = inst.save().serialize();
