@@ -111,7 +111,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
 ) -> Component {
     guard(std::ptr::null_mut(), || {
         // SAFETY: NUL-terminated or NULL by the FMI contract.
-        let name = unsafe { c_str(instance_name) }.unwrap_or_else(|| MODEL_IDENTIFIER.into());
+        let guid = unsafe { c_str(fmu_guid) };
+        let found = Fmu::for_instantiation("fmi2Instantiate", guid.as_deref());
+        let fmu = found.clone().unwrap_or_else(|_| Fmu::all()[0]);
+        // SAFETY: as above.
+        let name = unsafe { c_str(instance_name) }
+            .unwrap_or_else(|| fmu.identity().model_identifier.into());
         // SAFETY: `functions` is NULL or a valid struct by the contract.
         let log = match unsafe { functions.as_ref() } {
             Some(CallbackFunctions {
@@ -124,20 +129,17 @@ pub unsafe extern "C" fn fmi2Instantiate(
             },
             _ => LogSink::None,
         };
-        let mut inst = Instance::new(Standard::Fmi2, &name, log, logging_on != 0);
+        let mut inst = Instance::new(Standard::Fmi2, fmu, &name, log, logging_on != 0);
         if fmu_type != FMI2_COSIMULATION {
-            inst.fail("fmi2Instantiate: TaylorImpact supports only Co-Simulation (fmuType = fmi2CoSimulation)");
+            inst.fail(&format!(
+                "fmi2Instantiate: {} supports only Co-Simulation (fmuType = fmi2CoSimulation)",
+                fmu.identity().model_identifier
+            ));
             return std::ptr::null_mut();
         }
-        // SAFETY: as above.
-        if let Some(guid) = unsafe { c_str(fmu_guid) } {
-            let expected = instantiation_token();
-            if guid != expected {
-                inst.fail(&format!(
-                    "fmi2Instantiate: GUID `{guid}` does not match this FMU's `{expected}`"
-                ));
-                return std::ptr::null_mut();
-            }
+        if let Err(message) = found {
+            inst.fail(&message);
+            return std::ptr::null_mut();
         }
         Box::into_raw(Box::new(inst)) as Component
     })
@@ -773,7 +775,7 @@ mod tests {
 
     /// A new Co-Simulation instance with the right GUID and no logger.
     fn instance() -> Component {
-        let guid = std::ffi::CString::new(instantiation_token()).unwrap();
+        let guid = std::ffi::CString::new(taylor_fmu().token()).unwrap();
         // SAFETY: NUL-terminated strings or NULL; no callbacks.
         let c = unsafe {
             fmi2Instantiate(

@@ -124,7 +124,12 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 ) -> Instance3 {
     guard(std::ptr::null_mut(), || {
         // SAFETY: NUL-terminated or NULL by the FMI contract.
-        let name = unsafe { c_str(instance_name) }.unwrap_or_else(|| MODEL_IDENTIFIER.into());
+        let token = unsafe { c_str(instantiation_token) };
+        let found = Fmu::for_instantiation("fmi3InstantiateCoSimulation", token.as_deref());
+        let fmu = found.clone().unwrap_or_else(|_| Fmu::all()[0]);
+        // SAFETY: as above.
+        let name = unsafe { c_str(instance_name) }
+            .unwrap_or_else(|| fmu.identity().model_identifier.into());
         let log = match log_message {
             Some(callback) => LogSink::Fmi3 {
                 callback,
@@ -132,17 +137,11 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
             },
             None => LogSink::None,
         };
-        let mut inst = Instance::new(Standard::Fmi3, &name, log, logging_on != 0);
+        let mut inst = Instance::new(Standard::Fmi3, fmu, &name, log, logging_on != 0);
         inst.early_return_allowed = early_return_allowed != 0;
-        // SAFETY: as above.
-        if let Some(token) = unsafe { c_str(instantiation_token) } {
-            let expected = super::instantiation_token();
-            if token != expected {
-                inst.fail(&format!(
-                    "fmi3InstantiateCoSimulation: instantiationToken `{token}` does not match this FMU's `{expected}`"
-                ));
-                return std::ptr::null_mut();
-            }
+        if let Err(message) = found {
+            inst.fail(&message);
+            return std::ptr::null_mut();
         }
         Box::into_raw(Box::new(inst)) as Instance3
     })
@@ -831,7 +830,7 @@ pub(crate) unsafe fn serialized_size(
                 return inst.fail(&format!("{function}: FMUState or size is NULL"));
             }
             // SAFETY: a live `Box<Saved>`; `size` writable.
-            *size = (*(state as *const Saved)).serialize().len();
+            *size = (*(state as *const Saved)).serialize(inst.fmu).len();
             Status::Ok
         })
     }
@@ -855,7 +854,7 @@ pub(crate) unsafe fn serialize(
                 return inst.fail(&format!("{function}: FMUState is NULL"));
             }
             // SAFETY: a live `Box<Saved>`.
-            let data = (*(state as *const Saved)).serialize();
+            let data = (*(state as *const Saved)).serialize(inst.fmu);
             if data.len() != size {
                 return inst.fail(&format!(
                     "{function}: size = {size} but the serialized state has {} bytes",
@@ -891,7 +890,7 @@ pub(crate) unsafe fn deserialize(
             if state.is_null() {
                 return inst.fail(&format!("{function}: FMUState is NULL"));
             }
-            match Saved::deserialize(data) {
+            match Saved::deserialize(inst.fmu, data) {
                 Ok(saved) => {
                     // SAFETY: writable; a non-null `*state` is a live `Box<Saved>`.
                     if (*state).is_null() {
@@ -981,7 +980,7 @@ mod tests {
 
     /// A new instance with the right token and no logger.
     fn instance() -> Instance3 {
-        let token = std::ffi::CString::new(instantiation_token()).unwrap();
+        let token = std::ffi::CString::new(taylor_fmu().token()).unwrap();
         // SAFETY: NUL-terminated strings or NULL, no logger.
         let inst = unsafe {
             fmi3InstantiateCoSimulation(
@@ -1054,7 +1053,8 @@ mod tests {
     /// A coarse instance (4 particles across) in step mode from `start`.
     fn stepping(start: f64) -> Instance3 {
         let inst = instance();
-        let pr = variables()
+        let pr = taylor_fmu()
+            .variables()
             .iter()
             .find(|v| v.name == "particles_radial")
             .unwrap()
@@ -1126,7 +1126,8 @@ mod tests {
     fn empty_lists_of_absent_types_follow_the_state_machine() {
         let inst = instance();
         let vrs = [0u32; 1];
-        let pr = variables()
+        let pr = taylor_fmu()
+            .variables()
             .iter()
             .find(|v| v.name == "particles_radial")
             .unwrap()

@@ -1,5 +1,8 @@
-//! FMI 3.0 and FMI 2.0 Co-Simulation glue over the same core (model
-//! identifier `TaylorImpact`).
+//! FMI 3.0 and FMI 2.0 Co-Simulation glue over the same core: one FMU per
+//! row of the scene registry that declares an FMU identity
+//! ([`crate::scene::registry::FmuIdentity`]; today `TaylorImpact`, the
+//! `taylor` scene). One library serves every FMU: an instance takes the row
+//! whose instantiation token the host gives.
 //!
 //! The FMUs expose the Taylor scene: every parameter of
 //! [`crate::scene::taylor::TAYLOR_PARAMS`] as a fixed
@@ -23,18 +26,161 @@ pub mod fmi2;
 pub mod fmi3;
 pub mod model_description;
 
-use crate::observe::{ObservableSpec, TAYLOR_OBSERVABLES};
+use crate::observe::ObservableSpec;
 use crate::scene::params::ParamSpec;
-use crate::scene::taylor::TAYLOR_PARAMS;
+use crate::scene::registry::{FmuIdentity, SCENES, SceneRow};
 use crate::{Scene, SceneKind, Simulation};
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-/// The model identifier: the name of the shared library inside the FMUs.
-pub const MODEL_IDENTIFIER: &str = "TaylorImpact";
+/// One FMU: a row of the scene registry with an FMU identity.
+#[derive(Clone, Copy)]
+pub struct Fmu(&'static SceneRow);
 
-/// The model name shown by hosts.
-pub const MODEL_NAME: &str = "TaylorImpact";
+impl std::fmt::Debug for Fmu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Fmu({})", self.identity().model_identifier)
+    }
+}
+
+impl PartialEq for Fmu {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.0, other.0)
+    }
+}
+
+impl Fmu {
+    /// Every FMU the registry declares, in its order.
+    pub fn all() -> Vec<Fmu> {
+        SCENES
+            .iter()
+            .filter(|r| r.fmu.is_some())
+            .map(|r| Fmu(r))
+            .collect()
+    }
+
+    /// The FMU whose model identifier is `id`.
+    pub fn named(id: &str) -> Option<Fmu> {
+        Fmu::all()
+            .into_iter()
+            .find(|f| f.identity().model_identifier == id)
+    }
+
+    /// The FMU whose instantiation token (GUID) is `token`.
+    pub fn with_token(token: &str) -> Option<Fmu> {
+        Fmu::all().into_iter().find(|f| f.token() == token)
+    }
+
+    /// The model identifier, name and description.
+    pub fn identity(self) -> FmuIdentity {
+        self.0.fmu.expect("an Fmu is a row with an FMU identity")
+    }
+
+    /// The scene row it packages.
+    pub fn row(self) -> &'static SceneRow {
+        self.0
+    }
+
+    /// The scene kind it runs.
+    pub fn kind(self) -> SceneKind {
+        SceneKind::named(self.0.name).expect("a row of the registry")
+    }
+
+    /// Every variable of the FMU: `time` (value reference 0, listed only in
+    /// the FMI 3 model description), then the scene's parameters in table
+    /// order (value references 1, 2, ...), then its observables in table
+    /// order. This is the single source of the value references.
+    pub fn variables(self) -> Vec<Variable> {
+        let mut out = vec![Variable {
+            vr: VR_TIME,
+            name: "time",
+            ty: VarType::Float64,
+            kind: VarKind::Time,
+        }];
+        let mut vr = 1;
+        for p in self.0.params {
+            out.push(Variable {
+                vr,
+                name: p.name,
+                ty: if p.range.integer {
+                    VarType::Int32
+                } else {
+                    VarType::Float64
+                },
+                kind: VarKind::Parameter(p),
+            });
+            vr += 1;
+        }
+        for (k, o) in self.0.observables.iter().enumerate() {
+            out.push(Variable {
+                vr,
+                name: o.name,
+                ty: if o.is_bool() {
+                    VarType::Boolean
+                } else {
+                    VarType::Float64
+                },
+                kind: VarKind::Output(k, o),
+            });
+            vr += 1;
+        }
+        out
+    }
+
+    /// The variable with value reference `vr`.
+    fn variable(self, vr: u32) -> Option<Variable> {
+        // The table is small (tens of rows); a linear lookup keeps one
+        // source of truth.
+        self.variables().into_iter().find(|v| v.vr == vr)
+    }
+
+    /// The instantiation token (FMI 3) / GUID (FMI 2): a deterministic hash
+    /// of the model identifier, the crate version and the generated
+    /// variable list, formatted as a GUID.
+    pub fn token(self) -> String {
+        // 128-bit FNV-1a over a canonical text of everything a host relies on.
+        let mut text = format!("{} {}\n", self.identity().model_identifier, crate::VERSION);
+        for v in self.variables() {
+            text.push_str(&format!("{} {} {:?} {}", v.vr, v.name, v.ty, v.unit()));
+            if let VarKind::Parameter(p) = v.kind {
+                text.push_str(&format!(" {:e} {}", p.default, p.range));
+            }
+            text.push('\n');
+        }
+        let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
+        for b in text.bytes() {
+            h ^= b as u128;
+            h = h.wrapping_mul(0x0000000001000000000000000000013B);
+        }
+        let s = format!("{h:032x}");
+        format!(
+            "{{{}-{}-{}-{}-{}}}",
+            &s[0..8],
+            &s[8..12],
+            &s[12..16],
+            &s[16..20],
+            &s[20..32]
+        )
+    }
+
+    /// The FMU an instantiation asks for: the one whose token it gives, or
+    /// with no token the first FMU; otherwise a message for the log.
+    pub(crate) fn for_instantiation(function: &str, token: Option<&str>) -> Result<Fmu, String> {
+        let Some(token) = token else {
+            return Ok(Fmu::all()[0]);
+        };
+        Fmu::with_token(token).ok_or_else(|| {
+            let known: Vec<String> = Fmu::all()
+                .into_iter()
+                .map(|f| format!("`{}` ({})", f.token(), f.identity().model_identifier))
+                .collect();
+            format!(
+                "{function}: instantiation token `{token}` is not one of this library's FMUs: {}",
+                known.join(", ")
+            )
+        })
+    }
+}
 
 /// Log categories declared in the model description, with their meaning.
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
@@ -76,7 +222,8 @@ pub enum VarKind {
     Time,
     /// A scene parameter: causality parameter, variability fixed.
     Parameter(&'static ParamSpec),
-    /// An observable, by its index in [`TAYLOR_OBSERVABLES`]: causality output.
+    /// An observable, by its index in the scene's observable table:
+    /// causality output.
     Output(usize, &'static ObservableSpec),
 }
 
@@ -115,81 +262,6 @@ impl Variable {
 
 /// Value reference of `time` (FMI 3).
 pub const VR_TIME: u32 = 0;
-
-/// Every variable of the FMU: `time` (value reference 0, listed only in the
-/// FMI 3 model description), then the Taylor parameters in table order
-/// (value references 1, 2, ...), then the observables in table order.
-/// This is the single source of the value references.
-pub fn variables() -> Vec<Variable> {
-    let mut out = vec![Variable {
-        vr: VR_TIME,
-        name: "time",
-        ty: VarType::Float64,
-        kind: VarKind::Time,
-    }];
-    let mut vr = 1;
-    for p in TAYLOR_PARAMS {
-        out.push(Variable {
-            vr,
-            name: p.name,
-            ty: if p.range.integer {
-                VarType::Int32
-            } else {
-                VarType::Float64
-            },
-            kind: VarKind::Parameter(p),
-        });
-        vr += 1;
-    }
-    for (k, o) in TAYLOR_OBSERVABLES.iter().enumerate() {
-        out.push(Variable {
-            vr,
-            name: o.name,
-            ty: if o.is_bool() {
-                VarType::Boolean
-            } else {
-                VarType::Float64
-            },
-            kind: VarKind::Output(k, o),
-        });
-        vr += 1;
-    }
-    out
-}
-
-/// The variable with value reference `vr`.
-fn variable(vr: u32) -> Option<Variable> {
-    // The table is small (34 rows); a linear lookup keeps one source of truth.
-    variables().into_iter().find(|v| v.vr == vr)
-}
-
-/// The instantiation token (FMI 3) / GUID (FMI 2): a deterministic hash of
-/// the crate version and the generated variable list, formatted as a GUID.
-pub fn instantiation_token() -> String {
-    // 128-bit FNV-1a over a canonical text of everything a host relies on.
-    let mut text = format!("{MODEL_IDENTIFIER} {}\n", crate::VERSION);
-    for v in variables() {
-        text.push_str(&format!("{} {} {:?} {}", v.vr, v.name, v.ty, v.unit()));
-        if let VarKind::Parameter(p) = v.kind {
-            text.push_str(&format!(" {:e} {}", p.default, p.range));
-        }
-        text.push('\n');
-    }
-    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
-    for b in text.bytes() {
-        h ^= b as u128;
-        h = h.wrapping_mul(0x0000000001000000000000000000013B);
-    }
-    let s = format!("{h:032x}");
-    format!(
-        "{{{}-{}-{}-{}-{}}}",
-        &s[0..8],
-        &s[8..12],
-        &s[12..16],
-        &s[16..20],
-        &s[20..32]
-    )
-}
 
 /// Status codes; the numbers are those of `fmi3Status` and `fmi2Status`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -319,11 +391,14 @@ pub(crate) struct Saved {
     last_successful_time: f64,
 }
 
-const STATE_MAGIC: &[u8] = b"TaylorImpact FMU state v1\n";
+/// The first line of a serialized state, after the model identifier.
+const STATE_MAGIC: &[u8] = b" FMU state v1\n";
 
 /// One FMU instance (FMI 3 or FMI 2).
 pub(crate) struct Instance {
     pub standard: Standard,
+    /// The FMU this instance is.
+    pub fmu: Fmu,
     pub name: CString,
     log: LogSink,
     categories: [bool; 4],
@@ -346,19 +421,22 @@ pub(crate) struct Instance {
     pub status_string: CString,
 }
 
-fn default_scene() -> Scene {
-    Scene::builtin("taylor").expect("the taylor scene is built in")
-}
-
 impl Instance {
-    pub(crate) fn new(standard: Standard, name: &str, log: LogSink, logging_on: bool) -> Self {
+    pub(crate) fn new(
+        standard: Standard,
+        fmu: Fmu,
+        name: &str,
+        log: LogSink,
+        logging_on: bool,
+    ) -> Self {
         Instance {
             standard,
+            fmu,
             name: CString::new(name.replace('\0', "")).unwrap_or_default(),
             log,
             categories: [logging_on; 4],
             state: INSTANTIATED,
-            scene: default_scene(),
+            scene: Scene::default_of(fmu.kind()),
             sim: None,
             start_time: 0.0,
             stop_time: None,
@@ -515,10 +593,13 @@ impl Instance {
             return s;
         }
         let sim = self.sim.as_ref().expect("built above");
+        let first = &self.scene.param_specs()[0];
         let msg = format!(
-            "initialized: {} particles, impact_speed = {} m/s, end_time = {} s",
+            "initialized: {} particles, {} = {} {}, end_time = {} s",
             sim.particles(),
-            self.scene.get("impact_speed").unwrap_or(f64::NAN),
+            first.name,
+            self.scene.get(first.name).unwrap_or(f64::NAN),
+            first.unit,
             sim.end_time()
         );
         self.log(Status::Ok, CAT_EVENTS, &msg);
@@ -543,7 +624,7 @@ impl Instance {
 
     pub(crate) fn reset(&mut self) -> Status {
         self.state = INSTANTIATED;
-        self.scene = default_scene();
+        self.scene = Scene::default_of(self.fmu.kind());
         self.sim = None;
         self.start_time = 0.0;
         self.stop_time = None;
@@ -556,7 +637,7 @@ impl Instance {
 
     /// Looks up `vr` and checks its type.
     fn lookup(&mut self, vr: u32, ty: VarType, function: &str) -> Result<Variable, Status> {
-        match variable(vr) {
+        match self.fmu.variable(vr) {
             Some(v)
                 if v.ty == ty && !(self.standard == Standard::Fmi2 && v.kind == VarKind::Time) =>
             {
@@ -707,16 +788,19 @@ impl Instance {
             return Err(self.fail(&msg));
         }
         let sim_time = self.start_time + sim.time();
-        let (steps, length) = (
-            sim.steps(),
-            sim.observable("rod_length").unwrap_or(f64::NAN),
-        );
+        let steps = sim.steps();
+        // The scene's first observable (for a rod, its length).
+        let first = &sim.observable_specs()[0];
+        let value = sim.observables()[0];
         let finished = sim.finished();
         let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
         self.log(
             Status::Ok,
             CAT_PROGRESS,
-            &format!("t = {sim_time:.6e} s, {steps} steps, rod_length = {length:.6e} m"),
+            &format!(
+                "t = {sim_time:.6e} s, {steps} steps, {} = {value:.6e} {}",
+                first.name, first.unit
+            ),
         );
         if !finished {
             self.time = target;
@@ -793,21 +877,25 @@ impl Instance {
 }
 
 impl Saved {
-    /// Bytes of this state: a magic line, the instantiation token, JSON.
-    pub(crate) fn serialize(&self) -> Vec<u8> {
-        let mut out = STATE_MAGIC.to_vec();
-        out.extend_from_slice(instantiation_token().as_bytes());
+    /// Bytes of this state of an instance of `fmu`: a magic line (the model
+    /// identifier), the instantiation token, JSON.
+    pub(crate) fn serialize(&self, fmu: Fmu) -> Vec<u8> {
+        let mut out = fmu.identity().model_identifier.as_bytes().to_vec();
+        out.extend_from_slice(STATE_MAGIC);
+        out.extend_from_slice(fmu.token().as_bytes());
         out.push(b'\n');
         out.extend(serde_json::to_vec(self).expect("the state holds only finite numbers"));
         out
     }
 
-    /// Parses [`Saved::serialize`] bytes.
-    pub(crate) fn deserialize(bytes: &[u8]) -> Result<Saved, String> {
+    /// Parses [`Saved::serialize`] bytes of an instance of `fmu`.
+    pub(crate) fn deserialize(fmu: Fmu, bytes: &[u8]) -> Result<Saved, String> {
+        let id = fmu.identity().model_identifier;
         let rest = bytes
-            .strip_prefix(STATE_MAGIC)
-            .ok_or("the bytes are not a serialized TaylorImpact FMU state")?;
-        let token = instantiation_token();
+            .strip_prefix(id.as_bytes())
+            .and_then(|r| r.strip_prefix(STATE_MAGIC))
+            .ok_or_else(|| format!("the bytes are not a serialized {id} FMU state"))?;
+        let token = fmu.token();
         let rest = rest
             .strip_prefix(token.as_bytes())
             .and_then(|r| r.strip_prefix(b"\n"))
@@ -830,10 +918,11 @@ impl Saved {
         if let Some(e) = experiment_error(saved.start_time, saved.stop_time) {
             return Err(format!("invalid serialized state: its experiment: {e}"));
         }
-        if saved.scene.kind() != SceneKind::Taylor {
-            return Err(
-                "invalid serialized state: its parameters are not the Taylor scene's".into(),
-            );
+        if saved.scene.kind() != fmu.kind() {
+            return Err(format!(
+                "invalid serialized state: its parameters are not the `{}` scene's",
+                fmu.kind().name()
+            ));
         }
         // The run is there exactly when an instance in that state has one,
         // and it is the run of the instance's parameters (those it reports).
@@ -948,13 +1037,21 @@ pub(crate) unsafe fn c_str(p: *const c_char) -> Option<String> {
     )
 }
 
+/// The Taylor FMU, for the tests of this module and its children.
+#[cfg(test)]
+pub(crate) fn taylor_fmu() -> Fmu {
+    Fmu::named("TaylorImpact").expect("the registry declares the Taylor FMU")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::observe::TAYLOR_OBSERVABLES;
+    use crate::scene::taylor::TAYLOR_PARAMS;
 
     #[test]
     fn variables_follow_the_tables() {
-        let vars = variables();
+        let vars = taylor_fmu().variables();
         assert_eq!(
             vars.len(),
             1 + TAYLOR_PARAMS.len() + TAYLOR_OBSERVABLES.len()
@@ -974,21 +1071,59 @@ mod tests {
     }
 
     #[test]
+    fn one_library_serves_every_fmu_of_the_registry() {
+        let all = Fmu::all();
+        assert!(all.contains(&taylor_fmu()));
+        for (k, f) in all.iter().enumerate() {
+            let id = f.identity().model_identifier;
+            assert_eq!(Fmu::named(id), Some(*f), "{id}");
+            assert_eq!(Fmu::with_token(&f.token()), Some(*f), "{id}");
+            assert_eq!(Fmu::for_instantiation("x", Some(&f.token())), Ok(*f));
+            for g in &all[k + 1..] {
+                assert_ne!(id, g.identity().model_identifier);
+                assert_ne!(f.token(), g.token());
+            }
+            // Its variables are its scene's tables.
+            let n = 1 + f.row().params.len() + f.row().observables.len();
+            assert_eq!(f.variables().len(), n, "{id}");
+            assert_eq!(
+                Instance::new(Standard::Fmi3, *f, "t", LogSink::None, false)
+                    .scene
+                    .kind(),
+                f.kind()
+            );
+        }
+        // No token: the first FMU; an unknown one: an error naming the known.
+        assert_eq!(Fmu::for_instantiation("x", None), Ok(all[0]));
+        let e = Fmu::for_instantiation("fmi3InstantiateCoSimulation", Some("{nope}")).unwrap_err();
+        assert!(
+            e.contains("`{nope}`") && e.contains(&taylor_fmu().token()),
+            "{e}"
+        );
+        assert!(e.contains("TaylorImpact"), "{e}");
+    }
+
+    #[test]
     fn token_is_deterministic_and_guid_shaped() {
-        let t = instantiation_token();
-        assert_eq!(t, instantiation_token());
+        let t = taylor_fmu().token();
+        assert_eq!(t, taylor_fmu().token());
         assert_eq!(t.len(), 38);
         assert!(t.starts_with('{') && t.ends_with('}'));
     }
 
     /// The value reference of a variable.
     fn vr_of(name: &str) -> u32 {
-        variables().iter().find(|v| v.name == name).unwrap().vr
+        taylor_fmu()
+            .variables()
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap()
+            .vr
     }
 
     /// A new instance at 4 particles across the radius (cheap steps).
     fn coarse(standard: Standard) -> Instance {
-        let mut inst = Instance::new(standard, "t", LogSink::None, false);
+        let mut inst = Instance::new(standard, taylor_fmu(), "t", LogSink::None, false);
         let pr = vr_of("particles_radial");
         assert_eq!(inst.set("set", &[pr], &[4.0], VarType::Int32), Status::Ok);
         inst
@@ -996,7 +1131,7 @@ mod tests {
 
     #[test]
     fn fixed_parameter_refused_after_initialization_and_bad_values_named() {
-        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
+        let mut inst = Instance::new(Standard::Fmi3, taylor_fmu(), "t", LogSink::None, false);
         let density = vr_of("density");
         assert_eq!(
             inst.set("fmi3SetFloat64", &[density], &[-5.0], VarType::Float64),
@@ -1055,7 +1190,7 @@ mod tests {
                 callback: keep,
                 environment: &mut messages as *mut Vec<String> as *mut c_void,
             };
-            let mut inst = Instance::new(Standard::Fmi3, "t", log, false);
+            let mut inst = Instance::new(Standard::Fmi3, taylor_fmu(), "t", log, false);
             assert_eq!(inst.set_experiment("f", start, stop), Status::Error);
             assert_eq!(inst.state, TERMINATED);
             assert_eq!(inst.stop_time, None, "{named}: not recorded");
@@ -1066,7 +1201,7 @@ mod tests {
                 "{messages:?} should name {named}"
             );
         }
-        let mut inst = Instance::new(Standard::Fmi3, "t", LogSink::None, false);
+        let mut inst = Instance::new(Standard::Fmi3, taylor_fmu(), "t", LogSink::None, false);
         assert_eq!(inst.set_experiment("f", 1e-6, Some(1e-6)), Status::Ok);
         assert_eq!((inst.start_time, inst.stop_time), (1e-6, Some(1e-6)));
     }
@@ -1130,10 +1265,10 @@ mod tests {
     fn states_whose_run_does_not_fit_are_refused() {
         let mut inst = coarse(Standard::Fmi3);
         inst.enter_initialization_mode();
-        let init = inst.save().serialize();
+        let init = inst.save().serialize(taylor_fmu());
         inst.exit_initialization_mode();
         inst.do_step("doStep", 0.0, 1e-6).unwrap();
-        let stepped = inst.save().serialize();
+        let stepped = inst.save().serialize(taylor_fmu());
         let mut other = Scene::builtin("taylor").unwrap();
         other.set("particles_radial", 5.0).unwrap();
         let other = serde_json::to_value(Simulation::new(other).unwrap()).unwrap();
@@ -1141,7 +1276,7 @@ mod tests {
         noh.set("particles_radial", 100.0).unwrap();
         let noh = serde_json::to_value(Simulation::new(noh).unwrap()).unwrap();
         let refused = |bytes: &[u8], why: &str| {
-            let e = Saved::deserialize(bytes).unwrap_err();
+            let e = Saved::deserialize(taylor_fmu(), bytes).unwrap_err();
             assert!(e.contains(why), "{e} should say {why}");
         };
         refused(
@@ -1171,16 +1306,16 @@ mod tests {
         );
         refused(
             &forge(&init, |j| j["scene"] = noh["scene"].clone()),
-            "not the Taylor scene's",
+            "not the `taylor` scene's",
         );
         // The honest states load, and one without a run where that is right.
-        assert!(Saved::deserialize(&stepped).is_ok());
-        assert!(Saved::deserialize(&init).is_ok());
+        assert!(Saved::deserialize(taylor_fmu(), &stepped).is_ok());
+        assert!(Saved::deserialize(taylor_fmu(), &init).is_ok());
         let ended = forge(&stepped, |j| {
             j["sim"] = serde_json::Value::Null;
             j["state"] = serde_json::json!(TERMINATED);
         });
-        assert!(Saved::deserialize(&ended).is_ok());
+        assert!(Saved::deserialize(taylor_fmu(), &ended).is_ok());
     }
 
     /// Found by the FMU call-order fuzzer: the stopTime was not part of the
@@ -1194,7 +1329,7 @@ mod tests {
         inst.exit_initialization_mode();
         inst.do_step("doStep", 0.0, 1e-6).unwrap();
         let saved = inst.save();
-        let bytes = saved.serialize();
+        let bytes = saved.serialize(taylor_fmu());
         inst.reset();
         assert_eq!(inst.stop_time, None);
         inst.restore(&saved);
@@ -1203,8 +1338,8 @@ mod tests {
             inst.do_step("doStep", 1e-6, 2e-6).unwrap_err(),
             Status::Error
         );
-        let mut other = Instance::new(Standard::Fmi2, "u", LogSink::None, false);
-        other.restore(&Saved::deserialize(&bytes).unwrap());
+        let mut other = Instance::new(Standard::Fmi2, taylor_fmu(), "u", LogSink::None, false);
+        other.restore(&Saved::deserialize(taylor_fmu(), &bytes).unwrap());
         assert_eq!(other.stop_time, Some(2e-6));
         assert!(
             other.do_step("doStep", 1e-6, 1e-6).is_ok(),
@@ -1217,7 +1352,7 @@ mod tests {
         // A forged experiment is refused; bytes without a stopTime (as
         // before) load without one.
         let before = forge(&bytes, |j| j["stop_time"] = serde_json::json!(-1e-6));
-        let e = Saved::deserialize(&before).unwrap_err();
+        let e = Saved::deserialize(taylor_fmu(), &before).unwrap_err();
         assert!(
             e.contains("stopTime = -0.000001 must be finite and not before"),
             "{e}"
@@ -1225,7 +1360,10 @@ mod tests {
         let old = forge(&bytes, |j| {
             j.as_object_mut().unwrap().remove("stop_time");
         });
-        assert_eq!(Saved::deserialize(&old).unwrap().stop_time, None);
+        assert_eq!(
+            Saved::deserialize(taylor_fmu(), &old).unwrap().stop_time,
+            None
+        );
     }
 
     #[test]
@@ -1234,8 +1372,8 @@ mod tests {
         inst.enter_initialization_mode();
         inst.exit_initialization_mode();
         inst.do_step("doStep", 0.0, 1e-6).unwrap();
-        let bytes = inst.save().serialize();
-        let saved = Saved::deserialize(&bytes).unwrap();
+        let bytes = inst.save().serialize(taylor_fmu());
+        let saved = Saved::deserialize(taylor_fmu(), &bytes).unwrap();
         let out = inst.do_step("doStep", 1e-6, 1e-6).unwrap();
         let a = inst.sim.as_ref().unwrap().observables();
         inst.restore(&saved);
@@ -1246,6 +1384,6 @@ mod tests {
             a.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
             b.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
         );
-        assert!(Saved::deserialize(b"nonsense").is_err());
+        assert!(Saved::deserialize(taylor_fmu(), b"nonsense").is_err());
     }
 }

@@ -1,13 +1,9 @@
 //! `modelDescription.xml` for FMI 3.0 and FMI 2.0, generated from
-//! [`super::variables`] (and so from the parameter and observable
-//! tables). `cargo xtask fmu` writes its output into the FMUs; there is no
+//! [`super::Fmu::variables`] (and so from the parameter and observable
+//! tables of the FMU's scene row). `cargo xtask fmu` writes its output into the FMUs; there is no
 //! hand-edited model description.
 
-use super::{
-    LOG_CATEGORIES, MODEL_IDENTIFIER, MODEL_NAME, VarKind, VarType, Variable, instantiation_token,
-    variables,
-};
-use crate::scene::taylor::TAYLOR_PARAMS;
+use super::{Fmu, LOG_CATEGORIES, VarKind, VarType, Variable};
 use std::fmt::Write;
 
 /// Which standard to describe.
@@ -69,20 +65,22 @@ pub fn full_description(v: &Variable) -> String {
 }
 
 /// Default stop time of the experiment: the scene's `end_time` default.
-fn default_stop_time() -> f64 {
-    TAYLOR_PARAMS
+fn default_stop_time(fmu: Fmu) -> f64 {
+    fmu.row()
+        .params
         .iter()
         .find(|p| p.name == "end_time")
         .map(|p| p.default)
-        .unwrap_or(4.0e-4)
+        .expect("every scene has end_time")
 }
 
 /// Default communication step of the experiment (1 µs).
 pub const DEFAULT_STEP: f64 = 1.0e-6;
 
-/// The model description of the given standard.
-pub fn model_description(version: FmiVersion) -> Result<String, String> {
-    let vars: Vec<Variable> = variables()
+/// The model description of `fmu` in the given standard.
+pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String> {
+    let vars: Vec<Variable> = fmu
+        .variables()
         .into_iter()
         .filter(|v| version == FmiVersion::Fmi3 || v.kind != VarKind::Time)
         .collect();
@@ -100,17 +98,18 @@ pub fn model_description(version: FmiVersion) -> Result<String, String> {
             }
         }
     }
-    let token = instantiation_token();
+    let token = fmu.token();
     let version_str = crate::VERSION;
-    let desc = "Taylor rod impact on a rigid anvil: axisymmetric Modified SPH (MSPH, Batra & Zhang 2008) \
-                with Johnson-Cook thermo-viscoplasticity; defaults are House et al. (1995) test 7 on 4340 steel";
+    let identity = fmu.identity();
+    let (model_name, model_identifier) = (identity.model_name, identity.model_identifier);
+    let desc = identity.description;
     let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     match version {
         FmiVersion::Fmi3 => {
             writeln!(
                 x,
-                "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{MODEL_NAME}\" description=\"{}\" \
+                "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{model_name}\" description=\"{}\" \
                  instantiationToken=\"{token}\" version=\"{version_str}\" generationTool=\"meshless-impact {version_str}\" \
                  license=\"MIT OR Apache-2.0\" variableNamingConvention=\"flat\">",
                 escape(desc)
@@ -118,7 +117,7 @@ pub fn model_description(version: FmiVersion) -> Result<String, String> {
             .unwrap();
             writeln!(
                 x,
-                "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
+                "  <CoSimulation modelIdentifier=\"{model_identifier}\" canHandleVariableCommunicationStepSize=\"true\" \
                  canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" mightReturnEarlyFromDoStep=\"true\"/>"
             )
             .unwrap();
@@ -126,7 +125,7 @@ pub fn model_description(version: FmiVersion) -> Result<String, String> {
         FmiVersion::Fmi2 => {
             writeln!(
                 x,
-                "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{MODEL_NAME}\" description=\"{}\" \
+                "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{model_name}\" description=\"{}\" \
                  guid=\"{token}\" version=\"{version_str}\" generationTool=\"meshless-impact {version_str}\" \
                  license=\"MIT OR Apache-2.0\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
                 escape(desc)
@@ -134,7 +133,7 @@ pub fn model_description(version: FmiVersion) -> Result<String, String> {
             .unwrap();
             writeln!(
                 x,
-                "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
+                "  <CoSimulation modelIdentifier=\"{model_identifier}\" canHandleVariableCommunicationStepSize=\"true\" \
                  canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\"/>"
             )
             .unwrap();
@@ -165,7 +164,7 @@ pub fn model_description(version: FmiVersion) -> Result<String, String> {
     writeln!(
         x,
         "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
-        num(default_stop_time()),
+        num(default_stop_time(fmu)),
         num(DEFAULT_STEP)
     )
     .unwrap();
@@ -271,12 +270,19 @@ pub fn model_description(version: FmiVersion) -> Result<String, String> {
 mod tests {
     use super::*;
     use crate::observe::TAYLOR_OBSERVABLES;
+    use crate::scene::taylor::TAYLOR_PARAMS;
+
+    fn taylor() -> Fmu {
+        Fmu::named("TaylorImpact").unwrap()
+    }
 
     #[test]
     fn every_unit_of_the_tables_is_defined() {
-        for v in variables() {
-            if let Some(u) = declared_unit(&v) {
-                assert!(base_units(u).is_some(), "unit {u} of {}", v.name);
+        for fmu in Fmu::all() {
+            for v in fmu.variables() {
+                if let Some(u) = declared_unit(&v) {
+                    assert!(base_units(u).is_some(), "unit {u} of {}", v.name);
+                }
             }
         }
     }
@@ -284,7 +290,7 @@ mod tests {
     #[test]
     fn descriptions_list_every_table_row_once() {
         for version in [FmiVersion::Fmi3, FmiVersion::Fmi2] {
-            let x = model_description(version).unwrap();
+            let x = model_description(taylor(), version).unwrap();
             for p in TAYLOR_PARAMS {
                 assert_eq!(
                     x.matches(&format!("name=\"{}\"", p.name)).count(),
@@ -301,14 +307,14 @@ mod tests {
                     o.name
                 );
             }
-            assert!(x.contains(&instantiation_token()));
+            assert!(x.contains(&taylor().token()));
             assert!(!x.contains("shock_radius"));
         }
-        let x3 = model_description(FmiVersion::Fmi3).unwrap();
+        let x3 = model_description(taylor(), FmiVersion::Fmi3).unwrap();
         assert!(x3.contains("<Int32 name=\"particles_radial\""));
         assert!(x3.contains("<Boolean name=\"at_rest\""));
         assert!(x3.contains("start=\"181.0\""));
-        let x2 = model_description(FmiVersion::Fmi2).unwrap();
+        let x2 = model_description(taylor(), FmiVersion::Fmi2).unwrap();
         assert!(x2.contains("canNotUseMemoryManagementFunctions=\"true\""));
         assert!(!x2.contains("name=\"time\""));
     }

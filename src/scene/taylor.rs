@@ -27,7 +27,8 @@ pub static ROW: SceneRow = SceneRow {
     fmu: Some(FmuIdentity {
         model_identifier: "TaylorImpact",
         model_name: "TaylorImpact",
-        description: "Taylor impact of a rod on a rigid anvil (MSPH, axisymmetric, Johnson-Cook)",
+        description: "Taylor rod impact on a rigid anvil: axisymmetric Modified SPH (MSPH, Batra & Zhang 2008) \
+                      with Johnson-Cook thermo-viscoplasticity; defaults are House et al. (1995) test 7 on 4340 steel",
     }),
 };
 

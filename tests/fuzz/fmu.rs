@@ -301,7 +301,7 @@ impl Fmu for Fmi3 {
     type Bool = u8;
 
     fn new(rng: &mut Rng, log: *const Mutex<Log>) -> (Self, Option<bool>) {
-        let good = CString::new(fmi::instantiation_token()).unwrap();
+        let good = CString::new(fmi::Fmu::named("TaylorImpact").unwrap().token()).unwrap();
         let bad = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
         let (token, expect) = match rng.below(10) {
             0 => (bad.as_ptr(), Some(false)),
@@ -465,7 +465,7 @@ impl Fmu for Fmi2 {
     type Bool = c_int;
 
     fn new(rng: &mut Rng, _log: *const Mutex<Log>) -> (Self, Option<bool>) {
-        let good = CString::new(fmi::instantiation_token()).unwrap();
+        let good = CString::new(fmi::Fmu::named("TaylorImpact").unwrap().token()).unwrap();
         let bad = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
         let (guid, mut expect) = match rng.below(10) {
             0 => (bad.as_ptr(), Some(false)),
@@ -659,7 +659,13 @@ pub fn reference_state() -> Bytes {
 
 /// The value reference of a variable.
 fn vr(name: &str) -> u32 {
-    fmi::variables().iter().find(|v| v.name == name).unwrap().vr
+    fmi::Fmu::named("TaylorImpact")
+        .unwrap()
+        .variables()
+        .iter()
+        .find(|v| v.name == name)
+        .unwrap()
+        .vr
 }
 
 /// Mangles serialized bytes: a byte changed, a cut, a JSON leaf edited, a
@@ -917,7 +923,7 @@ impl<F: Fmu> Case<F> {
     /// A list of value references: the variables of the table, and some
     /// that are not.
     fn refs(rng: &mut Rng) -> Vec<u32> {
-        let n = fmi::variables().len() as u32;
+        let n = fmi::Fmu::named("TaylorImpact").unwrap().variables().len() as u32;
         (0..rng.below(4))
             .map(|_| match rng.below(8) {
                 0 => *rng.pick(&[n, n + 1, 999, u32::MAX]),
@@ -927,7 +933,7 @@ impl<F: Fmu> Case<F> {
     }
 
     fn set(&mut self, rng: &mut Rng, logged: usize) {
-        let vars = fmi::variables();
+        let vars = fmi::Fmu::named("TaylorImpact").unwrap().variables();
         let ty = *rng.pick(&[
             VarType::Float64,
             VarType::Float64,
@@ -1012,7 +1018,7 @@ impl<F: Fmu> Case<F> {
     }
 
     fn get(&mut self, rng: &mut Rng, logged: usize) {
-        let vars = fmi::variables();
+        let vars = fmi::Fmu::named("TaylorImpact").unwrap().variables();
         let ty = *rng.pick(&[
             VarType::Float64,
             VarType::Float64,
