@@ -4,12 +4,11 @@
 //! `taylor` scene). One library serves every FMU: an instance takes the row
 //! whose instantiation token the host gives.
 //!
-//! The FMUs expose the Taylor scene: every parameter of
-//! [`crate::scene::taylor::TAYLOR_PARAMS`] as a fixed
-//! parameter, every observable of [`TAYLOR_OBSERVABLES`] as an output.
-//! [`variables`] derives the variable list (and so the value references) from
-//! those tables; [`model_description`] writes the `modelDescription.xml` from
-//! the same list, so the glue and the packaged FMU can never disagree.
+//! An FMU exposes its scene: every parameter of the row's table as a fixed
+//! parameter, every observable as an output. [`Fmu::variables`] derives the
+//! variable list (and so the value references) from those tables;
+//! [`model_description`] writes the `modelDescription.xml` from the same
+//! list, so the glue and the packaged FMU can never disagree.
 //!
 //! Layout, after the Reference-FMUs:
 //!
