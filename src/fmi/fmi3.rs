@@ -1107,6 +1107,12 @@ mod tests {
         assert_eq!(step(inst, 1e30, 1e300).0, error);
         // SAFETY: a live instance, freed once.
         unsafe { fmi3FreeInstance(inst) };
+        // Found by the ten-minute fuzz: from startTime = f64::MAX the
+        // tolerance overflowed to infinity and accepted any current time.
+        let inst = stepping(f64::MAX);
+        assert_eq!(step(inst, 1.0, 1e-6).0, error);
+        // SAFETY: a live instance, freed once.
+        unsafe { fmi3FreeInstance(inst) };
         let inst = stepping(-1.0);
         // Near t = 0 from startTime = -1 s, a host's sums carry the rounding
         // of 1 s.

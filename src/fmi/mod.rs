@@ -357,6 +357,13 @@ pub(crate) struct StepOutcome {
     pub last_successful_time: f64,
 }
 
+/// Rounding slack of a time computed from `a` and `b`: 1e-9 of |a| + |b|,
+/// finite for any finite `a` and `b` (their sum may overflow: a slack of
+/// infinity would accept any time).
+fn slack(a: f64, b: f64) -> f64 {
+    1e-9 * a.abs() + 1e-9 * b.abs()
+}
+
 /// Why a startTime and stopTime are not an experiment: startTime must be
 /// finite, and a defined stopTime finite and not before it. A NaN stopTime
 /// would disable the check of every step against it, one before startTime
@@ -745,7 +752,7 @@ impl Instance {
         // time may differ from the FMU's in the last digits of the times
         // added (the start and the steps so far, not this step's size: a
         // huge step must not excuse any current time).
-        let tol = 1e-9 * (self.time.abs() + self.start_time.abs());
+        let tol = slack(self.time, self.start_time);
         if !current.is_finite() || (current - self.time).abs() > tol {
             return Err(self.fail(&format!(
                 "{function}: currentCommunicationPoint = {current} s does not match the FMU's time {} s",
@@ -765,7 +772,7 @@ impl Instance {
         // (fmi3EnterInitializationMode): computing past a defined stopTime
         // is an error. Rounding slack: 1e-9 of |stopTime| + step size.
         if let Some(stop) = self.stop_time
-            && target > stop + 1e-9 * (stop.abs() + h)
+            && target > stop + slack(stop, h)
         {
             return Err(self.fail(&format!(
                 "{function}: the step would end at t = {target} s (currentCommunicationPoint = {current} s + communicationStepSize = {h} s), past stopTime = {stop} s"
@@ -824,7 +831,7 @@ impl Instance {
             ),
         );
         // The run ended before the end of the step (beyond rounding).
-        let early = sim_time < target - 1e-9 * (current.abs() + h);
+        let early = sim_time < target - slack(current, h);
         let last = if early { sim_time } else { target };
         self.last_successful_time = last;
         Ok(StepOutcome {
