@@ -11,7 +11,11 @@
 pub mod lattice;
 pub mod mls;
 pub mod sphere;
+pub mod step;
 pub mod weak;
+
+#[cfg(test)]
+mod measure;
 
 pub use lattice::{Cylinder, NodeLattice, Surfaces};
 pub use mls::{NodalShapes, Recompute, ShapeRow, SupportParams, Supports};

@@ -153,19 +153,18 @@ mod tests {
         (pts, sup, spheres, inner)
     }
 
+    /// The operator with the solver's rules.
+    fn operator(pts: &[[f64; 3]], sup: &Supports, spheres: &[TestSphere]) -> TractionOperator {
+        let (whole, cut) = (SphereRule::of(DEFAULT_RULE), SphereRule::of(BOUNDARY_RULE));
+        TractionOperator::build(pts, sup, spheres, &whole, &cut).unwrap()
+    }
+
     #[test]
     fn constant_and_linear_stress_give_the_divergence_exactly() {
         let h = 1e-3;
         let (pts, sup, spheres, inner) = setup(7, h);
-        let op = TractionOperator::build(
-            &pts,
-            &sup,
-            &spheres,
-            &SphereRule::of(DEFAULT_RULE),
-            &SphereRule::of(BOUNDARY_RULE),
-        )
-        .unwrap();
-        // σ = σ0 + G x: component c grows along x with slope g[c].
+        let op = operator(&pts, &sup, &spheres);
+        // σ = σ0 + G x: each component an affine function of x.
         let s0 = [3e8, -1e8, 2e8, 5e7, -4e7, 6e7];
         let g = [
             [2e11, -3e11, 1e11],
@@ -173,7 +172,6 @@ mod tests {
             [-1e11, 5e11, 3e11],
         ];
         let lin = |p: &[f64; 3], c: usize| {
-            // Components xx, yy, zz, xy, yz, zx built from a rows-sum form.
             let k = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)][c];
             s0[c] + g[k.0][0] * p[0] + g[k.1][1] * p[1] + g[(k.0 + k.1) % 3][2] * p[2]
         };
@@ -202,6 +200,25 @@ mod tests {
             }
         }
         assert!(worst < 1e-12, "linear: {worst:e}");
+    }
+
+    #[test]
+    fn one_thread_and_two_give_the_same_bits() {
+        let (pts, sup, spheres, _) = setup(6, 1.0);
+        let build = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let shapes = crate::mlpg::NodalShapes::build(&pts, &sup).unwrap();
+                let op = operator(&pts, &sup, &spheres);
+                let again = Supports::compute(&pts, SupportParams::default()).unwrap();
+                (shapes, op, again)
+            })
+        };
+        let (a, b) = (build(1), build(2));
+        assert!(a == b, "thread count changed the result");
     }
 
     /// ∂σ_c/∂x_a of a linear field, by a difference (exact for linear).
