@@ -29,6 +29,7 @@ pub mod isa;
 pub mod kernel;
 pub mod lanes;
 pub mod material;
+pub mod mlpg;
 pub mod model;
 pub mod msph;
 pub mod neighbors;

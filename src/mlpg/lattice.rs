@@ -1,0 +1,276 @@
+//! The node lattice of a solid cylinder (radius `R0`, length `L0`, axis along
+//! z, impact face at z = 0): concentric rings in equally spaced layers.
+//!
+//! # The lattice
+//!
+//! With `n` rings across the radius the radial spacing is `Δ = R0 / n`.
+//! Ring `k` (k = 0..=n) lies at radius `k Δ` and holds `6 k` nodes (one on
+//! the axis for k = 0), at the angles `2π l / (6 k)`, so every ring has a
+//! node at angle 0 and the nodes of a ring are `2π k Δ / (6 k) ≈ 1.047 Δ`
+//! apart: a hexagon-like pattern of nearly uniform density. The layers lie
+//! at `z = j Δz`, j = 0..=nz, with `nz = round(L0 / Δ)` and `Δz = L0 / nz`.
+//! The outermost ring lies on the mantle, the first and last layers on the
+//! face and the top: the global boundary carries nodes, as the seed's
+//! boundary treatment (section 3.2) expects.
+//!
+//! # The nodal volumes (lumped mass)
+//!
+//! A node carries its share of the annulus of its ring, `(k ± 1/2) Δ`
+//! clipped to `[0, R0]`, times its share of the layer, `j Δz ± Δz / 2`
+//! clipped to `[0, L0]`, divided by the number of nodes of the ring:
+//! `π (Δ/2)²` for the axis node, `(π/3) Δ²` for an inner ring node and
+//! `π (R0² − (R0 − Δ/2)²) / (6 n)` on the mantle. The volumes sum to
+//! `π R0² L0` exactly: measured with a compensated sum, a relative error of
+//! at most 2.2e-16 (one ulp) for n = 1..=12 (77 to 56 749 nodes). Each
+//! node's mass is `ρ V`.
+//!
+//! For comparison, a simple cubic lattice of spacing `Δ` clipped to the
+//! cylinder (cell centres inside the circle, each carrying `Δ³`) misses the
+//! cross-section by a staircase error that does not fall monotonically:
+//! measured +7.0 %, +1.9 %, +0.16 %, +0.59 % of `π R0²` for 5, 10, 15, 20
+//! cells across the diameter — and its mantle nodes are not on the mantle,
+//! so the rod observables would start from a ragged radius. That is why
+//! the rings are used.
+
+use crate::rod::RodSets;
+use std::f64::consts::PI;
+
+/// Which parts of the global boundary a node lies on (bit flags).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Surfaces(pub u8);
+
+impl Surfaces {
+    /// The impact face, z = 0.
+    pub const FACE: u8 = 1;
+    /// The free end, z = L0.
+    pub const TOP: u8 = 2;
+    /// The mantle, √(x² + y²) = R0.
+    pub const MANTLE: u8 = 4;
+
+    /// True when the node lies on the surface `flag`.
+    pub fn has(self, flag: u8) -> bool {
+        self.0 & flag != 0
+    }
+
+    /// True when the node lies on no part of the boundary.
+    pub fn interior(self) -> bool {
+        self.0 == 0
+    }
+}
+
+/// A solid cylinder with its axis along z and its base (the impact face) at
+/// z = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cylinder {
+    /// Radius R0 (m).
+    pub radius: f64,
+    /// Length L0 (m).
+    pub length: f64,
+}
+
+impl Cylinder {
+    /// Volume π R0² L0.
+    pub fn volume(&self) -> f64 {
+        PI * self.radius * self.radius * self.length
+    }
+
+    /// Distance from a point inside the cylinder to its surface (the
+    /// nearest of the mantle, the face and the top); zero on the surface.
+    pub fn distance_to_surface(&self, p: &[f64; 3]) -> f64 {
+        let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        (self.radius - rho)
+            .min(p[2])
+            .min(self.length - p[2])
+            .max(0.0)
+    }
+}
+
+/// The nodes of a cylinder on the ring lattice, in structure-of-arrays form.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeLattice {
+    /// The cylinder filled.
+    pub cylinder: Cylinder,
+    /// Node positions (m).
+    pub position: Vec<[f64; 3]>,
+    /// Nodal volumes (m³); they sum to the cylinder's volume.
+    pub volume: Vec<f64>,
+    /// The parts of the boundary each node lies on.
+    pub surfaces: Vec<Surfaces>,
+    /// The face, one mantle generator (angle 0, face to top) and the tail
+    /// (the axis node of the top layer), for [`crate::rod::RodObservables`].
+    pub sets: RodSets,
+    /// Radial spacing Δ = R0 / rings (m).
+    pub radial_spacing: f64,
+    /// Axial spacing Δz = L0 / layers (m).
+    pub axial_spacing: f64,
+}
+
+impl NodeLattice {
+    /// The ring lattice of `cylinder` with `rings ≥ 1` rings across the
+    /// radius (the radial spacing is `R0 / rings`).
+    pub fn cylinder(cylinder: Cylinder, rings: usize) -> Self {
+        let rings = rings.max(1);
+        let (r0, l0) = (cylinder.radius, cylinder.length);
+        let dr = r0 / rings as f64;
+        let layers = ((l0 / dr).round() as usize).max(1);
+        let dz = l0 / layers as f64;
+        // Area per node of each ring: the annulus (k ± 1/2) Δ clipped to R0.
+        let ring_area = |k: usize| {
+            let outer = ((k as f64 + 0.5) * dr).min(r0);
+            let inner = ((k as f64 - 0.5) * dr).max(0.0);
+            PI * (outer * outer - inner * inner) / nodes_on_ring(k) as f64
+        };
+        let per_layer: usize = (0..=rings).map(nodes_on_ring).sum();
+        let n = per_layer * (layers + 1);
+        let mut lattice = NodeLattice {
+            cylinder,
+            position: Vec::with_capacity(n),
+            volume: Vec::with_capacity(n),
+            surfaces: Vec::with_capacity(n),
+            sets: RodSets::default(),
+            radial_spacing: dr,
+            axial_spacing: dz,
+        };
+        for j in 0..=layers {
+            let z = if j == layers { l0 } else { j as f64 * dz };
+            let thickness = if j == 0 || j == layers { dz / 2.0 } else { dz };
+            for k in 0..=rings {
+                let r = if k == rings { r0 } else { k as f64 * dr };
+                let count = nodes_on_ring(k);
+                for l in 0..count {
+                    let theta = 2.0 * PI * l as f64 / count as f64;
+                    let i = lattice.position.len();
+                    let mut s = 0;
+                    if j == 0 {
+                        s |= Surfaces::FACE;
+                        lattice.sets.face.push(i);
+                    }
+                    if j == layers {
+                        s |= Surfaces::TOP;
+                        if k == 0 {
+                            lattice.sets.tail = i;
+                        }
+                    }
+                    if k == rings {
+                        s |= Surfaces::MANTLE;
+                        if l == 0 {
+                            lattice.sets.mantle.push(i);
+                        }
+                    }
+                    lattice.position.push([r * theta.cos(), r * theta.sin(), z]);
+                    lattice.volume.push(ring_area(k) * thickness);
+                    lattice.surfaces.push(Surfaces(s));
+                }
+            }
+        }
+        lattice
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// True when there are no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// The outward unit normals of the boundary planes through node `i`
+    /// (none inside, one on a face or the mantle, two on an edge), as the
+    /// local frame `[e1, e2, e3]` (e1 radial, e2 tangential, e3 = z) and
+    /// the sign of each frame axis that points out of the body (0 when that
+    /// axis is not cut): the input of [`crate::mlpg::sphere::TestSphere`].
+    pub fn boundary_frame(&self, i: usize) -> ([[f64; 3]; 3], [i8; 3]) {
+        let p = self.position[i];
+        let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        let (c, s) = if rho > 0.0 {
+            (p[0] / rho, p[1] / rho)
+        } else {
+            (1.0, 0.0)
+        };
+        let frame = [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]];
+        let f = self.surfaces[i];
+        let mut out = [0i8; 3];
+        if f.has(Surfaces::MANTLE) {
+            out[0] = 1;
+        }
+        if f.has(Surfaces::FACE) {
+            out[2] = -1;
+        } else if f.has(Surfaces::TOP) {
+            out[2] = 1;
+        }
+        (frame, out)
+    }
+}
+
+/// Nodes on ring `k`: one on the axis, `6 k` on the others.
+fn nodes_on_ring(k: usize) -> usize {
+    if k == 0 { 1 } else { 6 * k }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rod::RodObservables;
+
+    #[test]
+    fn ring_lattice_volumes_sum_to_the_cylinder() {
+        let cyl = Cylinder {
+            radius: 3.8e-3,
+            length: 38e-3,
+        };
+        for rings in 1..=12 {
+            let lat = NodeLattice::cylinder(cyl, rings);
+            // Compensated (Neumaier) sum: the error left is the lattice's.
+            let (mut total, mut comp) = (0.0f64, 0.0f64);
+            for &v in &lat.volume {
+                let t = total + v;
+                comp += if total.abs() >= v.abs() {
+                    (total - t) + v
+                } else {
+                    (v - t) + total
+                };
+                total = t;
+            }
+            let err = ((total + comp) / cyl.volume() - 1.0).abs();
+            assert!(err < 1e-15, "rings {rings}: {err:e}");
+            // Every node inside or on the cylinder, on the boundary iff tagged.
+            for (p, s) in lat.position.iter().zip(&lat.surfaces) {
+                let d = cyl.distance_to_surface(p);
+                assert!(d >= 0.0);
+                assert_eq!(d < 1e-12 * cyl.length, !s.interior(), "{p:?}");
+            }
+            let per_layer = 1 + 3 * rings * (rings + 1);
+            assert_eq!(lat.len() % per_layer, 0);
+            assert_eq!(lat.sets.face.len(), per_layer);
+        }
+    }
+
+    #[test]
+    fn rod_observables_of_the_undeformed_lattice() {
+        let cyl = Cylinder {
+            radius: 3.8e-3,
+            length: 38e-3,
+        };
+        let lat = NodeLattice::cylinder(cyl, 4);
+        let mut vel = vec![[0.0; 3]; lat.len()];
+        for v in &mut vel {
+            v[2] = -181.0;
+        }
+        let o = RodObservables::of::<3>(&lat.sets, &lat.position, &vel, cyl.radius);
+        assert_eq!(o.rod_length, cyl.length);
+        assert!((o.mushroom_radius - cyl.radius).abs() < 1e-15);
+        assert!((o.undeformed_length - cyl.length).abs() < 1e-15);
+        assert_eq!(o.tail_velocity, 181.0);
+        // The mantle generator runs from the face to the top at angle 0.
+        let m = &lat.sets.mantle;
+        assert_eq!(m.len(), 41);
+        assert!(
+            m.windows(2)
+                .all(|w| lat.position[w[1]][2] > lat.position[w[0]][2])
+        );
+        assert!(m.iter().all(|&i| lat.position[i][1] == 0.0));
+        assert_eq!(lat.position[lat.sets.tail], [0.0, 0.0, cyl.length]);
+    }
+}

@@ -1,0 +1,679 @@
+//! Moving least squares (MLS) interpolation, eq. (1) of the seed, with the
+//! linear basis `p = [1, x, y, z]` (m = 4, eq. (11) with t = 1) and the
+//! quartic spline weight of Atluri & Zhu (1998) (the seed names no weight;
+//! this is the one of its reference Atluri (2004)):
+//!
+//! `W(s) = 1 − 6 s² + 8 s³ − 3 s⁴` for `s = |x − x_J| / r_J ≤ 1`, else 0.
+//!
+//! # Support sizes (seed section 3.1)
+//!
+//! Each node `I` names its `k` nearest other nodes as its neighbours. The
+//! support radius of a node `J` is the scale factor times the largest
+//! distance from `J` to a node that names it (or to its own `k`-th
+//! nearest, whichever is larger): so at every node, at least `k + 1`
+//! supports (its own and those of its `k` named neighbours) cover it, as
+//! eq. (11) asks for `k + 1 ≥ m`. [`Supports::recompute_reason`] says when
+//! the supports are recomputed.
+//!
+//! # The choice of `k` and the factor, by measurement
+//!
+//! RMS error of the collocated gradient (eq. 4) of a quadratic velocity
+//! field on the unit cube jittered by 0.3 h, over the nodes in [0.3, 0.7]³,
+//! relative to the largest gradient, and the mean number of nodes covering
+//! a node (the cost of every MLS evaluation is proportional to it;
+//! `mlpg::measure::support_table`):
+//!
+//! | k | factor | h = 1/8 | h = 1/16 | covering |
+//! |---|---|---|---|---|
+//! | 6 | 1.5 | 1.25e-2 | 5.76e-3 | 23.8 |
+//! | 6 | 2.0 | 7.25e-3 | 3.20e-3 | 55.1 |
+//! | 10 | 1.25 | 1.29e-2 | 6.32e-3 | 22.5 |
+//! | 10 | 1.5 | 1.05e-2 | 4.43e-3 | 37.1 |
+//! | 10 | 2.0 | 6.97e-3 | 2.43e-3 | 83.6 |
+//! | 14 | 1.5 | 9.68e-3 | 3.54e-3 | 53.1 |
+//! | 18 | 1.5 | 7.87e-3 | 3.03e-3 | 69.5 |
+//! | 26 | 1.5 | 6.97e-3 | 2.39e-3 | 103.5 |
+//!
+//! The error depends weakly on the choice (within a factor 2 over a
+//! five-fold range of cost); the factor also sets the margin for motion
+//! between recomputations (pairs may stretch by `(1 + factor)/2`). Chosen:
+//! `k = 10`, factor 1.5 ([`SupportParams::default`]): 37 covering nodes,
+//! within 1.25× the error of `k = 14` at 70 % of its cost, and a 25 %
+//! stretch before recomputing.
+//!
+//! # Shape functions
+//!
+//! With the basis centred at the evaluation point `x` and scaled by a length
+//! `h` (the largest covering support), `A = Σ w_J p_J p_Jᵀ`,
+//! `γ = A⁻¹ e₁`, `φ_J = w_J γ·p_J`, and
+//! `∂φ_J/∂x_k = w_J γ_k·p_J + ∂w_J/∂x_k γ·p_J` with
+//! `γ_k = A⁻¹ (e_{k+1} / h − A_{,k} γ)`. A moment matrix that is singular
+//! or whose 1-norm condition number passes [`crate::msph::MAX_CONDITION`]
+//! (too few, coplanar or collinear covering nodes) is the named error
+//! [`crate::Error::SingularMomentMatrix`], never a NaN.
+
+use crate::msph::{MAX_CONDITION, invert};
+use crate::neighbors::{NeighborList, cell_list};
+use crate::{Error, Result};
+use rayon::prelude::*;
+
+/// Number of basis functions of the linear basis in 3-D, eq. (11), t = 1.
+pub const BASIS: usize = 4;
+
+/// The quartic spline weight `W(s)` and `W'(s) / s` (finite at s = 0), for
+/// `s = d / r` (zero outside the support).
+#[inline]
+pub fn quartic_spline(s: f64) -> (f64, f64) {
+    if s >= 1.0 {
+        return (0.0, 0.0);
+    }
+    let t = 1.0 - s;
+    (1.0 - s * s * (6.0 - 8.0 * s + 3.0 * s * s), -12.0 * t * t)
+}
+
+/// The choices behind the support sizes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SupportParams {
+    /// Nearest neighbours each node names (k ≥ m − 1 = 3).
+    pub neighbours: usize,
+    /// Scale factor applied to the support sizes (> 1), the margin for the
+    /// nodes' motion between recomputations.
+    pub factor: f64,
+}
+
+impl Default for SupportParams {
+    /// `k = 10`, factor 1.5: see the measurement in the module docs.
+    fn default() -> Self {
+        SupportParams {
+            neighbours: 10,
+            factor: 1.5,
+        }
+    }
+}
+
+/// Why the supports must be recomputed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Recompute {
+    /// A named pair `(node, neighbour)` has stretched by `ratio` (> the
+    /// limit) since the supports were computed: coverage is at risk.
+    Stretched {
+        /// The node that names the neighbour.
+        node: usize,
+        /// The named neighbour.
+        neighbour: usize,
+        /// Current distance over the distance at computation.
+        ratio: f64,
+    },
+    /// A named pair has shrunk by `ratio` (< 1 / limit): the supports cover
+    /// needlessly many nodes (locality and cost).
+    Compressed {
+        /// The node that names the neighbour.
+        node: usize,
+        /// The named neighbour.
+        neighbour: usize,
+        /// Current distance over the distance at computation.
+        ratio: f64,
+    },
+}
+
+/// Support radii of the nodes and what they were computed from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Supports {
+    /// Support radius `r_J` of each node (m).
+    pub radius: Vec<f64>,
+    /// The `k` nearest other nodes named by each node, nearest first.
+    pub named: NeighborList,
+    /// Distance of each named pair when the supports were computed.
+    pub named_distance: Vec<f64>,
+    /// The parameters used.
+    pub params: SupportParams,
+}
+
+impl Supports {
+    /// The supports of the nodes at `points` (seed section 3.1). Fails with
+    /// [`Error::OutOfRange`] for `neighbours < 3`, a factor ≤ 1 or fewer
+    /// than `neighbours + 1` nodes.
+    pub fn compute(points: &[[f64; 3]], params: SupportParams) -> Result<Self> {
+        let k = params.neighbours;
+        if k < BASIS - 1 || k >= points.len() {
+            return Err(Error::OutOfRange {
+                name: "support neighbours".into(),
+                value: k as f64,
+                range: format!("[{}, {}]", BASIS - 1, points.len().saturating_sub(1)),
+            });
+        }
+        if params.factor.is_nan() || params.factor <= 1.0 || !params.factor.is_finite() {
+            return Err(Error::OutOfRange {
+                name: "support factor".into(),
+                value: params.factor,
+                range: "(1, inf)".into(),
+            });
+        }
+        // A search radius that holds k others for an evenly filled box, then
+        // doubled until every node has them.
+        let (lo, hi) = bounds(points);
+        let extent: f64 = (0..3).map(|d| (hi[d] - lo[d]).max(0.0)).fold(0.0, f64::max);
+        let mut search = (extent * ((k + 1) as f64 / points.len() as f64).cbrt()).max(1e-300);
+        let list = loop {
+            let list = cell_list(points, search);
+            if (0..points.len()).all(|i| list.of(i).len() > k) {
+                break list;
+            }
+            search *= 2.0;
+        };
+        let rows: Vec<Vec<(f64, usize)>> = (0..points.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut row: Vec<(f64, usize)> = list
+                    .of(i)
+                    .iter()
+                    .filter(|&&j| j != i)
+                    .map(|&j| (distance(&points[i], &points[j]), j))
+                    .collect();
+                row.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                row.truncate(k);
+                row
+            })
+            .collect();
+        let mut radius: Vec<f64> = rows.iter().map(|r| r[k - 1].0).collect();
+        let mut named = NeighborList {
+            offsets: Vec::with_capacity(points.len() + 1),
+            indices: Vec::with_capacity(points.len() * k),
+        };
+        let mut named_distance = Vec::with_capacity(points.len() * k);
+        named.offsets.push(0);
+        for row in &rows {
+            for &(d, j) in row {
+                radius[j] = radius[j].max(d);
+                named.indices.push(j);
+                named_distance.push(d);
+            }
+            named.offsets.push(named.indices.len());
+        }
+        for r in &mut radius {
+            *r *= params.factor;
+        }
+        Ok(Supports {
+            radius,
+            named,
+            named_distance,
+            params,
+        })
+    }
+
+    /// The rule for recomputing the supports: `Some(reason)` when a named
+    /// pair has stretched or shrunk by more than `λ = (1 + factor) / 2`
+    /// since the computation (half the margin the factor leaves: a pair
+    /// stays covered until it stretches by `factor`), `None` otherwise. The
+    /// first offending pair in node order is reported. Cost: one pass over
+    /// the `k N` named pairs; call it every step and recompute on `Some`.
+    pub fn recompute_reason(&self, points: &[[f64; 3]]) -> Option<Recompute> {
+        let limit = 0.5 * (1.0 + self.params.factor);
+        (0..self.named.len()).find_map(|i| {
+            let lo = self.named.offsets[i];
+            self.named.of(i).iter().enumerate().find_map(|(q, &j)| {
+                let ratio = distance(&points[i], &points[j]) / self.named_distance[lo + q];
+                if ratio > limit {
+                    Some(Recompute::Stretched {
+                        node: i,
+                        neighbour: j,
+                        ratio,
+                    })
+                } else if ratio < 1.0 / limit {
+                    Some(Recompute::Compressed {
+                        node: i,
+                        neighbour: j,
+                        ratio,
+                    })
+                } else {
+                    None
+                }
+            })
+        })
+    }
+
+    /// The largest support radius.
+    pub fn max_radius(&self) -> f64 {
+        self.radius.iter().copied().fold(0.0, f64::max)
+    }
+}
+
+/// Componentwise bounds of a point set.
+fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    points.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                std::array::from_fn(|d| lo[d].min(p[d])),
+                std::array::from_fn(|d| hi[d].max(p[d])),
+            )
+        },
+    )
+}
+
+/// Euclidean distance.
+#[inline]
+pub fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}
+
+/// The MLS shape functions at one point: the covering nodes, `φ_J` and,
+/// when asked for, `∇φ_J`. The buffers are reused between points.
+#[derive(Debug, Clone, Default)]
+pub struct ShapeRow {
+    /// Covering nodes, in the order of the candidates given.
+    pub nodes: Vec<usize>,
+    /// Position of each covering node in the candidate list.
+    pub slot: Vec<usize>,
+    /// `φ_J(x)`.
+    pub phi: Vec<f64>,
+    /// `∂φ_J/∂x_k (x)` (empty unless gradients were asked for).
+    pub grad: Vec<[f64; 3]>,
+    basis: Vec<[f64; BASIS]>,
+    weight: Vec<f64>,
+    dweight: Vec<[f64; 3]>,
+}
+
+impl ShapeRow {
+    /// Evaluates the shape functions at `x` over the `candidates` (node
+    /// indices; those whose support covers `x` are kept). `node` labels
+    /// the error. Fails with [`Error::SingularMomentMatrix`] (time 0: the
+    /// caller knows the clock) when fewer than 4 supports cover `x` or the
+    /// moment matrix is singular or too ill-conditioned.
+    pub fn evaluate(
+        &mut self,
+        x: [f64; 3],
+        candidates: &[usize],
+        points: &[[f64; 3]],
+        radius: &[f64],
+        gradient: bool,
+        node: usize,
+    ) -> Result<()> {
+        self.nodes.clear();
+        self.slot.clear();
+        self.phi.clear();
+        self.grad.clear();
+        self.basis.clear();
+        self.weight.clear();
+        self.dweight.clear();
+        let mut h = 0.0f64;
+        for (slot, &j) in candidates.iter().enumerate() {
+            let d = [
+                x[0] - points[j][0],
+                x[1] - points[j][1],
+                x[2] - points[j][2],
+            ];
+            let r = radius[j];
+            let s = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / r;
+            if s < 1.0 {
+                let (w, dw_s) = quartic_spline(s);
+                self.nodes.push(j);
+                self.slot.push(slot);
+                self.weight.push(w);
+                // ∂w/∂x_k = W'(s)/s · s_{,k}·s = (W'(s)/s) d_k / r².
+                let c = dw_s / (r * r);
+                self.dweight.push([c * d[0], c * d[1], c * d[2]]);
+                h = h.max(r);
+            }
+        }
+        let singular = |condition| Error::SingularMomentMatrix {
+            particle: node,
+            time: 0.0,
+            condition,
+        };
+        if self.nodes.len() < BASIS {
+            return Err(singular(f64::INFINITY));
+        }
+        let mut a = [[0.0; BASIS]; BASIS];
+        for &j in &self.nodes {
+            let p = [
+                1.0,
+                (points[j][0] - x[0]) / h,
+                (points[j][1] - x[1]) / h,
+                (points[j][2] - x[2]) / h,
+            ];
+            self.basis.push(p);
+        }
+        for (p, &w) in self.basis.iter().zip(&self.weight) {
+            add_outer(&mut a, p, w);
+        }
+        let inv = invert(a).ok_or_else(|| singular(f64::INFINITY))?;
+        let condition = norm1(&a) * norm1(&inv);
+        if !condition.is_finite() || condition > MAX_CONDITION {
+            return Err(singular(condition));
+        }
+        let gamma: [f64; BASIS] = std::array::from_fn(|r| inv[r][0]);
+        for (p, &w) in self.basis.iter().zip(&self.weight) {
+            self.phi.push(w * dot(&gamma, p));
+        }
+        if gradient {
+            // γ_k = A⁻¹ (e_{k+1} / h − A_{,k} γ).
+            let mut gk = [[0.0; BASIS]; 3];
+            for k in 0..3 {
+                let mut ak = [[0.0; BASIS]; BASIS];
+                for (p, dw) in self.basis.iter().zip(&self.dweight) {
+                    add_outer(&mut ak, p, dw[k]);
+                }
+                let mut rhs: [f64; BASIS] = std::array::from_fn(|r| -dot(&ak[r], &gamma));
+                rhs[k + 1] += 1.0 / h;
+                gk[k] = std::array::from_fn(|r| dot(&inv[r], &rhs));
+            }
+            for ((p, &w), dw) in self.basis.iter().zip(&self.weight).zip(&self.dweight) {
+                let gp = dot(&gamma, p);
+                self.grad
+                    .push(std::array::from_fn(|k| w * dot(&gk[k], p) + dw[k] * gp));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[inline]
+fn dot(a: &[f64; BASIS], b: &[f64; BASIS]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+#[inline]
+fn add_outer(a: &mut [[f64; BASIS]; BASIS], p: &[f64; BASIS], w: f64) {
+    for r in 0..BASIS {
+        for c in 0..BASIS {
+            a[r][c] += w * p[r] * p[c];
+        }
+    }
+}
+
+/// Largest absolute column sum.
+fn norm1(m: &[[f64; BASIS]; BASIS]) -> f64 {
+    (0..BASIS)
+        .map(|c| m.iter().map(|row| row[c].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// Candidate nodes for points within `reach` of each node: the cell-list
+/// neighbours within `reach + max r_J`, a superset of the nodes whose
+/// supports cover any point within `reach` of the node.
+pub fn candidates(points: &[[f64; 3]], supports: &Supports, reach: f64) -> NeighborList {
+    cell_list(points, reach + supports.max_radius())
+}
+
+/// The shape functions and their gradients at the nodes themselves, in
+/// compressed rows: row `i` lists the nodes covering `x_i`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NodalShapes {
+    /// Row `i` is `offsets[i]..offsets[i + 1]`.
+    pub offsets: Vec<usize>,
+    /// Covering nodes `J`, ascending in each row.
+    pub nodes: Vec<usize>,
+    /// `φ_J(x_i)`.
+    pub phi: Vec<f64>,
+    /// `∇φ_J(x_i)`.
+    pub grad: Vec<[f64; 3]>,
+}
+
+impl NodalShapes {
+    /// The shape functions at every node (in parallel; the same bits for
+    /// any number of threads). The first failing node, in index order,
+    /// names the error.
+    pub fn build(points: &[[f64; 3]], supports: &Supports) -> Result<Self> {
+        let list = candidates(points, supports, 0.0);
+        let rows: Vec<Result<ShapeRow>> = (0..points.len())
+            .into_par_iter()
+            .map_init(ShapeRow::default, |row, i| {
+                row.evaluate(points[i], list.of(i), points, &supports.radius, true, i)?;
+                Ok(ShapeRow {
+                    nodes: row.nodes.clone(),
+                    phi: row.phi.clone(),
+                    grad: row.grad.clone(),
+                    ..ShapeRow::default()
+                })
+            })
+            .collect();
+        let mut out = NodalShapes {
+            offsets: vec![0],
+            ..NodalShapes::default()
+        };
+        for row in rows {
+            let row = row?;
+            out.nodes.extend_from_slice(&row.nodes);
+            out.phi.extend_from_slice(&row.phi);
+            out.grad.extend_from_slice(&row.grad);
+            out.offsets.push(out.nodes.len());
+        }
+        Ok(out)
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// True when there are no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The range of row `i` in `nodes`, `phi` and `grad`.
+    pub fn row(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i]..self.offsets[i + 1]
+    }
+
+    /// Nodal velocity gradients by collocation, eq. (4):
+    /// `L_i[a][b] = ∂v_a/∂x_b (x_i) = Σ_J v_J[a] ∂φ_J/∂x_b (x_i)`, written
+    /// into `out` (one per node), in parallel.
+    pub fn velocity_gradients(&self, velocity: &[[f64; 3]], out: &mut [[[f64; 3]; 3]]) {
+        out.par_iter_mut().enumerate().for_each(|(i, l)| {
+            *l = [[0.0; 3]; 3];
+            for q in self.row(i) {
+                let (v, g) = (velocity[self.nodes[q]], self.grad[q]);
+                for a in 0..3 {
+                    for b in 0..3 {
+                        l[a][b] += v[a] * g[b];
+                    }
+                }
+            }
+        });
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A deterministic uniform number in [0, 1) (xorshift).
+    pub(crate) fn uniform(seed: &mut u64) -> f64 {
+        *seed ^= *seed << 13;
+        *seed ^= *seed >> 7;
+        *seed ^= *seed << 17;
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// An `n³` cubic lattice of spacing `h` in [0, (n-1) h]³, each point
+    /// moved by up to `jitter · h` along each axis.
+    pub(crate) fn jittered_cube(n: usize, h: f64, jitter: f64, seed: u64) -> Vec<[f64; 3]> {
+        let mut s = seed;
+        let mut pts = Vec::with_capacity(n * n * n);
+        for k in 0..n {
+            for j in 0..n {
+                for i in 0..n {
+                    let mut p = [i as f64 * h, j as f64 * h, k as f64 * h];
+                    for x in &mut p {
+                        *x += (2.0 * uniform(&mut s) - 1.0) * jitter * h;
+                    }
+                    pts.push(p);
+                }
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn quartic_spline_values_and_slope() {
+        assert_eq!(quartic_spline(0.0), (1.0, -12.0));
+        assert_eq!(quartic_spline(1.0), (0.0, 0.0));
+        assert_eq!(quartic_spline(2.0), (0.0, 0.0));
+        // W'(s)/s against a central difference of W.
+        for s in [0.1, 0.37, 0.5, 0.83, 0.99] {
+            let e = 1e-6;
+            let fd = (quartic_spline(s + e).0 - quartic_spline(s - e).0) / (2.0 * e);
+            assert!((quartic_spline(s).1 * s - fd).abs() < 1e-8, "{s}");
+        }
+    }
+
+    #[test]
+    fn mls_reproduces_linear_fields_on_a_jittered_set() {
+        let h = 1e-3;
+        let pts = jittered_cube(7, h, 0.3, 7);
+        let sup = Supports::compute(&pts, SupportParams::default()).unwrap();
+        let shapes = NodalShapes::build(&pts, &sup).unwrap();
+        // f = 3 + 2x − 5y + 7z (x in units of h).
+        let c = [2.0 / h, -5.0 / h, 7.0 / h];
+        let f = |p: &[f64; 3]| 3.0 + c[0] * p[0] + c[1] * p[1] + c[2] * p[2];
+        let mut worst = [0.0f64; 4];
+        for i in 0..pts.len() {
+            let r = shapes.row(i);
+            let sum: f64 = shapes.phi[r.clone()].iter().sum();
+            worst[0] = worst[0].max((sum - 1.0).abs());
+            let mut x = [0.0; 3];
+            let mut fx = 0.0;
+            let mut g = [0.0; 3];
+            let mut gsum = [0.0; 3];
+            for q in r {
+                let pj = pts[shapes.nodes[q]];
+                for d in 0..3 {
+                    x[d] += shapes.phi[q] * pj[d];
+                    g[d] += shapes.grad[q][d] * f(&pj);
+                    gsum[d] += shapes.grad[q][d];
+                }
+                fx += shapes.phi[q] * f(&pj);
+            }
+            for d in 0..3 {
+                worst[1] = worst[1].max((x[d] - pts[i][d]).abs() / h);
+                worst[3] = worst[3].max((g[d] - c[d]).abs() / 7.0 * h + gsum[d].abs() * h);
+            }
+            worst[2] = worst[2].max((fx - f(&pts[i])).abs() / 30.0);
+        }
+        // Σφ = 1, Σφ x_J = x, the field and its gradient: round-off.
+        assert!(worst.iter().all(|&w| w < 1e-12), "{worst:?}");
+    }
+
+    #[test]
+    fn mls_at_an_arbitrary_point_matches_linear_fields() {
+        let h = 0.5;
+        let pts = jittered_cube(5, h, 0.25, 11);
+        let sup = Supports::compute(&pts, SupportParams::default()).unwrap();
+        let list: Vec<usize> = (0..pts.len()).collect();
+        let mut row = ShapeRow::default();
+        let x = [0.93, 1.07, 1.21];
+        row.evaluate(x, &list, &pts, &sup.radius, true, 0).unwrap();
+        let f = |p: &[f64; 3]| 1.0 - p[0] + 4.0 * p[1] + 0.5 * p[2];
+        let fx: f64 = row
+            .nodes
+            .iter()
+            .zip(&row.phi)
+            .map(|(&j, &p)| p * f(&pts[j]))
+            .sum();
+        assert!((fx - f(&x)).abs() < 1e-13, "{fx} {}", f(&x));
+        let gy: f64 = row
+            .nodes
+            .iter()
+            .zip(&row.grad)
+            .map(|(&j, g)| g[1] * f(&pts[j]))
+            .sum();
+        assert!((gy - 4.0).abs() < 1e-12, "{gy}");
+        // Covering nodes only: their number is what the supports give.
+        assert!(row.nodes.len() > BASIS);
+    }
+
+    #[test]
+    fn a_singular_moment_matrix_is_a_named_error() {
+        // Coplanar nodes (z = 0): the z column of A vanishes.
+        let mut pts = Vec::new();
+        for j in 0..5 {
+            for i in 0..5 {
+                pts.push([i as f64, j as f64, 0.0]);
+            }
+        }
+        let sup = Supports::compute(&pts, SupportParams::default()).unwrap();
+        let err = NodalShapes::build(&pts, &sup).unwrap_err();
+        assert_eq!(err.name(), "SingularMomentMatrix");
+        assert!(matches!(
+            err,
+            Error::SingularMomentMatrix { particle: 0, .. }
+        ));
+        // Too few covering nodes: three points and a far one.
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let mut row = ShapeRow::default();
+        let err = row
+            .evaluate([9.0, 9.0, 9.0], &[0, 1, 2, 3], &pts, &[1.5; 4], true, 7)
+            .unwrap_err();
+        assert!(matches!(
+            err,
+            Error::SingularMomentMatrix { particle: 7, condition, .. } if condition.is_infinite()
+        ));
+        // Bad parameters are range errors.
+        let bad = SupportParams {
+            neighbours: 2,
+            factor: 1.5,
+        };
+        assert_eq!(
+            Supports::compute(&pts, bad).unwrap_err().name(),
+            "OutOfRange"
+        );
+        let bad = SupportParams {
+            neighbours: 3,
+            factor: 1.0,
+        };
+        assert_eq!(
+            Supports::compute(&pts, bad).unwrap_err().name(),
+            "OutOfRange"
+        );
+    }
+
+    #[test]
+    fn supports_cover_the_named_neighbours_and_the_recompute_rule() {
+        let pts = jittered_cube(6, 1.0, 0.3, 3);
+        let p = SupportParams::default();
+        let sup = Supports::compute(&pts, p).unwrap();
+        for i in 0..pts.len() {
+            assert_eq!(sup.named.of(i).len(), p.neighbours);
+            for &j in sup.named.of(i) {
+                assert!(distance(&pts[i], &pts[j]) * p.factor <= sup.radius[j]);
+            }
+        }
+        assert_eq!(sup.recompute_reason(&pts), None);
+        // A uniform stretch of 20 % is within λ = 1.25; 30 % is not.
+        let scaled = |s: f64| pts.iter().map(|x| x.map(|c| c * s)).collect::<Vec<_>>();
+        assert_eq!(sup.recompute_reason(&scaled(1.2)), None);
+        assert!(matches!(
+            sup.recompute_reason(&scaled(1.3)),
+            Some(Recompute::Stretched { node: 0, ratio, .. }) if (ratio - 1.3).abs() < 1e-12
+        ));
+        assert!(matches!(
+            sup.recompute_reason(&scaled(0.75)),
+            Some(Recompute::Compressed { node: 0, .. })
+        ));
+        // A rigid motion (rotation and translation) never asks for one.
+        let (c, s) = (0.6f64, 0.8f64);
+        let moved: Vec<[f64; 3]> = pts
+            .iter()
+            .map(|x| {
+                [
+                    c * x[0] - s * x[1] + 5.0,
+                    s * x[0] + c * x[1] - 2.0,
+                    x[2] + 9.0,
+                ]
+            })
+            .collect();
+        assert_eq!(sup.recompute_reason(&moved), None);
+        // Up to the limit, every node stays covered by k + 1 supports.
+        let stretched = scaled(1.24);
+        let shapes = NodalShapes::build(&stretched, &sup).unwrap();
+        assert!((0..pts.len()).all(|i| shapes.row(i).len() > p.neighbours));
+    }
+}

@@ -1,0 +1,277 @@
+//! The MLPG foundations working together: a free 3-D elastic bar (linear
+//! elastic, small strain, no plasticity) on the ring lattice, integrated by
+//! central differences (Newmark β = 0, γ = 1/2), against the period of its
+//! fundamental longitudinal mode; and the highest frequency of its discrete
+//! operator behind the stable time step.
+
+use meshless_impact::mlpg::mls::distance;
+use meshless_impact::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE};
+use meshless_impact::mlpg::step::{OMEGA_FACTOR, largest_eigenvalue, stable_step};
+use meshless_impact::mlpg::{
+    Cylinder, NodalShapes, NodeLattice, SphereRule, SupportParams, Supports, TestSphere,
+    TractionOperator,
+};
+use std::f64::consts::PI;
+
+/// Steel-like constants (Pa, kg/m³).
+const E: f64 = 200e9;
+const NU: f64 = 0.28;
+const RHO: f64 = 8000.0;
+
+/// Lamé constants.
+fn lame() -> (f64, f64) {
+    let mu = E / (2.0 * (1.0 + NU));
+    let lambda = E * NU / ((1.0 + NU) * (1.0 - 2.0 * NU));
+    (lambda, mu)
+}
+
+/// Hooke's law for this test only: the stress rate of a velocity gradient,
+/// `σ̇ = λ tr(D) I + 2 μ D`, in `[xx, yy, zz, xy, yz, zx]`.
+fn hooke_rate(l: &[[f64; 3]; 3]) -> [f64; 6] {
+    let (lambda, mu) = lame();
+    let d = |a: usize, b: usize| 0.5 * (l[a][b] + l[b][a]);
+    let tr = d(0, 0) + d(1, 1) + d(2, 2);
+    [
+        lambda * tr + 2.0 * mu * d(0, 0),
+        lambda * tr + 2.0 * mu * d(1, 1),
+        lambda * tr + 2.0 * mu * d(2, 2),
+        2.0 * mu * d(0, 1),
+        2.0 * mu * d(1, 2),
+        2.0 * mu * d(2, 0),
+    ]
+}
+
+/// A bar of radius 2 mm and length 20 mm on the ring lattice, with its
+/// shapes, test spheres and traction operator.
+struct Bar {
+    lattice: NodeLattice,
+    shapes: NodalShapes,
+    op: TractionOperator,
+    d_min: f64,
+}
+
+impl Bar {
+    fn new(rings: usize, alpha: f64) -> Self {
+        let cyl = Cylinder {
+            radius: 2e-3,
+            length: 20e-3,
+        };
+        let lattice = NodeLattice::cylinder(cyl, rings);
+        let pts = &lattice.position;
+        let sup = Supports::compute(pts, SupportParams::default()).unwrap();
+        let shapes = NodalShapes::build(pts, &sup).unwrap();
+        let nearest: Vec<f64> = (0..pts.len())
+            .map(|i| distance(&pts[i], &pts[sup.named.of(i)[0]]))
+            .collect();
+        let bdist: Vec<f64> = pts.iter().map(|p| cyl.distance_to_surface(p)).collect();
+        let radii = meshless_impact::mlpg::sphere::test_radii(&nearest, &bdist, alpha);
+        let spheres: Vec<TestSphere> = (0..pts.len())
+            .map(|i| {
+                let (frame, cut) = lattice.boundary_frame(i);
+                TestSphere {
+                    radius: radii[i],
+                    frame,
+                    cut,
+                }
+            })
+            .collect();
+        let op = TractionOperator::build(
+            pts,
+            &sup,
+            &spheres,
+            &SphereRule::of(DEFAULT_RULE),
+            &SphereRule::of(BOUNDARY_RULE),
+        )
+        .unwrap();
+        let d_min = nearest.iter().copied().fold(f64::INFINITY, f64::min);
+        Bar {
+            lattice,
+            shapes,
+            op,
+            d_min,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.lattice.len()
+    }
+
+    /// Accelerations of the stresses: `a_i = F_i / (ρ V_s)`.
+    fn accelerations(&self, stress: &[[f64; 6]], force: &mut [[f64; 3]]) {
+        self.op.apply(stress, force);
+        for (f, v) in force.iter_mut().zip(&self.op.volume) {
+            *f = f.map(|x| x / (RHO * v));
+        }
+    }
+
+    /// The linear operator `u ↦ −a(σ(u))`, `σ = C : sym(∇u)`, on flat
+    /// vectors: its eigenvalues are ω².
+    fn stiffness(&self, u: &[f64], out: &mut [f64]) {
+        let n = self.len();
+        let disp: Vec<[f64; 3]> = (0..n)
+            .map(|i| [u[3 * i], u[3 * i + 1], u[3 * i + 2]])
+            .collect();
+        let mut l = vec![[[0.0; 3]; 3]; n];
+        self.shapes.velocity_gradients(&disp, &mut l);
+        let stress: Vec<[f64; 6]> = l.iter().map(hooke_rate).collect();
+        let mut a = vec![[0.0; 3]; n];
+        self.accelerations(&stress, &mut a);
+        for i in 0..n {
+            for d in 0..3 {
+                out[3 * i + d] = -a[i][d];
+            }
+        }
+    }
+
+    /// Runs the fundamental longitudinal mode of the free bar,
+    /// `v_z = V cos(π z / L)`, for `periods` expected periods with the
+    /// step `stable_step(c_p, d_min, safety)`; returns the measured period
+    /// (from the zero crossings of the modal velocity) and the largest
+    /// relative energy error over the run.
+    fn fundamental_period(&self, periods: f64, safety: f64) -> (f64, f64, usize) {
+        let (lambda, mu) = lame();
+        let cp = ((lambda + 2.0 * mu) / RHO).sqrt();
+        let dt = stable_step(cp, self.d_min, safety);
+        let n = self.len();
+        let len = self.lattice.cylinder.length;
+        let pos = &self.lattice.position;
+        let mode: Vec<f64> = pos.iter().map(|p| (PI * p[2] / len).cos()).collect();
+        let mass: Vec<f64> = self.lattice.volume.iter().map(|v| RHO * v).collect();
+        let v0 = 1.0;
+        let mut vel: Vec<[f64; 3]> = mode.iter().map(|m| [0.0, 0.0, v0 * m]).collect();
+        let mut stress = vec![[0.0; 6]; n];
+        let mut strain = vec![[0.0; 6]; n];
+        let mut l = vec![[[0.0; 3]; 3]; n];
+        let mut acc = vec![[0.0; 3]; n];
+        let modal_norm: f64 = mode.iter().zip(&mass).map(|(m, w)| w * m * m).sum();
+        let kinetic = |vel: &[[f64; 3]]| -> f64 {
+            0.5 * vel
+                .iter()
+                .zip(&mass)
+                .map(|(v, m)| m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+                .sum::<f64>()
+        };
+        let e0 = kinetic(&vel);
+        let steps = (periods * 2.0 * len / (E / RHO).sqrt() / dt).ceil() as usize;
+        let mut crossings = Vec::new();
+        let mut q_prev = v0;
+        let mut energy_error = 0.0f64;
+        // Central differences: v holds v^{n+1/2} (= v^0, as a^0 = 0).
+        for step in 0..steps {
+            self.shapes.velocity_gradients(&vel, &mut l);
+            for i in 0..n {
+                let rate = hooke_rate(&l[i]);
+                for c in 0..6 {
+                    stress[i][c] += dt * rate[c];
+                }
+                let d = |a: usize, b: usize| 0.5 * (l[i][a][b] + l[i][b][a]);
+                let eps = [d(0, 0), d(1, 1), d(2, 2), d(0, 1), d(1, 2), d(2, 0)];
+                for c in 0..6 {
+                    strain[i][c] += dt * eps[c];
+                }
+            }
+            self.accelerations(&stress, &mut acc);
+            // Kinetic energy at the integer step, from the two half steps.
+            let half: Vec<[f64; 3]> = vel
+                .iter()
+                .zip(&acc)
+                .map(|(v, a)| std::array::from_fn(|d| v[d] + 0.5 * dt * a[d]))
+                .collect();
+            for (v, a) in vel.iter_mut().zip(&acc) {
+                for d in 0..3 {
+                    v[d] += dt * a[d];
+                }
+            }
+            let elastic: f64 = (0..n)
+                .map(|i| {
+                    let (s, e) = (&stress[i], &strain[i]);
+                    let w = s[0] * e[0]
+                        + s[1] * e[1]
+                        + s[2] * e[2]
+                        + 2.0 * (s[3] * e[3] + s[4] * e[4] + s[5] * e[5]);
+                    0.5 * self.lattice.volume[i] * w
+                })
+                .sum();
+            energy_error = energy_error.max((kinetic(&half) + elastic - e0).abs() / e0);
+            let q: f64 = (0..n).map(|i| mass[i] * mode[i] * half[i][2]).sum::<f64>() / modal_norm;
+            if (q_prev > 0.0) != (q > 0.0) {
+                let t = (step as f64 + q_prev / (q_prev - q)) * dt;
+                crossings.push(t);
+            }
+            q_prev = q;
+        }
+        assert!(crossings.len() >= 3, "{crossings:?}");
+        (crossings[2] - crossings[0], energy_error, steps)
+    }
+}
+
+/// The period of the fundamental mode of a free bar with Love's lateral
+/// inertia correction: `ω = c k / √(1 + ν² k² R² / 2)`, `k = π / L`.
+fn love_period(radius: f64, length: f64) -> f64 {
+    let k = PI / length;
+    let omega = (E / RHO).sqrt() * k / (1.0 + NU * NU * k * k * radius * radius / 2.0).sqrt();
+    2.0 * PI / omega
+}
+
+/// `κ = ω_max d_min / c_p` of the discrete operator, by power iteration.
+fn kappa(bar: &Bar) -> f64 {
+    let (lambda, mu) = lame();
+    let cp = ((lambda + 2.0 * mu) / RHO).sqrt();
+    let w2 = largest_eigenvalue(3 * bar.len(), 600, |u, out| bar.stiffness(u, out));
+    w2.sqrt() * bar.d_min / cp
+}
+
+/// Measured κ: 1.4475 (2 rings, 399 nodes) and 1.4507 (3 rings, 1147
+/// nodes), under `OMEGA_FACTOR` = 1.52.
+#[test]
+fn highest_frequency_of_the_elastic_operator() {
+    for rings in [2, 3] {
+        let k = kappa(&Bar::new(rings, ALPHA));
+        println!("rings {rings}: kappa {k:.4}");
+        assert!(
+            k < OMEGA_FACTOR && k > 0.9 * OMEGA_FACTOR - 0.2,
+            "rings {rings}: kappa {k}"
+        );
+    }
+}
+
+/// The fundamental longitudinal period of the free bar over 1.3 periods at
+/// the stable step (safety 0.9) against Love's bar: measured errors
+/// +0.81 % (2 rings) and +0.22 % (3 rings); the energy error over the run
+/// 6.2e-2 and 1.7e-2. Over longer runs the energy grows: see `alpha_table`
+/// and `sphere::ALPHA`.
+#[test]
+fn elastic_bar_fundamental_period() {
+    let expected = love_period(2e-3, 20e-3);
+    for (rings, tol_period, tol_energy) in [(2, 1e-2, 0.1), (3, 4e-3, 0.03)] {
+        let bar = Bar::new(rings, ALPHA);
+        let (period, energy, steps) = bar.fundamental_period(1.3, 0.9);
+        let err = period / expected - 1.0;
+        println!(
+            "rings {rings}: {} nodes, {steps} steps, period error {err:.4e}, energy error {energy:.3e}",
+            bar.len()
+        );
+        assert!(err.abs() < tol_period, "rings {rings}: period error {err}");
+        assert!(energy < tol_energy, "rings {rings}: energy error {energy}");
+    }
+}
+
+/// The measurement behind `sphere::ALPHA`: for each α, κ and, over 5
+/// periods at a third of the stable step, the period error and the largest
+/// energy error, at 3 rings.
+#[test]
+#[ignore = "measurement: prints the table behind sphere::ALPHA"]
+fn alpha_table() {
+    let expected = love_period(2e-3, 20e-3);
+    for alpha in [0.5, 0.6, 0.7, 0.8, 0.9, 0.99] {
+        for rings in [2, 3] {
+            let bar = Bar::new(rings, alpha);
+            let (period, energy, _) = bar.fundamental_period(5.0, 0.3);
+            println!(
+                "alpha {alpha} rings {rings}: kappa {:.3}, period error {:.2e}, energy error {energy:.2e}",
+                kappa(&bar),
+                period / expected - 1.0
+            );
+        }
+    }
+}
