@@ -70,7 +70,12 @@ impl Isa {
 
     /// The best copy this processor runs.
     pub fn best() -> Isa {
-        Self::available()[0]
+        // Without the vector of `available`: `Neighbourhood::power_sums`
+        // asks for it on every call.
+        Self::ALL
+            .iter()
+            .find(|(level, _)| Self::runs(*level))
+            .map_or(Isa::BASELINE, |&(level, _)| Isa(level))
     }
 
     /// The copy called `name` (`avx512`, `avx2+fma` or `baseline`), if this
