@@ -32,6 +32,18 @@ pub enum Error {
         /// Comma-separated list of scene names.
         allowed: String,
     },
+    /// A material model or preset name that does not exist (`key` is
+    /// `strength`, `eos` or `preset`), or a material choice that the scene
+    /// cannot take.
+    #[error("unknown {key} `{name}`; allowed: {allowed}")]
+    UnknownModel {
+        /// What was named: `strength`, `eos` or `preset`.
+        key: String,
+        /// The unknown name.
+        name: String,
+        /// Comma-separated list of allowed names.
+        allowed: String,
+    },
     /// A parameter value that could not be parsed as a number.
     #[error("parameter `{name}`: cannot parse `{text}` as a number")]
     ParseValue {
@@ -163,6 +175,7 @@ impl Error {
             Error::OutOfRange { .. } => "OutOfRange",
             Error::UnknownParameter { .. } => "UnknownParameter",
             Error::UnknownScene { .. } => "UnknownScene",
+            Error::UnknownModel { .. } => "UnknownModel",
             Error::ParseValue { .. } => "ParseValue",
             Error::Inconsistent(_) => "Inconsistent",
             Error::SceneFile(_) => "SceneFile",

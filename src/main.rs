@@ -37,11 +37,15 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
-    /// List the parameters of a scene with units, defaults and allowed ranges.
+    /// List the parameters of a scene with units, defaults and allowed
+    /// ranges: only those of its material models (see --strength, --eos,
+    /// --preset).
     Params {
         /// Scene name.
         #[arg(default_value = "taylor")]
         scene: String,
+        #[command(flatten)]
+        material: MaterialArgs,
     },
     /// List the observables of a scene.
     Observables {
@@ -53,9 +57,43 @@ enum Command {
     Scene {
         /// Scene name (`meshless-impact scenes` lists them).
         name: String,
+        #[command(flatten)]
+        material: MaterialArgs,
     },
     /// List the built-in scenes with their titles.
     Scenes,
+    /// List the material presets: name, models, constants and source.
+    Materials,
+}
+
+/// The choice of the material models, as a scene file's `[material]` table
+/// makes it.
+#[derive(Args, Default)]
+struct MaterialArgs {
+    /// Strength model: johnson_cook or bilinear.
+    #[arg(long, value_name = "MODEL")]
+    strength: Option<String>,
+    /// Equation of state: linear or mie_gruneisen.
+    #[arg(long, value_name = "EOS")]
+    eos: Option<String>,
+    /// A material preset (`meshless-impact materials` lists them): its
+    /// models and constants; --set may override its constants.
+    #[arg(long, value_name = "NAME")]
+    preset: Option<String>,
+}
+
+impl MaterialArgs {
+    /// Applies the choice to `scene`, if one is made.
+    fn apply(&self, scene: &mut Scene) -> Result<(), Error> {
+        if self.strength.is_none() && self.eos.is_none() && self.preset.is_none() {
+            return Ok(());
+        }
+        scene.choose_material(
+            self.strength.as_deref(),
+            self.eos.as_deref(),
+            self.preset.as_deref(),
+        )
+    }
 }
 
 #[derive(Args, Default)]
@@ -66,6 +104,8 @@ struct RunArgs {
     /// Read the scene from a TOML file instead.
     #[arg(long, value_name = "FILE")]
     scene_file: Option<PathBuf>,
+    #[command(flatten)]
+    material: MaterialArgs,
     /// Override a parameter, e.g. `--set impact_speed=200` (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
@@ -186,11 +226,14 @@ fn try_main() -> Result<(), Stop> {
         Some(Command::Run(a)) => run(a)?,
         Some(Command::Sweep(a)) => sweep(a)?,
         Some(Command::Report { out, quick }) => report(out, quick)?,
-        Some(Command::Params { scene }) => params(&scene)?,
+        Some(Command::Params { scene, material }) => params(&scene, &material)?,
         Some(Command::Observables { scene }) => observables(&scene)?,
         Some(Command::Scenes) => scenes()?,
-        Some(Command::Scene { name }) => {
-            let toml = Scene::builtin(&name)?.to_toml();
+        Some(Command::Materials) => materials()?,
+        Some(Command::Scene { name, material }) => {
+            let mut scene = Scene::builtin(&name)?;
+            material.apply(&mut scene)?;
+            let toml = scene.to_toml();
             write!(std::io::stdout(), "{toml}").map_err(|e| Stop::write("stdout", e))?;
         }
     }
@@ -240,6 +283,7 @@ fn run(a: RunArgs) -> Result<(), Stop> {
         Some(f) => Scene::from_file(f)?,
         None => Scene::builtin(&a.scene)?,
     };
+    a.material.apply(&mut scene)?;
     apply_sets(&mut scene, &a.set)?;
     let mut sim = Simulation::new(scene)?;
     if let Some(name) = &a.isa {
@@ -495,8 +539,9 @@ fn report(out: PathBuf, quick: bool) -> Result<(), Stop> {
     )
 }
 
-fn params(scene: &str) -> Result<(), Stop> {
-    let s = Scene::builtin(scene)?;
+fn params(scene: &str, material: &MaterialArgs) -> Result<(), Stop> {
+    let mut s = Scene::builtin(scene)?;
+    material.apply(&mut s)?;
     outln!(
         "{:<24} {:<10} {:>12}  {:<28} meaning",
         "name",
@@ -520,6 +565,33 @@ fn params(scene: &str) -> Result<(), Stop> {
 fn scenes() -> Result<(), Stop> {
     for name in meshless_impact::scene::builtin_names() {
         outln!("{:<12} {}", name, Scene::builtin(&name)?.title)?;
+    }
+    Ok(())
+}
+
+fn materials() -> Result<(), Stop> {
+    use meshless_impact::material::presets::PRESETS;
+    for p in PRESETS {
+        outln!("{:<24} {}", p.name, p.choice)?;
+        let values: Vec<String> = p
+            .choice
+            .param_specs(meshless_impact::material::choice::Prefix::None)
+            .iter()
+            .map(|spec| {
+                let v = p
+                    .value(spec.name)
+                    .expect("a preset gives every parameter of its models");
+                if v.abs() >= 1e5 {
+                    format!("{} = {v:e} {}", spec.name, spec.unit)
+                } else {
+                    format!("{} = {v} {}", spec.name, spec.unit)
+                }
+            })
+            .collect();
+        for chunk in values.chunks(4) {
+            outln!("    {}", chunk.join(", "))?;
+        }
+        outln!("    source: {}", p.source)?;
     }
     Ok(())
 }

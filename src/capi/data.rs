@@ -425,8 +425,8 @@ pub unsafe extern "C" fn mi_sim_state_load(
                 mi_result::MI_INVALID_STATE,
                 format!(
                     "the state is of scene kind `{}`, the handle of `{}`",
-                    restored.kind().name(),
-                    s.kind().name()
+                    restored.kind(),
+                    s.kind()
                 ),
             ));
         }

@@ -48,6 +48,10 @@ pub enum mi_result {
     /// A call in the wrong order: setting a parameter after the run started,
     /// or stepping a run that has ended.
     MI_WRONG_ORDER = 14,
+    /// No material model or preset has this name (`strength`, `eos` or
+    /// `preset` of `mi_sim_set_material`, or of a TOML `[material]` table),
+    /// or the scene has no material to choose.
+    MI_UNKNOWN_MATERIAL = 15,
     /// The run stopped: an MSPH moment matrix was singular (too few or
     /// collinear neighbours).
     MI_SINGULAR_MOMENT_MATRIX = 20,
@@ -143,6 +147,11 @@ pub(crate) const RESULTS: &[(mi_result, &str, &str)] = &[
         "call in the wrong order\0",
     ),
     (
+        mi_result::MI_UNKNOWN_MATERIAL,
+        "MI_UNKNOWN_MATERIAL\0",
+        "unknown material model or preset\0",
+    ),
+    (
         mi_result::MI_SINGULAR_MOMENT_MATRIX,
         "MI_SINGULAR_MOMENT_MATRIX\0",
         "singular MSPH moment matrix\0",
@@ -213,6 +222,7 @@ pub(crate) fn code_of(e: &Error) -> mi_result {
         Error::OutOfRange { .. } => MI_OUT_OF_RANGE,
         Error::UnknownParameter { .. } => MI_UNKNOWN_PARAMETER,
         Error::UnknownScene { .. } => MI_UNKNOWN_SCENE,
+        Error::UnknownModel { .. } => MI_UNKNOWN_MATERIAL,
         Error::ParseValue { .. } => MI_PARSE_VALUE,
         Error::Inconsistent(_) => MI_INCONSISTENT,
         Error::SceneFile(_) => MI_SCENE_FILE,
@@ -267,6 +277,6 @@ mod tests {
             assert!(name.ends_with('\0') && desc.ends_with('\0'));
             assert_eq!(format!("{code:?}\0"), *name);
         }
-        assert_eq!(RESULTS.len(), 24);
+        assert_eq!(RESULTS.len(), 25);
     }
 }

@@ -101,6 +101,16 @@ impl mi_sim {
         }
     }
 
+    /// A new scene in place of the handle's (its run and names go; the
+    /// progress callback stays).
+    fn replace_scene(&mut self, scene: Scene) {
+        *self = mi_sim {
+            progress: self.progress,
+            progress_data: self.progress_data,
+            ..mi_sim::new(scene)
+        };
+    }
+
     pub(crate) fn set_error(&mut self, message: String) {
         self.last_error = message;
     }
@@ -323,11 +333,50 @@ pub unsafe extern "C" fn mi_sim_load_toml(sim: *mut mi_sim, toml: *const c_char)
         let t = unsafe { text(toml, "toml") }?;
         s.check_not_started("mi_sim_load_toml")?;
         let scene = Scene::from_toml_str(t)?;
-        *s = mi_sim {
-            progress: s.progress,
-            progress_data: s.progress_data,
-            ..mi_sim::new(scene)
-        };
+        s.replace_scene(scene);
+        Ok(())
+    })
+}
+
+/// Chooses the material of the handle's scene by the names of a scene
+/// file's `[material]` table, before the run starts: `key` is `"strength"`
+/// (`"johnson_cook"`, `"bilinear"`), `"eos"` (`"linear"`,
+/// `"mie_gruneisen"`) or `"preset"` (a material preset, for example
+/// `"copper_wilkins_bilinear"`; `meshless-impact materials` lists them).
+/// The parameter list then holds only the parameters of the chosen models
+/// (`mi_sim_param_count`, `mi_sim_param_info`); a parameter both models
+/// share keeps its value, a new one starts at its default, and a preset
+/// sets every parameter of its models. Call it before setting the
+/// material's parameters. String pointers from `mi_sim_param_info` are
+/// invalid afterwards. Errors: `MI_UNKNOWN_MATERIAL` (an unknown key or
+/// name, listing the known ones, or a scene with no material to choose),
+/// `MI_WRONG_ORDER` after the first step; on failure nothing changes.
+///
+/// # Safety
+/// `sim` must be NULL or a live handle; `key` and `value` NULL or
+/// NUL-terminated strings.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mi_sim_set_material(
+    sim: *mut mi_sim,
+    key: *const c_char,
+    value: *const c_char,
+) -> mi_result {
+    with_sim(sim, |s| {
+        // SAFETY: forwarded contract on `key` and `value`.
+        let (k, v) = unsafe { (text(key, "key")?, text(value, "value")?) };
+        s.check_not_started("mi_sim_set_material")?;
+        let mut scene = s.scene.clone();
+        match k {
+            "strength" => scene.choose_material(Some(v), None, None),
+            "eos" => scene.choose_material(None, Some(v), None),
+            "preset" => scene.choose_material(None, None, Some(v)),
+            _ => Err(Error::UnknownModel {
+                key: "material key".into(),
+                name: k.into(),
+                allowed: "strength, eos, preset".into(),
+            }),
+        }?;
+        s.replace_scene(scene);
         Ok(())
     })
 }

@@ -1,8 +1,10 @@
 //! FMI 3.0 and FMI 2.0 Co-Simulation glue over the same core: one FMU per
-//! row of the scene registry that declares an FMU identity
+//! kind of scene that the registry declares an FMU identity for
 //! ([`crate::scene::registry::FmuIdentity`]; today `TaylorImpact`, the
-//! `taylor` scene). One library serves every FMU: an instance takes the row
-//! whose instantiation token the host gives.
+//! `taylor` scene, and one FMU per other material choice of it:
+//! `TaylorImpactBilinear`, `TaylorImpactMieGruneisen`,
+//! `TaylorImpactBilinearMieGruneisen`). One library serves every FMU: an
+//! instance takes the FMU whose instantiation token the host gives.
 //!
 //! An FMU exposes its scene: every parameter of the row's table as a fixed
 //! parameter, every observable as an output. [`Fmu::variables`] derives the
@@ -27,14 +29,15 @@ pub mod model_description;
 
 use crate::observe::ObservableSpec;
 use crate::scene::params::ParamSpec;
-use crate::scene::registry::{FmuIdentity, SCENES, SceneRow};
+use crate::scene::registry::{FmuIdentity, SceneRow};
 use crate::{Scene, SceneKind, Simulation};
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-/// One FMU: a row of the scene registry with an FMU identity.
+/// One FMU: a kind of scene (a registry row and its material choice) with
+/// an FMU identity.
 #[derive(Clone, Copy)]
-pub struct Fmu(&'static SceneRow);
+pub struct Fmu(SceneKind, FmuIdentity);
 
 impl std::fmt::Debug for Fmu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -44,17 +47,16 @@ impl std::fmt::Debug for Fmu {
 
 impl PartialEq for Fmu {
     fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self.0, other.0)
+        self.0 == other.0
     }
 }
 
 impl Fmu {
     /// Every FMU the registry declares, in its order.
     pub fn all() -> Vec<Fmu> {
-        SCENES
-            .iter()
-            .filter(|r| r.fmu.is_some())
-            .map(|r| Fmu(r))
+        crate::scene::registry::fmus()
+            .into_iter()
+            .map(|(kind, id)| Fmu(kind, id))
             .collect()
     }
 
@@ -72,17 +74,17 @@ impl Fmu {
 
     /// The model identifier, name and description.
     pub fn identity(self) -> FmuIdentity {
-        self.0.fmu.expect("an Fmu is a row with an FMU identity")
+        self.1
     }
 
     /// The scene row it packages.
     pub fn row(self) -> &'static SceneRow {
-        self.0
+        self.0.row()
     }
 
-    /// The scene kind it runs.
+    /// The scene kind it runs (its material choice included).
     pub fn kind(self) -> SceneKind {
-        SceneKind::named(self.0.name).expect("a row of the registry")
+        self.0
     }
 
     /// Every variable of the FMU: `time` (value reference 0, listed only in
@@ -97,7 +99,7 @@ impl Fmu {
             kind: VarKind::Time,
         }];
         let mut vr = 1;
-        for p in self.0.params {
+        for p in self.0.param_specs() {
             out.push(Variable {
                 vr,
                 name: p.name,
@@ -110,7 +112,7 @@ impl Fmu {
             });
             vr += 1;
         }
-        for (k, o) in self.0.observables.iter().enumerate() {
+        for (k, o) in self.0.observable_specs().iter().enumerate() {
             out.push(Variable {
                 vr,
                 name: o.name,
@@ -1090,7 +1092,7 @@ mod tests {
                 assert_ne!(f.token(), g.token());
             }
             // Its variables are its scene's tables.
-            let n = 1 + f.row().params.len() + f.row().observables.len();
+            let n = 1 + f.kind().param_specs().len() + f.row().observables.len();
             assert_eq!(f.variables().len(), n, "{id}");
             assert_eq!(
                 Instance::new(Standard::Fmi3, *f, "t", LogSink::None, false)

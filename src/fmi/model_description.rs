@@ -66,8 +66,8 @@ pub fn full_description(v: &Variable) -> String {
 
 /// Default stop time of the experiment: the scene's `end_time` default.
 fn default_stop_time(fmu: Fmu) -> f64 {
-    fmu.row()
-        .params
+    fmu.kind()
+        .param_specs()
         .iter()
         .find(|p| p.name == "end_time")
         .map(|p| p.default)

@@ -7,12 +7,19 @@
 //! A solver keeps a [`MaterialState`] next to its material (per-particle
 //! state of the models: today the Johnson-Cook memo, later damage
 //! variables) and calls [`Material::update`] once per particle and step.
+//!
+//! A scene chooses the models by name ([`choice`]: `strength =
+//! "johnson_cook" | "bilinear"`, `eos = "linear" | "mie_gruneisen"`) or
+//! takes a named material ([`presets`]); its parameter table then lists only
+//! what the chosen models use, alone or under a body's prefix.
 
 pub mod bilinear;
+pub mod choice;
 pub mod eos;
 pub mod ideal_gas;
 pub mod johnson_cook;
 pub mod mie_gruneisen;
+pub mod presets;
 pub mod tensor;
 
 use crate::error::Result;

@@ -9,6 +9,8 @@ pub mod table1;
 pub mod taylor;
 
 use crate::error::{Error, Result};
+use crate::material::choice::{EosKind, MaterialChoice, Prefix, StrengthKind};
+use crate::material::presets::Preset;
 use crate::observe::ObservableSpec;
 use params::ParamSpec;
 use registry::SceneRow;
@@ -16,13 +18,18 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// A kind of scene: a handle to its row of the scene registry
-/// ([`registry::SCENES`]). Two kinds are equal when they are the same row.
+/// ([`registry::SCENES`]) and, for a scene with a body, the choice of its
+/// material models ([`MaterialChoice`]), which sets the parameter table.
+/// Two kinds are equal when they are the same row with the same choice.
 #[derive(Clone, Copy)]
-pub struct SceneKind(&'static SceneRow);
+pub struct SceneKind {
+    row: &'static SceneRow,
+    material: Option<MaterialChoice>,
+}
 
 impl PartialEq for SceneKind {
     fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self.0, other.0)
+        std::ptr::eq(self.row, other.row) && self.material == other.material
     }
 }
 
@@ -30,35 +37,89 @@ impl Eq for SceneKind {}
 
 impl std::fmt::Debug for SceneKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SceneKind({})", self.0.name)
+        write!(f, "SceneKind({self})")
+    }
+}
+
+impl std::fmt::Display for SceneKind {
+    /// The name, with the material choice when it is not the default one:
+    /// `taylor`, `taylor (strength = bilinear, eos = linear)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (self.material, self.row.material.as_ref()) {
+            (Some(c), Some(slot)) if c != slot.default => write!(f, "{} ({c})", self.row.name),
+            _ => write!(f, "{}", self.row.name),
+        }
     }
 }
 
 impl SceneKind {
     /// The kind called `name` (`taylor`, `noh`, ...), as the registry lists
-    /// it.
+    /// it, with its default material choice.
     pub fn named(name: &str) -> Result<SceneKind> {
-        registry::row(name).map(SceneKind)
+        registry::row(name).map(SceneKind::default_of_row)
+    }
+
+    /// The default kind of a registry row.
+    pub(crate) fn default_of_row(row: &'static SceneRow) -> SceneKind {
+        SceneKind {
+            row,
+            material: row.material.as_ref().map(|m| m.default),
+        }
+    }
+
+    /// The same scene with the material models `choice`; an error for a
+    /// scene with no material to choose.
+    pub fn with_material(self, choice: MaterialChoice) -> Result<SceneKind> {
+        if self.row.material.is_none() {
+            return Err(Error::UnknownModel {
+                key: "material".into(),
+                name: choice.to_string(),
+                allowed: format!("none: scene `{}` has no material to choose", self.row.name),
+            });
+        }
+        Ok(SceneKind {
+            material: Some(choice),
+            ..self
+        })
+    }
+
+    /// The material models chosen, for a scene with a body.
+    pub fn material(self) -> Option<MaterialChoice> {
+        self.material
     }
 
     /// The kind's registry row.
     pub fn row(self) -> &'static SceneRow {
-        self.0
+        self.row
     }
 
     /// The scene's name as used on the command line and in scene files.
     pub fn name(self) -> &'static str {
-        self.0.name
+        self.row.name
     }
 
-    /// Parameter table of this kind of scene.
+    /// Parameter table of this kind of scene: for a scene with a body, the
+    /// table of its material choice, which lists only the parameters the
+    /// chosen models use.
     pub fn param_specs(self) -> &'static [ParamSpec] {
-        self.0.params
+        match (self.material, self.row.material.as_ref()) {
+            (Some(c), Some(slot)) => (slot.params)(c),
+            _ => self.row.params,
+        }
     }
 
     /// Observables this kind of scene reports, in output order.
     pub fn observable_specs(self) -> &'static [ObservableSpec] {
-        self.0.observables
+        self.row.observables
+    }
+
+    /// The FMU of this kind (its model identifier, name, description), if
+    /// the registry declares one: one FMU per material choice.
+    pub fn fmu(self) -> Option<registry::FmuIdentity> {
+        registry::fmus()
+            .into_iter()
+            .find(|(k, _)| *k == self)
+            .map(|(_, id)| id)
     }
 
     /// The key of this kind in saved states: its name with a capital
@@ -100,6 +161,9 @@ pub fn builtin_names() -> Vec<String> {
 #[serde(deny_unknown_fields)]
 struct SavedScene {
     title: String,
+    /// The material models, for a scene with a body (absent: the default).
+    #[serde(default)]
+    material: Option<MaterialChoice>,
     params: BTreeMap<String, BTreeMap<String, f64>>,
     reference: BTreeMap<String, f64>,
 }
@@ -117,6 +181,7 @@ impl Serialize for Scene {
             .collect();
         SavedScene {
             title: self.title.clone(),
+            material: self.kind.material,
             params: BTreeMap::from([(self.kind.saved_key(), params)]),
             reference: self.reference.clone(),
         }
@@ -134,11 +199,14 @@ impl<'de> Deserialize<'de> for Scene {
         let (Some((key, params)), None) = (entries.next(), entries.next()) else {
             return Err(D::Error::custom("a scene has the parameters of one kind"));
         };
-        let kind = registry::SCENES
+        let mut kind = registry::SCENES
             .iter()
-            .map(|row| SceneKind(row))
+            .map(|row| SceneKind::default_of_row(row))
             .find(|k| k.saved_key() == key)
             .ok_or_else(|| D::Error::custom(format!("unknown kind of scene `{key}`")))?;
+        if let Some(choice) = saved.material {
+            kind = kind.with_material(choice).map_err(D::Error::custom)?;
+        }
         let mut scene = Scene::default_of(kind);
         scene.title = saved.title;
         scene.reference = saved.reference;
@@ -160,9 +228,23 @@ struct SceneFile {
     #[serde(default)]
     title: Option<String>,
     #[serde(default)]
+    material: Option<MaterialTable>,
+    #[serde(default)]
     parameters: BTreeMap<String, toml::Value>,
     #[serde(default)]
     reference: BTreeMap<String, f64>,
+}
+
+/// The `[material]` table of a scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialTable {
+    #[serde(default)]
+    strength: Option<String>,
+    #[serde(default)]
+    eos: Option<String>,
+    #[serde(default)]
+    preset: Option<String>,
 }
 
 impl Scene {
@@ -184,7 +266,7 @@ impl Scene {
     pub fn builtin(name: &str) -> Result<Scene> {
         for row in registry::SCENES {
             if row.name == name {
-                return Ok(Scene::default_of(SceneKind(row)));
+                return Ok(Scene::default_of(SceneKind::default_of_row(row)));
             }
             if let Some((_, scene)) = (row.variants)().into_iter().find(|(n, _)| n == name) {
                 return Ok(scene);
@@ -204,6 +286,9 @@ impl Scene {
         scene.reference = file.reference;
         if let Some(t) = file.title {
             scene.title = t;
+        }
+        if let Some(m) = &file.material {
+            scene.choose_material(m.strength.as_deref(), m.eos.as_deref(), m.preset.as_deref())?;
         }
         for (name, value) in &file.parameters {
             let v = match value {
@@ -232,13 +317,24 @@ impl Scene {
         })
     }
 
-    /// Writes the scene as TOML, every parameter included.
+    /// Writes the scene as TOML, every parameter included (and the
+    /// `[material]` table when the models are not the default ones).
     pub fn to_toml(&self) -> String {
         let mut out = format!(
-            "scene = \"{}\"\ntitle = {}\n\n[parameters]\n",
+            "scene = \"{}\"\ntitle = {}\n\n",
             self.kind().name(),
             toml::Value::String(self.title.clone())
         );
+        if let (Some(c), Some(slot)) = (self.kind.material, &self.kind.row.material)
+            && c != slot.default
+        {
+            out.push_str(&format!(
+                "[material]\nstrength = \"{}\"\neos = \"{}\"\n\n",
+                c.strength.name(),
+                c.eos.name()
+            ));
+        }
+        out.push_str("[parameters]\n");
         for spec in self.param_specs() {
             let v = self.get(spec.name).expect("name from own table");
             out.push_str(&format!("{} = {:?}  # {}\n", spec.name, v, spec.unit));
@@ -275,7 +371,7 @@ impl Scene {
             .position(|s| s.name == name)
             .ok_or_else(|| Error::UnknownParameter {
                 name: name.to_string(),
-                scene: self.kind.name().to_string(),
+                scene: self.kind.to_string(),
                 allowed: self
                     .param_specs()
                     .iter()
@@ -283,6 +379,94 @@ impl Scene {
                     .collect::<Vec<_>>()
                     .join(", "),
             })
+    }
+
+    /// Chooses the material models of the scene's body: the models
+    /// `choice` take the place of the current ones. The parameters the two
+    /// tables share keep their values; the new model's parameters start at
+    /// their defaults.
+    pub fn set_material(&mut self, choice: MaterialChoice) -> Result<()> {
+        let kind = self.kind.with_material(choice)?;
+        let values = kind
+            .param_specs()
+            .iter()
+            .map(|spec| self.get(spec.name).unwrap_or(spec.default))
+            .collect();
+        self.kind = kind;
+        self.values = values;
+        Ok(())
+    }
+
+    /// Chooses the material by names, as the `[material]` table of a scene
+    /// file, the CLI's `--strength`, `--eos` and `--preset` and the C ABI's
+    /// `mi_sim_set_material` give them: a `preset` takes its models and sets
+    /// every parameter of them to its values (a `strength` or `eos` given
+    /// with it must be the preset's own); `strength` and `eos` replace the
+    /// current models (see [`Scene::set_material`]). Unknown names are refused
+    /// with the list of known ones; nothing changes on an error.
+    pub fn choose_material(
+        &mut self,
+        strength: Option<&str>,
+        eos: Option<&str>,
+        preset: Option<&str>,
+    ) -> Result<()> {
+        let strength = strength.map(StrengthKind::named).transpose()?;
+        let eos = eos.map(EosKind::named).transpose()?;
+        let preset = preset.map(Preset::named).transpose()?;
+        let current = match (self.kind.material, &self.kind.row.material) {
+            (Some(c), _) => c,
+            (None, _) => {
+                let name = [strength.map(|s| s.name()), eos.map(|e| e.name())]
+                    .into_iter()
+                    .flatten()
+                    .chain(preset.map(|p| p.name))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                return Err(Error::UnknownModel {
+                    key: "material".into(),
+                    name,
+                    allowed: format!(
+                        "none: scene `{}` has no material to choose",
+                        self.kind.name()
+                    ),
+                });
+            }
+        };
+        let mut next = self.clone();
+        let choice = match preset {
+            Some(p) => {
+                for (given, own) in [
+                    (strength.map(|s| s.name()), p.choice.strength.name()),
+                    (eos.map(|e| e.name()), p.choice.eos.name()),
+                ] {
+                    if let Some(given) = given
+                        && given != own
+                    {
+                        return Err(Error::Inconsistent(format!(
+                            "preset `{}` has {}; `{given}` contradicts it (give the preset and set its \
+                             parameters, or name the models without a preset)",
+                            p.name, p.choice
+                        )));
+                    }
+                }
+                p.choice
+            }
+            None => MaterialChoice {
+                strength: strength.unwrap_or(current.strength),
+                eos: eos.unwrap_or(current.eos),
+            },
+        };
+        next.set_material(choice)?;
+        if let Some(p) = preset {
+            for spec in p.choice.param_specs(Prefix::None) {
+                let v = p
+                    .value(spec.name)
+                    .expect("a preset gives every parameter of its models");
+                next.set(spec.name, v)?;
+            }
+        }
+        *self = next;
+        Ok(())
     }
 
     /// Current value of a parameter.

@@ -14,6 +14,7 @@ pub static ROW: SceneRow = SceneRow {
     name: "noh",
     title: "Cylindrical Noh problem (gamma = 5/3)",
     params: NOH_PARAMS,
+    material: None,
     observables: NOH_OBSERVABLES,
     reference: || {
         BTreeMap::from([

@@ -168,3 +168,55 @@ macro_rules! param_table {
     };
 }
 pub(crate) use param_table;
+
+/// Declares a parameter struct whose rows live in a table declared
+/// elsewhere (for example a scene table composed with a material block):
+/// `Default` takes each field's default from `$table`, and `get` and `set`
+/// reach the fields by name.
+macro_rules! param_struct {
+    (
+        $(#[$meta:meta])*
+        $name:ident, $table:expr, { $( $field:ident ),* $(,)? }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[serde(deny_unknown_fields, default)]
+        pub struct $name {
+            $( #[doc = concat!("`", stringify!($field), "`, as the parameter table describes it.")]
+            pub $field: f64, )*
+        }
+
+        impl Default for $name {
+            /// The defaults of the table.
+            fn default() -> Self {
+                let d = |name: &str| {
+                    $table
+                        .iter()
+                        .find(|s| s.name == name)
+                        .expect("every field is a row of the table")
+                        .default
+                };
+                Self { $( $field: d(stringify!($field)), )* }
+            }
+        }
+
+        impl $name {
+            /// Value of the parameter called `name`, if it exists.
+            pub fn get(&self, name: &str) -> Option<f64> {
+                match name {
+                    $( stringify!($field) => Some(self.$field), )*
+                    _ => None,
+                }
+            }
+
+            /// Sets the parameter called `name`; whether it exists.
+            pub fn set(&mut self, name: &str, value: f64) -> bool {
+                match name {
+                    $( stringify!($field) => { self.$field = value; true } )*
+                    _ => false,
+                }
+            }
+        }
+    };
+}
+pub(crate) use param_struct;

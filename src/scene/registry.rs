@@ -2,9 +2,10 @@
 //! the C ABI, the FMU glue and `cargo xtask fmu` read it, so a new kind of
 //! scene is one new row (in its own module) plus its solver.
 
-use super::Scene;
 use super::params::ParamSpec;
+use super::{Scene, SceneKind};
 use crate::error::{Error, Result};
+use crate::material::choice::MaterialChoice;
 use crate::model::Model;
 use crate::observe::ObservableSpec;
 use std::collections::BTreeMap;
@@ -20,14 +21,30 @@ pub struct FmuIdentity {
     pub description: &'static str,
 }
 
+/// How a kind of scene lets its body's material models be chosen
+/// ([`MaterialChoice`]): each choice has a parameter table of its own, with
+/// only the parameters its models use, and may have an FMU of its own.
+pub struct MaterialSlot {
+    /// The choice of the default scene (its table is the row's `params`).
+    pub default: MaterialChoice,
+    /// The parameter table of each choice.
+    pub params: fn(MaterialChoice) -> &'static [ParamSpec],
+    /// The FMUs of the other choices (the default choice's FMU is the row's
+    /// `fmu`): one FMU per choice, so that each lists only its parameters.
+    pub fmus: &'static [(MaterialChoice, FmuIdentity)],
+}
+
 /// One kind of scene.
 pub struct SceneRow {
     /// Name on the command line, in scene files and in the C ABI.
     pub name: &'static str,
     /// Title of the default scene.
     pub title: &'static str,
-    /// Parameters, with units, defaults and ranges.
+    /// Parameters, with units, defaults and ranges (of the default
+    /// material choice, where the row has one).
     pub params: &'static [ParamSpec],
+    /// The choice of material models, if the scene has a body to choose for.
+    pub material: Option<MaterialSlot>,
     /// Observables, in output order.
     pub observables: &'static [ObservableSpec],
     /// Reference values of the default scene (experiment or exact solution),
@@ -44,8 +61,27 @@ pub struct SceneRow {
     /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked
     /// afterwards ([`Model::check_restored`]).
     pub restore: fn(serde_json::Value) -> std::result::Result<Box<dyn Model>, String>,
-    /// The FMU of this kind, if it has one.
+    /// The FMU of this kind (of its default material choice), if it has one.
     pub fmu: Option<FmuIdentity>,
+}
+
+/// Every FMU the registry declares, with the kind of scene (material choice
+/// included) each one runs, in registry order.
+pub fn fmus() -> Vec<(SceneKind, FmuIdentity)> {
+    let mut out = Vec::new();
+    for row in SCENES {
+        let kind = SceneKind::default_of_row(row);
+        if let Some(id) = row.fmu {
+            out.push((kind, id));
+        }
+        for (choice, id) in row.material.iter().flat_map(|m| m.fmus) {
+            let kind = kind
+                .with_material(*choice)
+                .expect("a row's FMU choices are its own");
+            out.push((kind, *id));
+        }
+    }
+    out
 }
 
 /// Every kind of scene, in the order they are listed.

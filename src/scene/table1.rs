@@ -72,7 +72,7 @@ impl Table1Row {
 
     /// The Taylor scene of this configuration (other parameters default).
     pub fn scene(&self) -> Scene {
-        let mut s = Scene::default_of(SceneKind(&super::taylor::ROW));
+        let mut s = Scene::default_of(SceneKind::default_of_row(&super::taylor::ROW));
         for (name, v) in [
             ("impact_speed", self.v),
             ("initial_length", self.l0),

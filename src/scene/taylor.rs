@@ -1,11 +1,20 @@
-//! The `taylor` scene: a rod of 4340 steel striking a rigid smooth anvil
-//! (House et al. test 7 by default), with Johnson-Cook strength, the linear
-//! EOS, adiabatic heating, a rigid smooth anvil and a traction-free mantle and
+//! The `taylor` scene: a rod striking a rigid smooth anvil (House et al.
+//! test 7 on 4340 steel by default), with the chosen strength model and
+//! equation of state (Johnson-Cook and the linear EOS by default),
+//! adiabatic heating, a rigid smooth anvil and a traction-free mantle and
 //! top.
+//!
+//! Its parameter table is the rod's geometry and speed, the material block
+//! of the chosen models ([`crate::material::choice`]), then the numerical
+//! parameters. Each choice has an FMU of its own: `TaylorImpact`
+//! (Johnson-Cook, linear: the table and variables of before the choice
+//! existed), `TaylorImpactBilinear`, `TaylorImpactMieGruneisen` and
+//! `TaylorImpactBilinearMieGruneisen`.
 
 use super::Scene;
-use super::params::{Range, param_table};
-use super::registry::{FmuIdentity, SceneRow, restore};
+use super::params::{ParamSpec, Range, param_struct};
+use super::registry::{FmuIdentity, MaterialSlot, SceneRow, restore};
+use crate::material::choice::{MaterialChoice, Prefix, block_len, compose};
 use crate::observe::TAYLOR_OBSERVABLES;
 use crate::solver::axisymmetric::TaylorSolver;
 
@@ -14,14 +23,52 @@ pub static ROW: SceneRow = SceneRow {
     name: "taylor",
     title: "Taylor impact, House et al. test 7 (4340 steel, 181 m/s)",
     params: TAYLOR_PARAMS,
+    material: Some(MaterialSlot {
+        default: MaterialChoice::JOHNSON_COOK_LINEAR,
+        params: params_of,
+        fmus: &[
+            (
+                MaterialChoice::BILINEAR_LINEAR,
+                FmuIdentity {
+                    model_identifier: "TaylorImpactBilinear",
+                    model_name: "TaylorImpactBilinear",
+                    description: "Taylor rod impact on a rigid anvil: axisymmetric Modified SPH (MSPH, Batra & Zhang 2008) \
+                                  with bilinear J2 plasticity and the linear equation of state",
+                },
+            ),
+            (
+                MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN,
+                FmuIdentity {
+                    model_identifier: "TaylorImpactMieGruneisen",
+                    model_name: "TaylorImpactMieGruneisen",
+                    description: "Taylor rod impact on a rigid anvil: axisymmetric Modified SPH (MSPH, Batra & Zhang 2008) \
+                                  with Johnson-Cook thermo-viscoplasticity and the Mie-Gruneisen equation of state",
+                },
+            ),
+            (
+                MaterialChoice::BILINEAR_MIE_GRUNEISEN,
+                FmuIdentity {
+                    model_identifier: "TaylorImpactBilinearMieGruneisen",
+                    model_name: "TaylorImpactBilinearMieGruneisen",
+                    description: "Taylor rod impact on a rigid anvil: axisymmetric Modified SPH (MSPH, Batra & Zhang 2008) \
+                                  with bilinear J2 plasticity and the Mie-Gruneisen equation of state",
+                },
+            ),
+        ],
+    }),
     observables: TAYLOR_OBSERVABLES,
     reference: || super::table1::Table1Row::all()[6].reference(),
     variants: super::table1::variants,
-    check: |s| TaylorParams::from_values(s.values()).check_consistency(),
+    check: |s| {
+        material_choice(s).check_consistency(Prefix::None, |n| s.get(n))?;
+        TaylorParams::of(s).check_consistency()
+    },
     build: |s: &Scene| {
-        Ok(Box::new(TaylorSolver::new(TaylorParams::from_values(
-            s.values(),
-        ))?))
+        let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
+        Ok(Box::new(TaylorSolver::with_material(
+            TaylorParams::of(s),
+            material,
+        )?))
     },
     restore: restore::<TaylorSolver>,
     fmu: Some(FmuIdentity {
@@ -32,75 +79,178 @@ pub static ROW: SceneRow = SceneRow {
     }),
 };
 
-param_table! {
-    /// Parameters of the Taylor impact scene (SI units). Defaults are House et
-    /// al. test 7 with the 4340 steel constants of Batra & Zhang (2008).
-    TaylorParams, TAYLOR_PARAMS {
-        impact_speed: "m/s" = 181.0, Range::closed(0.01, 2000.0),
-            "speed of the rod toward the anvil";
-        initial_length: "m" = 0.03797, Range::closed(1.0e-4, 10.0),
-            "rod length L0";
-        initial_diameter: "m" = 0.007595, Range::closed(1.0e-4, 10.0),
-            "rod diameter D0";
-        density: "kg/m3" = 7830.0, Range::closed(100.0, 1.0e5),
-            "reference mass density";
-        shear_modulus: "Pa" = 82.9e9, Range::closed(1.0e6, 1.0e14),
-            "shear modulus mu";
-        bulk_modulus: "Pa" = 169.1e9, Range::closed(1.0e6, 1.0e15),
-            "bulk modulus K of the linear EOS P = K(rho/rho0 - 1)";
-        specific_heat: "J/(kg.K)" = 460.0, Range::closed(1.0, 1.0e5),
-            "specific heat C";
-        taylor_quinney: "1" = 1.0, Range::closed(0.0, 1.0),
-            "Taylor-Quinney coefficient: the fraction of plastic work that becomes heat";
-        jc_a: "Pa" = 792.0e6, Range::closed(0.0, 1.0e11),
-            "Johnson-Cook a (initial yield stress)";
-        jc_b: "Pa" = 510.0e6, Range::closed(0.0, 1.0e11),
-            "Johnson-Cook b (hardening modulus)";
-        jc_n: "1" = 0.26, Range::open_closed(0.0, 5.0),
-            "Johnson-Cook n (hardening exponent)";
-        jc_c: "1" = 0.014, Range::closed(0.0, 1.0),
-            "Johnson-Cook c (strain-rate sensitivity)";
-        jc_m: "1" = 1.03, Range::open_closed(0.0, 10.0),
-            "Johnson-Cook m (thermal softening exponent)";
-        melt_temperature: "K" = 1293.0, Range::closed(1.0, 1.0e5),
-            "melting temperature T_M";
-        room_temperature: "K" = 293.0, Range::closed(1.0, 1.0e5),
-            "room temperature T_room";
-        initial_temperature: "K" = 293.0, Range::closed(1.0, 1.0e5),
-            "rod temperature at impact";
-        ref_strain_rate: "1/s" = 1.0, Range::closed(1.0e-6, 1.0e12),
-            "reference strain rate of Johnson-Cook";
-        particles_radial: "1" = 20.0, Range::integer(3.0, 200.0),
-            "particles across the radius, axis and mantle included; axial spacing matches";
-        smoothing_ratio: "1" = 1.5, Range::closed(0.5, 4.0),
-            "smoothing length h divided by the particle spacing";
-        smoothing_coefficient: "1" = 0.2, Range::closed(0.0, 0.5),
-            "alpha_cs of the conservative smoothing (3.23)";
-        smoothing_order: "1" = 1.0, Range::integer(1.0, 2.0),
-            "velocity smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)";
-        shifting: "1" = 0.0, Range::closed(0.0, 1.0),
-            "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper";
-        end_time: "s" = 400.0e-6, Range::closed(1.0e-9, 1.0),
-            "latest simulated time; the run normally ends earlier, when the rod is at rest";
+/// The material models of a `taylor` scene.
+fn material_choice(s: &Scene) -> MaterialChoice {
+    s.kind()
+        .material()
+        .expect("the taylor scene has a material choice")
+}
+
+/// The rod's speed and geometry: the rows before the material block.
+const BEFORE: &[ParamSpec] = &[
+    spec(
+        "impact_speed",
+        "m/s",
+        181.0,
+        Range::closed(0.01, 2000.0),
+        "speed of the rod toward the anvil",
+    ),
+    spec(
+        "initial_length",
+        "m",
+        0.03797,
+        Range::closed(1.0e-4, 10.0),
+        "rod length L0",
+    ),
+    spec(
+        "initial_diameter",
+        "m",
+        0.007595,
+        Range::closed(1.0e-4, 10.0),
+        "rod diameter D0",
+    ),
+];
+
+/// The numerical parameters and the end time: the rows after the material
+/// block.
+const AFTER: &[ParamSpec] = &[
+    spec(
+        "particles_radial",
+        "1",
+        20.0,
+        Range::integer(3.0, 200.0),
+        "particles across the radius, axis and mantle included; axial spacing matches",
+    ),
+    spec(
+        "smoothing_ratio",
+        "1",
+        1.5,
+        Range::closed(0.5, 4.0),
+        "smoothing length h divided by the particle spacing",
+    ),
+    spec(
+        "smoothing_coefficient",
+        "1",
+        0.2,
+        Range::closed(0.0, 0.5),
+        "alpha_cs of the conservative smoothing (3.23)",
+    ),
+    spec(
+        "smoothing_order",
+        "1",
+        1.0,
+        Range::integer(1.0, 2.0),
+        "velocity smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)",
+    ),
+    spec(
+        "shifting",
+        "1",
+        0.0,
+        Range::closed(0.0, 1.0),
+        "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper",
+    ),
+    spec(
+        "end_time",
+        "s",
+        400.0e-6,
+        Range::closed(1.0e-9, 1.0),
+        "latest simulated time; the run normally ends earlier, when the rod is at rest",
+    ),
+];
+
+const fn spec(
+    name: &'static str,
+    unit: &'static str,
+    default: f64,
+    range: Range,
+    description: &'static str,
+) -> ParamSpec {
+    ParamSpec {
+        name,
+        unit,
+        default,
+        range,
+        description,
+    }
+}
+
+/// The length of the table of a choice.
+const fn len(choice: MaterialChoice) -> usize {
+    BEFORE.len() + block_len(choice) + AFTER.len()
+}
+
+/// The parameter table of the `taylor` scene with Johnson-Cook and the
+/// linear EOS (the default): speed and geometry, the material block, the
+/// numerical parameters. Defaults are House et al. test 7 with the 4340
+/// steel constants of Batra & Zhang (2008).
+pub const TAYLOR_PARAMS: &[ParamSpec] = &compose::<{ len(MaterialChoice::JOHNSON_COOK_LINEAR) }>(
+    BEFORE,
+    MaterialChoice::JOHNSON_COOK_LINEAR,
+    AFTER,
+);
+/// The table with bilinear strength and the linear EOS.
+pub const TAYLOR_BILINEAR_PARAMS: &[ParamSpec] = &compose::<{ len(MaterialChoice::BILINEAR_LINEAR) }>(
+    BEFORE,
+    MaterialChoice::BILINEAR_LINEAR,
+    AFTER,
+);
+/// The table with Johnson-Cook and Mie-Grüneisen.
+pub const TAYLOR_MIE_GRUNEISEN_PARAMS: &[ParamSpec] =
+    &compose::<{ len(MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN) }>(
+        BEFORE,
+        MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN,
+        AFTER,
+    );
+/// The table with bilinear strength and Mie-Grüneisen.
+pub const TAYLOR_BILINEAR_MIE_GRUNEISEN_PARAMS: &[ParamSpec] =
+    &compose::<{ len(MaterialChoice::BILINEAR_MIE_GRUNEISEN) }>(
+        BEFORE,
+        MaterialChoice::BILINEAR_MIE_GRUNEISEN,
+        AFTER,
+    );
+
+/// The parameter table of a choice.
+fn params_of(choice: MaterialChoice) -> &'static [ParamSpec] {
+    use crate::material::choice::{EosKind::*, StrengthKind::*};
+    match (choice.strength, choice.eos) {
+        (JohnsonCook, Linear) => TAYLOR_PARAMS,
+        (Bilinear, Linear) => TAYLOR_BILINEAR_PARAMS,
+        (JohnsonCook, MieGruneisen) => TAYLOR_MIE_GRUNEISEN_PARAMS,
+        (Bilinear, MieGruneisen) => TAYLOR_BILINEAR_MIE_GRUNEISEN_PARAMS,
+    }
+}
+
+param_struct! {
+    /// The parameters of a Taylor run that the solver keeps (SI units):
+    /// those of [`TAYLOR_PARAMS`]. A run of another material choice takes
+    /// its geometry, numerical parameters, density and initial temperature
+    /// from here and its material from the scene's material block
+    /// ([`TaylorSolver::with_material`]); the other material fields then
+    /// keep their defaults and are not used.
+    TaylorParams, TAYLOR_PARAMS, {
+        impact_speed, initial_length, initial_diameter, density, shear_modulus,
+        bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
+        melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
+        particles_radial, smoothing_ratio, smoothing_coefficient, smoothing_order,
+        shifting, end_time,
     }
 }
 
 impl TaylorParams {
-    /// Checks the cross-parameter constraints that single ranges cannot express.
+    /// The parameters of a `taylor` scene, any material choice: every
+    /// row of its table that is a field here, the others at their defaults.
+    pub fn of(scene: &Scene) -> TaylorParams {
+        let mut p = TaylorParams::default();
+        for (spec, v) in scene.param_specs().iter().zip(scene.values()) {
+            p.set(spec.name, *v);
+        }
+        p
+    }
+
+    /// Checks the geometric constraint that single ranges cannot express
+    /// (the material's are [`MaterialChoice::check_consistency`]).
     pub fn check_consistency(&self) -> crate::Result<()> {
         use crate::Error::Inconsistent;
-        if self.melt_temperature <= self.room_temperature {
-            return Err(Inconsistent(format!(
-                "melt_temperature = {} K must exceed room_temperature = {} K",
-                self.melt_temperature, self.room_temperature
-            )));
-        }
-        if self.initial_temperature >= self.melt_temperature {
-            return Err(Inconsistent(format!(
-                "initial_temperature = {} K must be below melt_temperature = {} K",
-                self.initial_temperature, self.melt_temperature
-            )));
-        }
         let n = self.particles_radial;
         let axial = (self.initial_length / (0.5 * self.initial_diameter / (n - 1.0))).round() + 1.0;
         if !(2.0..=100_000.0).contains(&axial) {
@@ -111,5 +261,34 @@ impl TaylorParams {
             )));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every field of [`TaylorParams`] is a row of the default table, and
+    /// the default table lists exactly the fields, in the order of the
+    /// table before the material choice existed (the `TaylorImpact` FMU's
+    /// value references).
+    #[test]
+    fn default_table_is_the_fields_in_order() {
+        let names: Vec<&str> = TAYLOR_PARAMS.iter().map(|s| s.name).collect();
+        let p = TaylorParams::default();
+        assert!(names.iter().all(|n| p.get(n).is_some()));
+        assert_eq!(
+            names.join(" "),
+            "impact_speed initial_length initial_diameter density shear_modulus bulk_modulus \
+             specific_heat taylor_quinney jc_a jc_b jc_n jc_c jc_m melt_temperature \
+             room_temperature initial_temperature ref_strain_rate particles_radial \
+             smoothing_ratio smoothing_coefficient smoothing_order shifting end_time"
+        );
+        for c in MaterialChoice::ALL {
+            let t = params_of(c);
+            assert_eq!(t.len(), len(c));
+            assert_eq!(t[..3], *BEFORE);
+            assert_eq!(t[t.len() - AFTER.len()..], *AFTER);
+        }
     }
 }

@@ -42,9 +42,8 @@ use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
-use crate::material::eos::LinearEos;
-use crate::material::johnson_cook::JohnsonCook;
-use crate::material::{Damage, Eos, Loading, Material, MaterialState, Point, Strength};
+use crate::material::choice::{MaterialChoice, Prefix};
+use crate::material::{Loading, Material, MaterialState, Point};
 use crate::neighbors::padded_rows;
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{RodObservables, RodSets};
@@ -391,29 +390,15 @@ impl TaylorSolver {
     }
 
     /// The material of the parameters: Johnson-Cook strength, the linear
-    /// equation of state, no damage.
+    /// equation of state, no damage (the material block of
+    /// [`MaterialChoice::JOHNSON_COOK_LINEAR`] read from `p`).
     pub fn material_of(p: &TaylorParams) -> Material {
-        Material {
-            eos: Eos::Linear(LinearEos {
-                bulk_modulus: p.bulk_modulus,
-                density: p.density,
-            }),
-            strength: Strength::JohnsonCook(JohnsonCook {
-                a: p.jc_a,
-                b: p.jc_b,
-                n: p.jc_n,
-                c: p.jc_c,
-                m: p.jc_m,
-                melt_temperature: p.melt_temperature,
-                room_temperature: p.room_temperature,
-                ref_strain_rate: p.ref_strain_rate,
-            }),
-            damage: Damage::None,
-            shear_modulus: p.shear_modulus,
-            specific_heat: p.specific_heat,
-            taylor_quinney: p.taylor_quinney,
-            reference_temperature: p.initial_temperature,
-        }
+        MaterialChoice::JOHNSON_COOK_LINEAR
+            .material(Prefix::None, |name| {
+                p.get(name)
+                    .ok_or_else(|| Error::Inconsistent(format!("no parameter {name}")))
+            })
+            .expect("TaylorParams has every parameter of Johnson-Cook and the linear EOS")
     }
 
     /// Sets up the rod at the instant of impact, of `material`: its
