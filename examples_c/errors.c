@@ -153,6 +153,20 @@ int main(void) {
     check(s, mi_sim_set_param(s, "viscosity_linear", 0.0), "viscosity_linear");
     check(s, mi_sim_set_param(s, "smoothing_coefficient", 0.0), "smoothing_coefficient");
     run_and_free(s, "time step collapsed", MI_TIME_STEP_COLLAPSE, "run(noh, no viscosity)");
+    /* Mie-Gruneisen chosen by name; a soft, steep curve hit at 2000 m/s
+     * reaches its singular compression 1 / (eos_s - 1) at the face. */
+    s = make("taylor", 5);
+    expect(s, mi_sim_set_material(s, "eos", "gruneisen"), MI_UNKNOWN_MATERIAL, "mie_gruneisen",
+           "set_material(eos = gruneisen)");
+    expect(s, mi_sim_set_material(s, "preset", "ofhc_copper"), MI_UNKNOWN_MATERIAL,
+           "ofhc_copper_jc", "set_material(preset = ofhc_copper)");
+    check(s, mi_sim_set_material(s, "eos", "mie_gruneisen"), "mi_sim_set_material");
+    expect(s, mi_sim_set_param(s, "bulk_modulus", 1e11), MI_UNKNOWN_PARAMETER, "eos_c0",
+           "set(bulk_modulus) with MG");
+    check(s, mi_sim_set_param(s, "eos_c0", 500.0), "eos_c0");
+    check(s, mi_sim_set_param(s, "eos_s", 10.0), "eos_s");
+    check(s, mi_sim_set_param(s, "impact_speed", 2000.0), "impact_speed");
+    run_and_free(s, "Mie-Gr", MI_COMPRESSION_LIMIT, "run(MG, eos_c0 500, 2000 m/s)");
     patched_state(6, 1, "-1e6", MI_THROUGH_BOUNDARY, "anvil", "step(v_Z = -1e6)");
     patched_state(11, 0, "1e308", MI_NON_FINITE, "non-finite", "step(v_R = 1e308)");
 

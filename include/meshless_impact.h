@@ -110,6 +110,12 @@ typedef enum {
      */
     MI_WRONG_ORDER = 14,
     /**
+     * No material model or preset has this name (`strength`, `eos` or
+     * `preset` of `mi_sim_set_material`, or of a TOML `[material]` table),
+     * or the scene has no material to choose.
+     */
+    MI_UNKNOWN_MATERIAL = 15,
+    /**
      * The run stopped: an MSPH moment matrix was singular (too few or
      * collinear neighbours).
      */
@@ -351,6 +357,27 @@ mi_result mi_sim_last_error(const mi_sim *sim, char *buf, size_t len, size_t *ne
  * `sim` must be NULL or a live handle; `toml` NULL or a NUL-terminated string.
  */
 mi_result mi_sim_load_toml(mi_sim *sim, const char *toml);
+
+/**
+ * Chooses the material of the handle's scene by the names of a scene
+ * file's `[material]` table, before the run starts: `key` is `"strength"`
+ * (`"johnson_cook"`, `"bilinear"`), `"eos"` (`"linear"`,
+ * `"mie_gruneisen"`) or `"preset"` (a material preset, for example
+ * `"copper_wilkins_bilinear"`; `meshless-impact materials` lists them).
+ * The parameter list then holds only the parameters of the chosen models
+ * (`mi_sim_param_count`, `mi_sim_param_info`); a parameter both models
+ * share keeps its value, a new one starts at its default, and a preset
+ * sets every parameter of its models. Call it before setting the
+ * material's parameters. String pointers from `mi_sim_param_info` are
+ * invalid afterwards. Errors: `MI_UNKNOWN_MATERIAL` (an unknown key or
+ * name, listing the known ones, or a scene with no material to choose),
+ * `MI_WRONG_ORDER` after the first step; on failure nothing changes.
+ *
+ * # Safety
+ * `sim` must be NULL or a live handle; `key` and `value` NULL or
+ * NUL-terminated strings.
+ */
+mi_result mi_sim_set_material(mi_sim *sim, const char *key, const char *value);
 
 /**
  * Sets a parameter by name (SI units), before the run starts. Errors:

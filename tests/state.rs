@@ -146,3 +146,56 @@ fn forged_noh_states_are_refused() {
     s["scene"]["params"]["Noh"]["end_time"] = json!(5e-324);
     assert!(refused(&s).contains("end_time"));
 }
+
+/// A run of a chosen material (a preset, bilinear strength) saved and
+/// restored goes on to the same bits, its material choice included; a
+/// state whose scene claims other models than its solver ran, or whose
+/// solver's material was edited, is refused.
+#[test]
+fn a_preset_run_round_trips_and_a_forged_material_is_refused() {
+    let mut scene = Scene::builtin("taylor").unwrap();
+    scene
+        .choose_material(None, None, Some("copper_wilkins_bilinear"))
+        .unwrap();
+    scene.set("particles_radial", 5.0).unwrap();
+    let mut sim = Simulation::new(scene.clone()).unwrap();
+    sim.advance_to(5e-6).unwrap();
+    let bytes = sim.serialize_state();
+    let mut back = Simulation::deserialize_state(&bytes).unwrap();
+    assert_eq!(back.scene(), &scene);
+    assert_eq!(back.kind(), scene.kind());
+    sim.advance_to(10e-6).unwrap();
+    back.advance_to(10e-6).unwrap();
+    let bits =
+        |s: &Simulation| -> Vec<u64> { s.observables().iter().map(|v| v.to_bits()).collect() };
+    assert_eq!(bits(&sim), bits(&back));
+
+    let base: Value = serde_json::from_slice(&bytes).unwrap();
+    assert_eq!(
+        base["scene"]["material"],
+        json!({"strength": "bilinear", "eos": "linear"})
+    );
+    // The scene says Johnson-Cook: its table then has no hardening_modulus.
+    let mut s = base.clone();
+    s["scene"]["material"] = json!({"strength": "johnson_cook", "eos": "linear"});
+    let msg = refused(&s);
+    assert!(msg.contains("unknown parameter `hardening_modulus`"), "{msg}");
+    // The scene says Johnson-Cook with its parameters, the solver ran bilinear.
+    let mut s = base.clone();
+    s["scene"]["material"] = json!({"strength": "johnson_cook", "eos": "linear"});
+    let params = s["scene"]["params"]["Taylor"].as_object_mut().unwrap();
+    params.remove("yield_stress");
+    params.remove("hardening_modulus");
+    let msg = refused(&s);
+    assert!(msg.contains("material"), "{msg}");
+    // The solver's hardening edited.
+    let mut s = base.clone();
+    solver(&mut s, "Taylor")["material"]["strength"]["Bilinear"]["hardening_modulus"] = json!(1e9);
+    let msg = refused(&s);
+    assert!(msg.contains("material"), "{msg}");
+    // An unknown model name.
+    let mut s = base;
+    s["scene"]["material"]["strength"] = json!("plastic");
+    let msg = refused(&s);
+    assert!(msg.contains("plastic"), "{msg}");
+}

@@ -254,7 +254,7 @@ impl Scene {
         Scene {
             title: row.title.to_string(),
             kind,
-            values: row.params.iter().map(|p| p.default).collect(),
+            values: kind.param_specs().iter().map(|p| p.default).collect(),
             reference: (row.reference)(),
         }
     }
@@ -618,5 +618,96 @@ mod tests {
             }
         }
         assert_eq!(builtin_names().len(), 14);
+    }
+
+    /// A `[material]` table chooses the models; the table then lists only
+    /// their parameters, a preset sets them all and `[parameters]` may
+    /// override them; a parameter of other models is refused by name, as
+    /// are unknown names and a preset contradicted by `strength` or `eos`.
+    #[test]
+    fn material_table_chooses_the_models_and_their_parameters() {
+        let s = Scene::from_toml_str(
+            "scene = \"taylor\"\n[material]\nstrength = \"bilinear\"\neos = \"mie_gruneisen\"\n\
+             [parameters]\nyield_stress = 3e8\neos_s = 1.5\n",
+        )
+        .unwrap();
+        assert_eq!(
+            s.kind().material(),
+            Some(MaterialChoice::BILINEAR_MIE_GRUNEISEN)
+        );
+        assert_eq!(s.get("yield_stress").unwrap(), 3e8);
+        assert_eq!(s.get("eos_s").unwrap(), 1.5);
+        assert_eq!(s.get("eos_c0").unwrap(), 4578.0);
+        for gone in ["jc_a", "bulk_modulus", "melt_temperature"] {
+            let e = s.get(gone).unwrap_err().to_string();
+            assert!(
+                e.contains(gone) && e.contains("strength = bilinear, eos = mie_gruneisen"),
+                "{e}"
+            );
+        }
+        let back = Scene::from_toml_str(&s.to_toml()).unwrap();
+        assert_eq!(back, s);
+        // The default choice writes no [material] table.
+        assert!(
+            !Scene::builtin("taylor")
+                .unwrap()
+                .to_toml()
+                .contains("[material]")
+        );
+
+        let p = Scene::from_toml_str(
+            "scene = \"taylor\"\n[material]\npreset = \"ofhc_copper_jc\"\n\
+             [parameters]\njc_a = 1e8\n",
+        )
+        .unwrap();
+        assert_eq!(p.get("density").unwrap(), 8960.0);
+        assert_eq!(p.get("jc_a").unwrap(), 1e8);
+        assert_eq!(p.get("jc_b").unwrap(), 292e6);
+
+        for (text, needle) in [
+            (
+                "[material]\nstrength = \"johnson_cook\"\n[parameters]\nyield_stress = 1e8\n",
+                "unknown parameter `yield_stress`",
+            ),
+            (
+                "[material]\nstrength = \"plastic\"\n",
+                "johnson_cook, bilinear",
+            ),
+            ("[material]\npreset = \"ofhc_copper\"\n", "ofhc_copper_jc"),
+            (
+                "[material]\npreset = \"tungsten_seed\"\nstrength = \"johnson_cook\"\n",
+                "contradicts",
+            ),
+            ("[material]\nmodel = \"bilinear\"\n", "unknown field"),
+        ] {
+            let e = Scene::from_toml_str(&format!("scene = \"taylor\"\n{text}"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{text}: {e}");
+        }
+        let e = Scene::from_toml_str("scene = \"noh\"\n[material]\neos = \"linear\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no material"), "{e}");
+    }
+
+    /// Changing the models keeps the parameters both tables share.
+    #[test]
+    fn set_material_keeps_shared_values() {
+        let mut s = Scene::builtin("taylor").unwrap();
+        s.set("density", 8000.0).unwrap();
+        s.set("particles_radial", 7.0).unwrap();
+        s.choose_material(Some("bilinear"), None, None).unwrap();
+        assert_eq!(s.get("density").unwrap(), 8000.0);
+        assert_eq!(s.get("particles_radial").unwrap(), 7.0);
+        assert_eq!(s.get("hardening_modulus").unwrap(), 510e6);
+        s.choose_material(Some("johnson_cook"), None, None).unwrap();
+        assert_eq!(s.get("jc_a").unwrap(), 792e6);
+        let before = s.clone();
+        assert!(
+            s.choose_material(Some("bilinear"), Some("nope"), None)
+                .is_err()
+        );
+        assert_eq!(s, before, "nothing changes on an error");
     }
 }
