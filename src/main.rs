@@ -62,7 +62,8 @@ enum Command {
     },
     /// List the built-in scenes with their titles.
     Scenes,
-    /// List the material presets: name, models, constants and source.
+    /// List the material presets: name, models, constants and source
+    /// (`[material] preset = "NAME"` in a scene file, `--preset NAME`).
     Materials,
 }
 
@@ -581,10 +582,11 @@ fn materials() -> Result<(), Stop> {
                 let v = p
                     .value(spec.name)
                     .expect("a preset gives every parameter of its models");
+                let unit = if spec.unit == "1" { "" } else { spec.unit };
                 if v.abs() >= 1e5 {
-                    format!("{} = {v:e} {}", spec.name, spec.unit)
+                    format!("{} = {v:.4e} {unit}", spec.name)
                 } else {
-                    format!("{} = {v} {}", spec.name, spec.unit)
+                    format!("{} = {v} {unit}", spec.name)
                 }
             })
             .collect();
@@ -593,6 +595,7 @@ fn materials() -> Result<(), Stop> {
         }
         outln!("    source: {}", p.source)?;
     }
+    outln!("(values rounded; `meshless-impact params --preset NAME` prints them in full)")?;
     Ok(())
 }
 

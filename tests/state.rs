@@ -179,7 +179,10 @@ fn a_preset_run_round_trips_and_a_forged_material_is_refused() {
     let mut s = base.clone();
     s["scene"]["material"] = json!({"strength": "johnson_cook", "eos": "linear"});
     let msg = refused(&s);
-    assert!(msg.contains("unknown parameter `hardening_modulus`"), "{msg}");
+    assert!(
+        msg.contains("unknown parameter `hardening_modulus`"),
+        "{msg}"
+    );
     // The scene says Johnson-Cook with its parameters, the solver ran bilinear.
     let mut s = base.clone();
     s["scene"]["material"] = json!({"strength": "johnson_cook", "eos": "linear"});

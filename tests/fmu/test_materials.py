@@ -1,0 +1,130 @@
+"""fmpy checks of the FMUs of the other material choices of the `taylor`
+scene: one FMU per choice (README, "Materials"). Each must pass `fmpy
+validate` and `fmutool -check`, list exactly the parameters of its models
+(the CLI's `params --strength ... --eos ...`), and give the final
+observables of the command-line program on the same scene, bit for bit.
+A preset reaches an FMU as start values: the Wilkins bar of
+scenes/wilkins_copper_bilinear.toml through TaylorImpactBilinear equals the
+CLI run of that scene file."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.validation import validate_fmu
+
+from conftest import CLI, COARSE, ROOT, Model
+
+CHOICES = [
+    ("TaylorImpactBilinear", "bilinear", "linear"),
+    ("TaylorImpactMieGruneisen", "johnson_cook", "mie_gruneisen"),
+    ("TaylorImpactBilinearMieGruneisen", "bilinear", "mie_gruneisen"),
+]
+
+_models = {}
+
+
+def model(identifier, suffix):
+    key = identifier + suffix
+    if key not in _models:
+        path = ROOT / "target" / "fmu" / f"{key}.fmu"
+        assert path.exists(), "run `cargo xtask fmu` first (tests/fmu/run.sh does)"
+        _models[key] = Model(path, read_model_description(str(path)), extract(str(path)))
+    return _models[key]
+
+
+def cli(*args):
+    return subprocess.run([str(CLI), *args], check=True, capture_output=True, text=True).stdout
+
+
+_runs = {}
+
+
+def cli_json(tmp_path_factory, *args):
+    """Final observables of `meshless-impact run ARGS --json`."""
+    if args not in _runs:
+        out = tmp_path_factory.mktemp("cli") / "out.json"
+        cli("run", "-q", *args, "--json", str(out))
+        _runs[args] = json.loads(out.read_text())
+    return _runs[args]
+
+
+def params_of(*args):
+    """Names and values of `meshless-impact params ARGS`, in order."""
+    rows = cli("params", *args).splitlines()[1:]
+    return [(r.split()[0], float(r.split()[2])) for r in rows]
+
+
+def assert_equal_to_cli(r, ref, names):
+    for name in names:
+        value = r[name][-1]
+        if name == "at_rest":
+            assert bool(value) and ref[name] is True
+        else:
+            assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
+
+
+@pytest.mark.parametrize("suffix", ["", "_fmi2"])
+@pytest.mark.parametrize("identifier,strength,eos", CHOICES)
+def test_validate_and_fmutool_check(identifier, strength, eos, suffix):
+    m = model(identifier, suffix)
+    assert validate_fmu(str(m.path)) == []
+    bindir = Path(sys.executable).parent
+    r = subprocess.run([str(bindir / "fmpy"), "validate", str(m.path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    r = subprocess.run([str(bindir / "fmutool"), "-input", str(m.path), "-check"], capture_output=True, text=True)
+    log = r.stdout + r.stderr
+    assert r.returncode == 0, log
+    assert "seems to be compliant" in log and "No semantic error" in log, log
+    assert "ERROR" not in log, log
+
+
+@pytest.mark.parametrize("identifier,strength,eos", CHOICES)
+def test_variables_are_the_choice_parameters(identifier, strength, eos):
+    m3, m2 = model(identifier, ""), model(identifier, "_fmi2")
+    want = params_of("--strength", strength, "--eos", eos)
+    params = [v for v in m3.md.modelVariables if v.causality == "parameter"]
+    assert [v.name for v in params] == [n for n, _ in want]
+    assert [float(v.start) for v in params] == [v for _, v in want]
+    names = {v.name for v in params}
+    if strength == "bilinear":
+        assert {"yield_stress", "hardening_modulus"} <= names and not any(n.startswith("jc_") for n in names)
+    if eos == "mie_gruneisen":
+        assert {"eos_c0", "eos_s", "gruneisen"} <= names and "bulk_modulus" not in names
+    # The outputs are the Taylor scene's; the tokens differ from TaylorImpact's.
+    base = read_model_description(str(ROOT / "target" / "fmu" / "TaylorImpact.fmu"))
+    assert [v.name for v in m3.outputs] == [v.name for v in base.modelVariables if v.causality == "output"]
+    assert m3.md.guid == m2.md.guid != base.guid
+
+
+@pytest.mark.parametrize("suffix", ["", "_fmi2"])
+@pytest.mark.parametrize("identifier,strength,eos", CHOICES)
+def test_coarse_run_equals_the_cli(identifier, strength, eos, suffix, tmp_path_factory):
+    m = model(identifier, suffix)
+    ref = cli_json(tmp_path_factory, "--strength", strength, "--eos", eos, "--set", f"particles_radial={COARSE}")
+    names = [v.name for v in m.outputs]
+    r = simulate_fmu(str(m.path), start_values={"particles_radial": COARSE}, output=names)
+    assert_equal_to_cli(r, ref, names)
+    assert ref["at_rest"] is True
+
+
+def test_preset_as_start_values_equals_the_scene_file(tmp_path_factory):
+    """The Wilkins bar through TaylorImpactBilinear, its preset and
+    parameters given as start values, equals the CLI run of
+    scenes/wilkins_copper_bilinear.toml."""
+    scene = str(ROOT / "scenes" / "wilkins_copper_bilinear.toml")
+    ref = cli_json(tmp_path_factory, "--scene-file", scene, "--set", f"particles_radial={COARSE}")
+    m = model("TaylorImpactBilinear", "")
+    start = dict(params_of("--preset", "copper_wilkins_bilinear"))
+    for line in Path(scene).read_text().split("[parameters]")[1].split("[reference]")[0].splitlines():
+        if "=" in line:
+            name, value = line.split("#")[0].split("=")
+            start[name.strip()] = float(value)
+    start["particles_radial"] = COARSE
+    names = [v.name for v in m.outputs]
+    r = simulate_fmu(str(m.path), start_values=start, output=names, stop_time=400e-6)
+    assert_equal_to_cli(r, ref, names)
+    assert start["yield_stress"] == 400e6 and start["hardening_modulus"] == 100e6
