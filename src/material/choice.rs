@@ -147,27 +147,21 @@ pub struct BlockParam {
 }
 
 impl MaterialChoice {
+    /// The choice of `strength` and `eos`.
+    pub const fn new(strength: StrengthKind, eos: EosKind) -> Self {
+        MaterialChoice { strength, eos }
+    }
     /// Johnson-Cook strength with the linear EOS: the `taylor` scene's
     /// default.
-    pub const JOHNSON_COOK_LINEAR: MaterialChoice = MaterialChoice {
-        strength: StrengthKind::JohnsonCook,
-        eos: EosKind::Linear,
-    };
+    pub const JOHNSON_COOK_LINEAR: Self = Self::new(StrengthKind::JohnsonCook, EosKind::Linear);
     /// Bilinear strength with the linear EOS.
-    pub const BILINEAR_LINEAR: MaterialChoice = MaterialChoice {
-        strength: StrengthKind::Bilinear,
-        eos: EosKind::Linear,
-    };
+    pub const BILINEAR_LINEAR: Self = Self::new(StrengthKind::Bilinear, EosKind::Linear);
     /// Johnson-Cook strength with Mie-Grüneisen.
-    pub const JOHNSON_COOK_MIE_GRUNEISEN: MaterialChoice = MaterialChoice {
-        strength: StrengthKind::JohnsonCook,
-        eos: EosKind::MieGruneisen,
-    };
+    pub const JOHNSON_COOK_MIE_GRUNEISEN: Self =
+        Self::new(StrengthKind::JohnsonCook, EosKind::MieGruneisen);
     /// Bilinear strength with Mie-Grüneisen.
-    pub const BILINEAR_MIE_GRUNEISEN: MaterialChoice = MaterialChoice {
-        strength: StrengthKind::Bilinear,
-        eos: EosKind::MieGruneisen,
-    };
+    pub const BILINEAR_MIE_GRUNEISEN: Self =
+        Self::new(StrengthKind::Bilinear, EosKind::MieGruneisen);
     /// Every choice.
     pub const ALL: [MaterialChoice; 4] = [
         Self::JOHNSON_COOK_LINEAR,

@@ -5,11 +5,13 @@ low-level classes."""
 import json
 import os
 import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 from fmpy import extract, read_model_description
+from fmpy.validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parents[2]
 FMU3 = ROOT / "target" / "fmu" / "TaylorImpact.fmu"
@@ -66,3 +68,17 @@ def cli_run(tmp_path_factory, *sets):
                        env=dict(os.environ))
         _cli_cache[key] = json.loads(out.read_text())
     return _cli_cache[key]
+
+
+def check_fmu_file(path):
+    """fmpy's validation (library and command line) and fmutool's check
+    pass on the FMU at `path`."""
+    assert validate_fmu(str(path)) == []
+    bindir = Path(sys.executable).parent
+    r = subprocess.run([str(bindir / "fmpy"), "validate", str(path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    r = subprocess.run([str(bindir / "fmutool"), "-input", str(path), "-check"], capture_output=True, text=True)
+    log = r.stdout + r.stderr
+    assert r.returncode == 0, log
+    assert "seems to be compliant" in log and "No semantic error" in log, log
+    assert "ERROR" not in log, log
