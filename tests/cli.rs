@@ -452,3 +452,82 @@ fn vtk_times_outside_the_run_are_refused() {
     assert!(vtk.join("particles_0002.vtu").is_file());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The material choice on the command line: `materials` lists every preset
+/// with its models and source, `params` lists only the chosen models'
+/// parameters (a preset's values as the defaults), `scene` writes the
+/// `[material]` table, and bad names or parameters of other models are
+/// refused by name.
+#[test]
+fn material_choice_on_the_command_line() {
+    let text = |args: &[&str]| {
+        let out = bin().args(args).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let list = text(&["materials"]);
+    for p in meshless_impact::material::presets::PRESETS {
+        assert!(
+            list.contains(p.name) && list.contains(p.source),
+            "{}",
+            p.name
+        );
+    }
+    let names = |out: String| -> Vec<String> {
+        out.lines()
+            .skip(1)
+            .map(|l| l.split_whitespace().next().unwrap().to_string())
+            .collect()
+    };
+    let p = names(text(&[
+        "params",
+        "--strength",
+        "bilinear",
+        "--eos",
+        "mie_gruneisen",
+    ]));
+    for want in [
+        "yield_stress",
+        "hardening_modulus",
+        "eos_c0",
+        "eos_s",
+        "gruneisen",
+    ] {
+        assert!(p.iter().any(|n| n == want), "{want}");
+    }
+    assert!(
+        !p.iter()
+            .any(|n| n.starts_with("jc_") || n == "bulk_modulus")
+    );
+    let copper = text(&["params", "--preset", "copper_wilkins_bilinear"]);
+    let row = copper
+        .lines()
+        .find(|l| l.starts_with("yield_stress "))
+        .unwrap();
+    assert_eq!(row.split_whitespace().nth(2), Some("400000000"), "{row}");
+    let toml = text(&["scene", "taylor", "--strength", "bilinear"]);
+    assert!(
+        toml.contains("[material]\nstrength = \"bilinear\"\neos = \"linear\""),
+        "{toml}"
+    );
+    let mut run = SMALL_RUN.to_vec();
+    run.extend(["--strength", "plastic"]);
+    assert_error(
+        &bin().args(&run).output().unwrap(),
+        &["unknown strength `plastic`", "johnson_cook, bilinear"],
+    );
+    let mut run = SMALL_RUN.to_vec();
+    run.extend(["--preset", "tungsten_seed", "--set", "jc_a=1e9"]);
+    assert_error(
+        &bin().args(&run).output().unwrap(),
+        &[
+            "unknown parameter `jc_a`",
+            "strength = bilinear",
+            "yield_stress",
+        ],
+    );
+    let mut run = SMALL_RUN.to_vec();
+    run.extend(["--preset", "tungsten_seed", "-q"]);
+    let out = bin().args(&run).output().unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+}

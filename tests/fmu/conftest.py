@@ -1,4 +1,4 @@
-"""Shared fixtures of the FMU tests: the two FMUs (built by `cargo xtask fmu`,
+"""Shared fixtures of the FMU tests: the two TaylorImpact FMUs (built by `cargo xtask fmu`,
 see run.sh), extracted once, and helpers that drive them through fmpy's
 low-level classes."""
 
