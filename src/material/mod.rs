@@ -20,6 +20,7 @@ pub mod ideal_gas;
 pub mod johnson_cook;
 pub mod mie_gruneisen;
 pub mod presets;
+pub mod rajendran_grove;
 pub mod tensor;
 
 use crate::error::Result;
