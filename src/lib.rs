@@ -39,6 +39,7 @@ pub mod rod;
 pub mod scene;
 mod sim;
 pub mod solver;
+pub mod uniaxial;
 
 pub use error::{Error, Result};
 pub use isa::Isa;

@@ -331,6 +331,24 @@ impl RajendranGrove {
         n1 * self.rayleigh_speed() * (1.0 - (gc / gs).powf(n2))
     }
 
+    /// The Hugoniot elastic limit in uniaxial strain at strain rates up to
+    /// the reference rate (`Y = C1`) from the initial state: the log strain
+    /// `x` where the elastic path (`q = 2 R_g G x`, `eta = exp(x) - 1` at
+    /// the initial porosity) meets Gurson's surface, and the axial stress
+    /// `P + 2/3 q` there (Pa, compression positive).
+    pub fn hugoniot_elastic_limit(&self) -> (f64, f64) {
+        let f0 = self.initial_porosity;
+        let g = self.porosity_factor(f0) * self.shear_modulus;
+        let y = self.c1;
+        let surface = |x: f64| {
+            let (q, p) = (2.0 * g * x, self.pressure(x.exp() - 1.0, 1.0, 0.0));
+            (q / y).powi(2) + 2.0 * f0 * (1.5 * p / y).cosh() - f0 * f0 - 1.0
+        };
+        let x = solve_increasing(surface, 0.0, 1.0);
+        let stress = self.pressure(x.exp() - 1.0, 1.0, 0.0) + 2.0 / 3.0 * 2.0 * g * x;
+        (stress, x)
+    }
+
     /// The initial state of a point at rest.
     pub fn initial_point(&self) -> CeramicPoint {
         CeramicPoint {
@@ -385,7 +403,7 @@ impl RajendranGrove {
                         energy,
                     )
                 };
-                bisect(residual, p_trial.min(0.0), p_trial.max(0.0))
+                solve_increasing(residual, p_trial.min(0.0), p_trial.max(0.0))
             };
             let state = |dl: f64| {
                 let shrink = 1.0 / (1.0 + 6.0 * g_eff * dl / (y * y));
@@ -405,7 +423,7 @@ impl RajendranGrove {
                 hi *= 2.0;
                 grown += 1;
             }
-            let dl = bisect(|dl| -excess(dl), 0.0, hi);
+            let dl = solve_increasing(|dl| -excess(dl), 0.0, hi);
             let (shrink, p, f) = state(dl);
             let s = s_trial.scaled(shrink);
             let work = 6.0 * dl * 0.5 * s.double_dot(&s) / (y * y) + p * compaction(dl, p);
@@ -537,21 +555,55 @@ pub fn equivalent_rate(d: &Full) -> f64 {
 pub fn rayleigh_ratio(nu: f64) -> f64 {
     let k = (1.0 - 2.0 * nu) / (2.0 * (1.0 - nu));
     let r = |x: f64| ((x - 8.0) * x + 24.0 - 16.0 * k) * x - 16.0 * (1.0 - k);
-    bisect(r, 0.0, 1.0).sqrt()
+    solve_increasing(r, 0.0, 1.0).sqrt()
 }
 
 /// The root of an increasing `g` between `lo` and `hi` (`g(lo) <= 0 <=
-/// g(hi)`), by bisection to the last bit.
-fn bisect(g: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
+/// g(hi)`): regula falsi with the Illinois modification (Dowell & Jarratt
+/// 1971), which keeps the bracket and converges superlinearly, with a
+/// bisection wherever two steps have not halved the bracket; to 1e-15 of
+/// the bracket's scale.
+fn solve_increasing(g: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    let (mut g_lo, mut g_hi) = (g(lo), g(hi));
+    if g_lo >= 0.0 {
+        return lo;
+    }
+    if g_hi <= 0.0 {
+        return hi;
+    }
+    let tol = 1e-15 * lo.abs().max(hi.abs());
+    let mut side = 0i8;
+    let mut widths = [f64::INFINITY; 2];
+    for _ in 0..400 {
+        let w = hi - lo;
+        if w <= tol {
             break;
         }
-        if g(mid) > 0.0 {
-            hi = mid;
+        let mut x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+        // Bisect where the secant leaves the bracket or has not halved it
+        // in two steps (a far-off end value makes Illinois slow).
+        if !(x > lo && x < hi) || w > 0.5 * widths[0] {
+            x = 0.5 * (lo + hi);
+        }
+        widths = [widths[1], w];
+        let gx = g(x);
+        if gx == 0.0 {
+            return x;
+        }
+        if gx > 0.0 {
+            hi = x;
+            g_hi = gx;
+            if side == 1 {
+                g_lo *= 0.5;
+            }
+            side = 1;
         } else {
-            lo = mid;
+            lo = x;
+            g_lo = gx;
+            if side == -1 {
+                g_hi *= 0.5;
+            }
+            side = -1;
         }
     }
     0.5 * (lo + hi)
@@ -821,16 +873,7 @@ mod tests {
                 initial_porosity: f0,
                 ..RajendranGrove::ad85()
             };
-            let g = m.porosity_factor(f0) * m.shear_modulus;
-            let y = m.c1;
-            // Along the elastic path at log strain x: q = 2 G x, eta =
-            // exp(x) - 1 at constant porosity.
-            let surface = |x: f64| {
-                let (q, p) = (2.0 * g * x, m.pressure(x.exp() - 1.0, 1.0, 0.0));
-                (q / y).powi(2) + 2.0 * f0 * (1.5 * p / y).cosh() - f0 * f0 - 1.0
-            };
-            let x = bisect(surface, 0.0, 0.1);
-            let hel = m.pressure(x.exp() - 1.0, 1.0, 0.0) + 2.0 / 3.0 * 2.0 * g * x;
+            let (hel, _) = m.hugoniot_elastic_limit();
             // Driven at 1.5/s (equivalent rate 1/s), 1e-5 s a step.
             let rate = 1.5;
             let (mut before, mut after) = (0.0, f64::NAN);
