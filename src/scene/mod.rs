@@ -7,6 +7,7 @@ pub mod params;
 pub mod registry;
 pub mod table1;
 pub mod taylor;
+pub mod taylor3d;
 
 use crate::error::{Error, Result};
 use crate::observe::ObservableSpec;

@@ -1093,6 +1093,7 @@ impl TaylorSolver {
         }
         if let Some((particle, condition)) = a.singular {
             return Err(Error::SingularMomentMatrix {
+                method: crate::error::MomentMethod::Msph,
                 particle,
                 time: self.time,
                 condition,
