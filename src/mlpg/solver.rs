@@ -79,8 +79,8 @@ pub const SAFETY: f64 = 0.9;
 /// and traction operator are rebuilt.
 /// 0.05: at 0.01 the plastic zone of `taylor3d` (strain rates near 1e5/s)
 /// rebuilds every step (270 s for 447 steps at 6 nodes across, against
-/// 99 s for 465 steps at 0.05; both runs stop by spacing collapse, at 27.7
-/// and 28.6 µs, with rod lengths 34.56 and 34.51 mm).
+/// 99 s for 465 steps at 0.05; both runs stop early, at 27.7 and 28.6 µs,
+/// with rod lengths 34.56 and 34.51 mm).
 pub const REBUILD_STRAIN: f64 = 0.05;
 
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
