@@ -61,7 +61,7 @@ observables! {
     max_temperature: "K", "highest temperature";
     kinetic_energy: "J", "kinetic energy of the rod";
     internal_energy: "J", "stress work stored and dissipated in the material (elastic plus plastic)";
-    smoothing_dissipation: "J", "kinetic energy removed by smoothing: none in MLPG (always 0; see damping_dissipation)";
+    smoothing_dissipation: "J", "kinetic energy removed by the velocity smoothing toward the MLS approximation (smoothing_coefficient)";
     contact_dissipation: "J", "kinetic energy removed by the rigid anvil when it stops nodes";
     energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
     at_rest: "bool", "the rod has stopped or left the anvil: the end condition of a run";

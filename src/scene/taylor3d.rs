@@ -11,7 +11,7 @@ use super::Scene;
 use super::params::{Range, param_table};
 use super::registry::{SceneRow, no_variants, restore};
 use super::taylor::{TAYLOR_PARAMS, TaylorParams};
-use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup};
+use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
 use crate::mlpg::{Cylinder, lattice::NodeLattice};
 use crate::observe::TAYLOR3D_OBSERVABLES;
 use crate::solver::axisymmetric::TaylorSolver;
@@ -73,6 +73,8 @@ param_table! {
             "nodes across the radius, axis and mantle included (rings + 1); axial spacing matches";
         damping: "1" = DAMPING, Range::closed(0.0, 0.5),
             "damping ratio at the highest frequency of the stiffness-proportional damping (README, 3-D MLPG)";
+        smoothing_coefficient: "1" = SMOOTHING, Range::closed(0.0, 0.5),
+            "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, 3-D MLPG)";
         rebuild_strain: "1" = REBUILD_STRAIN, Range::closed(1.0e-4, 0.2),
             "relative motion of neighbours past which the MLPG shapes, test spheres and traction operator are rebuilt";
         end_time: "s" = 400.0e-6, Range::closed(1.0e-9, 1.0),
@@ -110,6 +112,7 @@ impl Taylor3dParams {
         );
         s.damping = self.damping;
         s.rebuild_strain = self.rebuild_strain;
+        s.smoothing = self.smoothing_coefficient;
         s
     }
 
