@@ -413,7 +413,7 @@ mod tests {
                     let msg = e.to_string();
                     assert!(
                         msg.starts_with(&format!(
-                            "unknown scene `{name}`; allowed: taylor, noh, table1-1,"
+                            "unknown scene `{name}`; allowed: taylor, noh, taylor3d, table1-1,"
                         )),
                         "{msg}"
                     );
@@ -431,9 +431,13 @@ mod tests {
                     Scene::default_of(SceneKind::named("taylor").unwrap())
                 ),
                 1 => assert_eq!(scene, Scene::default_of(SceneKind::named("noh").unwrap())),
-                _ => assert_eq!(scene, rows[k - 2].scene(), "{name}"),
+                2 => assert_eq!(
+                    scene,
+                    Scene::default_of(SceneKind::named("taylor3d").unwrap())
+                ),
+                _ => assert_eq!(scene, rows[k - 3].scene(), "{name}"),
             }
         }
-        assert_eq!(builtin_names().len(), 14);
+        assert_eq!(builtin_names().len(), 15);
     }
 }
