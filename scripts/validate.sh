@@ -2,7 +2,9 @@
 # Heavy validation, beyond the test command: the refinement study of test 7
 # (20, 31 and 41 particles across the radius), run as the ignored integration
 # tests (about 2 minutes on two cores), and test 7 at 600 m/s with the
-# large-strain scheme (173 s on one thread).
+# large-strain scheme (173 s on one thread); House test 7 in 3-D (taylor3d) at
+# 11 nodes across the radius (about 6 minutes on two shared cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo test --release --test taylor -- --ignored --nocapture
+cargo test --release --test taylor3d -- --ignored --nocapture

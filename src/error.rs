@@ -1,6 +1,39 @@
 //! The typed error of the core. Every variant names what went wrong, with the
 //! offending value and, for input errors, the allowed range.
 
+/// The approximation whose moment matrix
+/// [`Error::SingularMomentMatrix`] names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MomentMethod {
+    /// MSPH of the axisymmetric solver: the kernel's support, set by
+    /// `smoothing_ratio`.
+    Msph,
+    /// MLS of the 3-D MLPG solver: the supports of the `k` named
+    /// neighbours times the support factor.
+    Mls,
+}
+
+impl MomentMethod {
+    /// What to change.
+    pub fn hint(self) -> &'static str {
+        match self {
+            MomentMethod::Msph => "increase smoothing_ratio",
+            MomentMethod::Mls => {
+                "the MLS supports cover too few nodes off a plane (the lattice is too coarse or too distorted)"
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for MomentMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            MomentMethod::Msph => "MSPH",
+            MomentMethod::Mls => "MLS",
+        })
+    }
+}
+
 /// Errors returned by the core library.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
@@ -58,12 +91,15 @@ pub enum Error {
     /// A scene file that could not be read or parsed.
     #[error("scene file: {0}")]
     SceneFile(String),
-    /// The MSPH moment matrix of a particle is singular or too ill-conditioned.
+    /// The moment matrix of a particle or node is singular or too
+    /// ill-conditioned: MSPH's (axisymmetric solver) or MLS's (3-D MLPG).
     #[error(
-        "singular MSPH moment matrix at particle {particle} (t = {time:.4e} s, condition number {condition:.3e}): \
-         too few or collinear neighbours; increase smoothing_ratio"
+        "singular {method} moment matrix at particle {particle} (t = {time:.4e} s, condition number {condition:.3e}): \
+         too few or collinear neighbours; {}", method.hint()
     )]
     SingularMomentMatrix {
+        /// The approximation whose moment matrix failed.
+        method: MomentMethod,
         /// Particle index.
         particle: usize,
         /// Simulated time.

@@ -51,6 +51,26 @@ observables! {
 }
 
 observables! {
+    TAYLOR3D_OBSERVABLES, "Observables of the 3-D Taylor scene (MLPG), in output order: those of the Taylor scene, then its own.",
+    rod_length: "m", "current length of the rod (highest minus lowest material point)";
+    mushroom_radius: "m", "largest distance from the axis among nodes that started on the impact face";
+    undeformed_length: "m", "length of the contiguous part from the free end where R/R0 - 1 < 0.2%";
+    tail_velocity: "m/s", "axial velocity of the centre of the free end, positive toward the anvil";
+    face_lift: "m", "axial gap between the centre of the impact face and the anvil";
+    max_plastic_strain: "1", "largest effective plastic strain";
+    max_temperature: "K", "highest temperature";
+    kinetic_energy: "J", "kinetic energy of the rod";
+    internal_energy: "J", "stress work stored and dissipated in the material (elastic plus plastic)";
+    smoothing_dissipation: "J", "kinetic energy removed by the velocity smoothing toward the MLS approximation (smoothing_coefficient)";
+    contact_dissipation: "J", "kinetic energy removed by the rigid anvil when it stops nodes";
+    energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
+    at_rest: "bool", "the rod has stopped or left the anvil: the end condition of a run";
+    mushroom_radius_spread: "1", "(max - min) / mean of the distance from the axis of the impact face's outer ring";
+    damping_dissipation: "J", "work of the viscous stress of the stiffness-proportional damping";
+    plastic_work: "J", "plastic part of the internal energy (flow stress times plastic strain increment)";
+}
+
+observables! {
     NOH_OBSERVABLES, "Observables of the Noh scene, in output order.",
     shock_radius: "1", "outermost radius where the density reaches the mean of the exact pre- and post-shock values";
     post_shock_density: "1", "mean density over 0.1 <= r <= 0.18";

@@ -11,7 +11,7 @@
 pub const UNDEFORMED_STRAIN: f64 = 0.002;
 
 /// The particle sets of a rod, tagged by the scene's builder.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub struct RodSets {
     /// The particles of the impact face (on the anvil at the start).
     pub face: Vec<usize>,

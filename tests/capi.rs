@@ -856,8 +856,8 @@ fn only_the_documented_scene_names_are_accepted() {
         assert_eq!(d.to_str().unwrap(), "unknown scene name");
     }
     let names = meshless_impact::scene::builtin_names();
-    assert_eq!(names.len(), 14);
-    assert_eq!(names[13], "table1-12");
+    assert_eq!(names.len(), 15);
+    assert_eq!(names[14], "table1-12");
     for name in &names {
         let s = new_sim(name);
         let scene = Scene::builtin(name).unwrap();

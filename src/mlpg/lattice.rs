@@ -36,7 +36,7 @@ use crate::rod::RodSets;
 use std::f64::consts::PI;
 
 /// Which parts of the global boundary a node lies on (bit flags).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Surfaces(pub u8);
 
 impl Surfaces {
@@ -60,7 +60,7 @@ impl Surfaces {
 
 /// A solid cylinder with its axis along z and its base (the impact face) at
 /// z = 0.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Cylinder {
     /// Radius R0 (m).
     pub radius: f64,
@@ -86,7 +86,7 @@ impl Cylinder {
 }
 
 /// The nodes of a cylinder on the ring lattice, in structure-of-arrays form.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NodeLattice {
     /// The cylinder filled.
     pub cylinder: Cylinder,

@@ -318,6 +318,7 @@ impl ShapeRow {
             }
         }
         let singular = |condition| Error::SingularMomentMatrix {
+            method: crate::error::MomentMethod::Mls,
             particle: node,
             time: 0.0,
             condition,

@@ -29,6 +29,7 @@
 
 pub mod lattice;
 pub mod mls;
+pub mod solver;
 pub mod sphere;
 pub mod step;
 pub mod weak;
@@ -38,5 +39,6 @@ mod measure;
 
 pub use lattice::{Cylinder, NodeLattice, Surfaces};
 pub use mls::{NodalShapes, Recompute, ShapeRow, SupportParams, Supports};
+pub use solver::{Energies, Mlpg3d, RodSetup};
 pub use sphere::{SphereRule, TestSphere};
 pub use weak::TractionOperator;

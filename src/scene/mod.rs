@@ -7,6 +7,7 @@ pub mod params;
 pub mod registry;
 pub mod table1;
 pub mod taylor;
+pub mod taylor3d;
 
 use crate::error::{Error, Result};
 use crate::material::choice::{EosKind, MaterialChoice, Prefix, StrengthKind};
@@ -596,7 +597,7 @@ mod tests {
                     let msg = e.to_string();
                     assert!(
                         msg.starts_with(&format!(
-                            "unknown scene `{name}`; allowed: taylor, noh, table1-1,"
+                            "unknown scene `{name}`; allowed: taylor, noh, taylor3d, table1-1,"
                         )),
                         "{msg}"
                     );
@@ -614,10 +615,14 @@ mod tests {
                     Scene::default_of(SceneKind::named("taylor").unwrap())
                 ),
                 1 => assert_eq!(scene, Scene::default_of(SceneKind::named("noh").unwrap())),
-                _ => assert_eq!(scene, rows[k - 2].scene(), "{name}"),
+                2 => assert_eq!(
+                    scene,
+                    Scene::default_of(SceneKind::named("taylor3d").unwrap())
+                ),
+                _ => assert_eq!(scene, rows[k - 3].scene(), "{name}"),
             }
         }
-        assert_eq!(builtin_names().len(), 14);
+        assert_eq!(builtin_names().len(), 15);
     }
 
     /// A `[material]` table chooses the models; the table then lists only

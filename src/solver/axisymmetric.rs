@@ -1078,6 +1078,7 @@ impl TaylorSolver {
         }
         if let Some((particle, condition)) = a.singular {
             return Err(Error::SingularMomentMatrix {
+                method: crate::error::MomentMethod::Msph,
                 particle,
                 time: self.time,
                 condition,

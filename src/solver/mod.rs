@@ -40,6 +40,7 @@ pub(crate) fn first_degenerate(
 ) -> crate::Result<()> {
     match status.into_iter().find_map(|s| s.err()) {
         Some(e) => Err(crate::Error::SingularMomentMatrix {
+            method: crate::error::MomentMethod::Msph,
             particle: e.particle,
             time,
             condition: e.condition,

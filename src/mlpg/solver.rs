@@ -1,0 +1,1216 @@
+//! The time loop of the 3-D MLPG mixed method (seed sections 2-3): a rod on
+//! the ring lattice striking a rigid smooth anvil at z = 0.
+//!
+//! # One step
+//!
+//! Updated Lagrangian, central differences (Newmark β = 0, γ = 1/2, seed
+//! section 3.4), from positions `x^n`, velocities `v^{n−1/2}` and nodal
+//! stresses `σ^n`:
+//!
+//! 1. the traction of every node's test sphere, `F_i = ∫ (σ + σ_v)·n dS`
+//!    ([`TractionOperator`], eq. 10), with `σ_v` the viscous stress of the
+//!    damping ([`DAMPING`]); the acceleration `a_i = F_i / (ρ_i V_s,i)`
+//!    (the Heaviside weak form: the sphere's inertia);
+//! 2. `v^{n+1/2} = v^{n−1/2} + dt a_i`; a node on the anvil keeps `v_z = 0`
+//!    while the anvil pushes it (`F_z ≤ 0`) and is released when its sphere
+//!    pulls it away (`F_z > 0`: the contact force would be tensile); then
+//!    the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
+//!    ([`SMOOTHING`]), its kinetic energy booked as `smoothing_dissipation`;
+//! 3. `x^{n+1} = x^n + dt v^{n+1/2}`; a node that reaches z = 0 stops on
+//!    the anvil (its kinetic energy toward the anvil is booked as
+//!    `contact_dissipation`), one that passes it by half a spacing is the
+//!    error [`Error::ThroughBoundary`];
+//! 4. the geometry follows the body: supports recomputed by
+//!    [`Supports::recompute_reason`], shape functions, test spheres and the
+//!    traction operator rebuilt when a named pair has moved, relative to the
+//!    other, by more than [`REBUILD_STRAIN`] of its length since the last
+//!    build;
+//! 5. nodal velocity gradients by collocation (eq. 4), the rate of
+//!    deformation and spin, the density `ρ (1 − dt tr D)`, and the shared
+//!    [`Material::update`] in the 3-D ([`Full`]) form: Jaumann rate, radial
+//!    return, heating, equation of state;
+//! 6. energies, the checks (non-finite fields, energy drift, spacing
+//!    collapse, compression limit) and the next step, eq. (15).
+//!
+//! Every pass runs over nodes in parallel (rayon) and writes per node;
+//! sums are taken serially in node order, so any number of threads gives
+//! the same bits.
+//!
+//! # The deformed free boundary
+//!
+//! The cut planes of a boundary node's test sphere follow the body: the
+//! outward normal of the deformed surface is Nanson's `n ∝ F⁻ᵀ N`, with
+//! `N` the reference normal of the lattice (radial on the mantle, ∓z on
+//! the face and the top) and `F⁻¹ = ∂X/∂x` the collocated gradient (eq. 4)
+//! of the reference positions over the current nodes. On an edge (mantle
+//! and face or top) the mantle normal is made orthogonal to the face's, as
+//! the cut rule works in an orthonormal frame. A face node pressed on the
+//! anvil has the anvil's normal. An interior node's test radius is shrunk
+//! (eq. 12) to its distance from the tangent planes of the boundary nodes
+//! it names.
+
+use super::lattice::{Cylinder, NodeLattice, Surfaces};
+use super::mls::{NodalShapes, SupportParams, Supports, distance};
+use super::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii};
+use super::step::{OMEGA_FACTOR, stable_step};
+use super::weak::TractionOperator;
+use crate::error::{Error, Result};
+use crate::material::tensor::{Full, SymTensor};
+use crate::material::{Loading, Material, MaterialState, Point};
+use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
+use crate::rod::{RodObservables, radius};
+use crate::solver::axisymmetric::{QUIET_FRACTION, QUIET_TRANSITS, SPACING_COLLAPSE_BOUND};
+use crate::solver::{check_derived, check_time_step};
+use rayon::prelude::*;
+
+/// Default damping ratio ζ at the highest frequency `ω_max` of the
+/// stiffness-proportional damping: none, as in the seed. Measured (README,
+/// "3-D MLPG mixed method: the instability"): on the free bar ζ = 0.1
+/// slows the growth of the unstable modes (2.0 → 0.44 e-folds per period
+/// at 2 rings, 1.6 → 0.64 at 3) without removing it, as the remaining
+/// growth is in low modes (λ ≈ 2 % of λ_max); in `taylor3d` at 6 nodes
+/// across it dissipates 7.6 % of the impact energy and does not prevent
+/// the spacing collapse, while without it the energy error stays at 2.2 %.
+pub const DAMPING: f64 = 0.0;
+
+/// Default safety factor on the stable step of eq. (15).
+pub const SAFETY: f64 = 0.9;
+
+/// Relative motion of a named pair since the last build of the operator
+/// (`|Δ(x_i − x_j)| / |x_i − x_j|`) past which the shapes, test spheres
+/// and traction operator are rebuilt.
+/// 0.05: at 0.01 the plastic zone of `taylor3d` (strain rates near 1e5/s)
+/// rebuilds every step (270 s for 447 steps at 6 nodes across, against
+/// 99 s for 465 steps at 0.05; both runs stop early, at 27.7 and 28.6 µs,
+/// with rod lengths 34.56 and 34.51 mm).
+pub const REBUILD_STRAIN: f64 = 0.05;
+
+/// Default α of the velocity smoothing toward the MLS approximation at the
+/// node. The MLS approximation does not interpolate: a node can move
+/// relative to its neighbours by a motion the collocated gradients (eq. 4)
+/// barely see. Without smoothing `taylor3d` (6 nodes across) stops at
+/// 28.6 µs with the spacing collapsed to 0.1 on the axis at the face (the
+/// second node from the face 74 µm above the face centre, which had left
+/// the anvil, while the largest plastic strain is 0.95); measured α (Lf,
+/// face radius, energy error, smoothing work of 220 J): 0.02: at rest,
+/// 34.56 mm, 5.27 mm, 4.7 %, 4.2 J; 0.05: 34.59 mm, 5.20 mm, 2.5 %,
+/// 5.8 J; 0.1: 34.62 mm, 5.11 mm, 1.4 %, 8.7 J. The smoothing reproduces
+/// linear velocity fields, so it leaves uniform straining alone; 0.1 is
+/// chosen for the smallest energy error (README, "3-D MLPG").
+pub const SMOOTHING: f64 = 0.1;
+
+/// Energy error past which a run stops with [`Error::EnergyDrift`].
+pub const ENERGY_ERROR_BOUND: f64 = 0.5;
+
+/// A rod on the ring lattice at the instant of impact, and the solver's
+/// numerical choices.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RodSetup {
+    /// The rod (axis along z, impact face at z = 0).
+    pub cylinder: Cylinder,
+    /// Rings across the radius (radial spacing `R0 / rings`).
+    pub rings: usize,
+    /// Speed toward the anvil (m/s).
+    pub impact_speed: f64,
+    /// Damping ratio ζ at `ω_max` of the stiffness-proportional damping.
+    pub damping: f64,
+    /// Safety factor on the stable step.
+    pub safety: f64,
+    /// Latest simulated time (s).
+    pub end_time: f64,
+    /// See [`REBUILD_STRAIN`].
+    pub rebuild_strain: f64,
+    /// α of the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
+    /// after each velocity update ([`SMOOTHING`]).
+    pub smoothing: f64,
+}
+
+impl RodSetup {
+    /// A rod with the default numerical choices ([`DAMPING`], [`SAFETY`],
+    /// [`REBUILD_STRAIN`]).
+    pub fn new(cylinder: Cylinder, rings: usize, impact_speed: f64, end_time: f64) -> Self {
+        RodSetup {
+            cylinder,
+            rings,
+            impact_speed,
+            damping: DAMPING,
+            safety: SAFETY,
+            end_time,
+            rebuild_strain: REBUILD_STRAIN,
+            smoothing: SMOOTHING,
+        }
+    }
+}
+
+/// What follows from the positions at the last build: supports, nodal
+/// shapes, test spheres and the traction operator. Rebuilt, never saved.
+#[derive(Debug, Clone, Default)]
+struct Geometry {
+    supports: Option<Supports>,
+    shapes: NodalShapes,
+    spheres: Vec<TestSphere>,
+    op: TractionOperator,
+}
+
+/// A 3-D MLPG run of a rod striking a rigid smooth anvil.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct Mlpg3d {
+    setup: RodSetup,
+    material: Material,
+    #[serde(skip)]
+    material_state: MaterialState,
+    /// The reference lattice (positions at impact, volumes, surfaces, sets).
+    lattice: NodeLattice,
+    // Node fields (structure of arrays).
+    pos: Vec<[f64; 3]>,
+    vel: Vec<[f64; 3]>,
+    mass: Vec<f64>,
+    rho: Vec<f64>,
+    dev: Vec<Full>,
+    pressure: Vec<f64>,
+    eps_p: Vec<f64>,
+    temp: Vec<f64>,
+    /// Viscous stress of the damping, from the last rate of deformation.
+    visc: Vec<Full>,
+    contact: Vec<bool>,
+    /// Positions the supports were computed from.
+    supports_at: Vec<[f64; 3]>,
+    /// Positions the operator was last built at.
+    built_at: Vec<[f64; 3]>,
+    #[serde(skip)]
+    geometry: Option<Geometry>,
+    // Bookkeeping.
+    time: f64,
+    steps: u64,
+    dt: f64,
+    dt0: f64,
+    /// Damping time `c = 2 ζ / ω_max` of the viscous stress (s).
+    damping_time: f64,
+    d_min0: f64,
+    min_spacing: f64,
+    initial_energy: f64,
+    internal_energy: f64,
+    plastic_work: f64,
+    damping_dissipation: f64,
+    contact_dissipation: f64,
+    smoothing_dissipation: f64,
+    rebuilds: u64,
+    at_rest: bool,
+    quiet_since: Option<f64>,
+    /// Time of the last release of a node from the anvil.
+    last_release: f64,
+}
+
+/// The sums of one step over the nodes.
+#[derive(Debug, Clone, Copy, Default)]
+struct Tally {
+    internal: f64,
+    plastic: f64,
+    damping: f64,
+    kinetic: f64,
+    momentum: f64,
+    mass: f64,
+    worst_speed: f64,
+}
+
+impl Mlpg3d {
+    /// The rod of `setup` of `material` at the instant of impact: every
+    /// node moving at `-impact_speed` along z, the face on the anvil.
+    pub fn new(setup: RodSetup, material: Material) -> Result<Self> {
+        material.validate()?;
+        let density = material.eos.reference_density().ok_or_else(|| {
+            Error::Inconsistent("the rod's equation of state has no reference density".into())
+        })?;
+        let lattice = NodeLattice::cylinder(setup.cylinder, setup.rings);
+        let n = lattice.len();
+        let pos = lattice.position.clone();
+        let mass: Vec<f64> = lattice.volume.iter().map(|v| density * v).collect();
+        let total: f64 = mass.iter().sum();
+        let v0 = setup.impact_speed;
+        let contact = lattice
+            .surfaces
+            .iter()
+            .map(|s| s.has(Surfaces::FACE))
+            .collect();
+        let mut s = Mlpg3d {
+            material,
+            material_state: MaterialState::default(),
+            vel: vec![[0.0, 0.0, -v0]; n],
+            mass,
+            rho: vec![density; n],
+            dev: vec![[0.0; 6]; n],
+            pressure: vec![0.0; n],
+            eps_p: vec![0.0; n],
+            temp: vec![material.reference_temperature; n],
+            visc: vec![[0.0; 6]; n],
+            contact,
+            supports_at: pos.clone(),
+            built_at: pos.clone(),
+            pos,
+            lattice,
+            geometry: None,
+            time: 0.0,
+            steps: 0,
+            dt: 0.0,
+            dt0: 0.0,
+            damping_time: 0.0,
+            d_min0: 0.0,
+            min_spacing: 1.0,
+            initial_energy: 0.5 * total * v0 * v0,
+            internal_energy: 0.0,
+            plastic_work: 0.0,
+            damping_dissipation: 0.0,
+            contact_dissipation: 0.0,
+            smoothing_dissipation: 0.0,
+            rebuilds: 0,
+            at_rest: false,
+            quiet_since: None,
+            last_release: 0.0,
+            setup,
+        };
+        s.build_geometry(true)?;
+        s.d_min0 = s.nearest_distance();
+        let cp = s.wave_speed();
+        check_derived("wave speed", cp, " m/s")?;
+        s.damping_time = 2.0 * setup.damping * s.d_min0 / (OMEGA_FACTOR * cp);
+        s.dt = s.stable_dt(cp, s.d_min0);
+        check_derived("time step", s.dt, " s")?;
+        s.dt0 = s.dt;
+        Ok(s)
+    }
+
+    /// The stable step of eq. (15) for the wave speed `c` and the smallest
+    /// node distance `d`, times the safety factor, shortened for the
+    /// damping: `(2 / ω_max)(√(1 + ζ²) − ζ)`.
+    fn stable_dt(&self, c: f64, d: f64) -> f64 {
+        let z = self.setup.damping;
+        stable_step(c, d, self.setup.safety) * ((1.0 + z * z).sqrt() - z)
+    }
+
+    /// Longitudinal elastic wave speed of the reference state (m/s).
+    pub fn wave_speed(&self) -> f64 {
+        let rho = self.rho0();
+        (self.material.longitudinal_modulus(rho, 0.0) / rho).sqrt()
+    }
+
+    fn rho0(&self) -> f64 {
+        self.material.eos.reference_density().unwrap_or(self.rho[0])
+    }
+
+    /// The smallest current distance between a node and one it names.
+    fn nearest_distance(&self) -> f64 {
+        let sup = self.supports();
+        (0..self.pos.len())
+            .into_par_iter()
+            .map(|i| {
+                sup.named
+                    .of(i)
+                    .iter()
+                    .map(|&j| distance(&self.pos[i], &self.pos[j]))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect::<Vec<f64>>()
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    fn supports(&self) -> &Supports {
+        self.geometry
+            .as_ref()
+            .and_then(|g| g.supports.as_ref())
+            .expect("the geometry is built before use")
+    }
+
+    /// Rebuilds the geometry at `built_at` (and the supports at
+    /// `supports_at` when `supports` is true or none exist).
+    fn build_geometry(&mut self, supports: bool) -> Result<()> {
+        let time = self.time;
+        let at_time = |e: Error| match e {
+            Error::SingularMomentMatrix {
+                method,
+                particle,
+                condition,
+                ..
+            } => Error::SingularMomentMatrix {
+                method,
+                particle,
+                time,
+                condition,
+            },
+            e => e,
+        };
+        let mut g = self.geometry.take().unwrap_or_default();
+        if supports || g.supports.is_none() {
+            g.supports = Some(Supports::compute(
+                &self.supports_at,
+                SupportParams::default(),
+            )?);
+        }
+        let sup = g.supports.as_ref().expect("computed above");
+        let pts = &self.built_at;
+        g.shapes = NodalShapes::build(pts, sup).map_err(at_time)?;
+        g.spheres = self.spheres(pts, sup, &g.shapes);
+        g.op = TractionOperator::build(
+            pts,
+            sup,
+            &g.spheres,
+            &SphereRule::of(DEFAULT_RULE),
+            &SphereRule::of(BOUNDARY_RULE),
+        )
+        .map_err(at_time)?;
+        self.geometry = Some(g);
+        self.rebuilds += 1;
+        Ok(())
+    }
+
+    /// The test spheres at the points `pts` (see the module docs: the
+    /// deformed free boundary).
+    fn spheres(&self, pts: &[[f64; 3]], sup: &Supports, shapes: &NodalShapes) -> Vec<TestSphere> {
+        let n = pts.len();
+        // F⁻¹ = ∂X/∂x at every node.
+        let mut finv = vec![[[0.0; 3]; 3]; n];
+        shapes.velocity_gradients(&self.lattice.position, &mut finv);
+        let surf = &self.lattice.surfaces;
+        let contact = &self.contact;
+        let reference = &self.lattice.position;
+        // Current outward normals of the boundary planes through each node:
+        // (mantle, face or top), zero when absent.
+        let normals: Vec<[[f64; 3]; 2]> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let s = surf[i];
+                let nanson = |big: [f64; 3]| -> [f64; 3] {
+                    let g = &finv[i];
+                    unit(std::array::from_fn(|b| {
+                        (0..3).map(|a| big[a] * g[a][b]).sum::<f64>()
+                    }))
+                };
+                let mut out = [[0.0; 3]; 2];
+                if s.has(Surfaces::MANTLE) {
+                    let x = reference[i];
+                    let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
+                    out[0] = nanson([x[0] / r, x[1] / r, 0.0]);
+                }
+                if s.has(Surfaces::FACE) {
+                    out[1] = if contact[i] {
+                        [0.0, 0.0, -1.0]
+                    } else {
+                        nanson([0.0, 0.0, -1.0])
+                    };
+                } else if s.has(Surfaces::TOP) {
+                    out[1] = nanson([0.0, 0.0, 1.0]);
+                }
+                out
+            })
+            .collect();
+        let nearest: Vec<f64> = (0..n)
+            .map(|i| {
+                sup.named
+                    .of(i)
+                    .iter()
+                    .map(|&j| distance(&pts[i], &pts[j]))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        // Distance of an interior node to the tangent planes of the
+        // boundary nodes it names (infinite when it names none).
+        let bdist: Vec<f64> = (0..n)
+            .map(|i| {
+                if !surf[i].interior() {
+                    return 0.0;
+                }
+                let mut b = f64::INFINITY;
+                for &j in sup.named.of(i) {
+                    for nu in &normals[j] {
+                        if *nu != [0.0; 3] {
+                            let d: f64 = (0..3).map(|a| (pts[j][a] - pts[i][a]) * nu[a]).sum();
+                            if d > 0.0 {
+                                b = b.min(d);
+                            }
+                        }
+                    }
+                }
+                b
+            })
+            .collect();
+        let radii = test_radii(&nearest, &bdist, ALPHA);
+        (0..n)
+            .map(|i| {
+                let s = surf[i];
+                if s.interior() {
+                    return TestSphere::whole(radii[i]);
+                }
+                let [nm, nf] = normals[i];
+                let mut cut = [0i8; 3];
+                // e3: the face's inward or the top's outward normal, else z.
+                let e3 = if s.has(Surfaces::FACE) {
+                    cut[2] = -1;
+                    nf.map(|x| -x)
+                } else if s.has(Surfaces::TOP) {
+                    cut[2] = 1;
+                    nf
+                } else {
+                    [0.0, 0.0, 1.0]
+                };
+                let e1 = if s.has(Surfaces::MANTLE) {
+                    cut[0] = 1;
+                    nm
+                } else {
+                    let p = pts[i];
+                    let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+                    if r > 0.0 {
+                        [p[0] / r, p[1] / r, 0.0]
+                    } else {
+                        [1.0, 0.0, 0.0]
+                    }
+                };
+                // Orthonormal frame: keep the plane that is not the mantle
+                // (face or top) when both cut; else keep e1.
+                let (e1, e3) = if cut[2] != 0 {
+                    (unit(reject(e1, e3)), e3)
+                } else {
+                    (e1, unit(reject(e3, e1)))
+                };
+                let e2 = cross(e3, e1);
+                TestSphere {
+                    radius: radii[i],
+                    frame: [e1, e2, e3],
+                    cut,
+                }
+            })
+            .collect()
+    }
+
+    /// Number of nodes.
+    pub fn particles(&self) -> usize {
+        self.pos.len()
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Current time step (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// Builds of the operator so far (the first included).
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+
+    /// The reference lattice.
+    pub fn lattice(&self) -> &NodeLattice {
+        &self.lattice
+    }
+
+    /// Node positions (m).
+    pub fn positions(&self) -> &[[f64; 3]] {
+        &self.pos
+    }
+
+    /// Node velocities (m/s).
+    pub fn velocities(&self) -> &[[f64; 3]] {
+        &self.vel
+    }
+
+    /// Node masses (kg).
+    pub fn masses(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Whether each node is pressed on the anvil.
+    pub fn in_contact(&self) -> &[bool] {
+        &self.contact
+    }
+
+    /// Time of the last release of a node from the anvil (s).
+    pub fn last_release(&self) -> f64 {
+        self.last_release
+    }
+
+    /// Whether the end condition holds: the rod is at rest or has left the
+    /// anvil, or `end_time` has been reached.
+    pub fn finished(&self) -> bool {
+        self.at_rest || self.time >= self.setup.end_time
+    }
+
+    /// Smallest distance between named neighbours relative to the initial
+    /// smallest, over the run so far.
+    pub fn min_spacing_ratio(&self) -> f64 {
+        self.min_spacing
+    }
+
+    /// The energies: kinetic, internal (stress work), plastic work, damping
+    /// and contact dissipation, and the relative energy error.
+    pub fn energies(&self) -> Energies {
+        let kinetic = kinetic(&self.vel, &self.mass);
+        Energies {
+            initial: self.initial_energy,
+            kinetic,
+            internal: self.internal_energy,
+            plastic_work: self.plastic_work,
+            damping: self.damping_dissipation,
+            contact: self.contact_dissipation,
+            smoothing: self.smoothing_dissipation,
+            error: self.energy_error_with(kinetic),
+        }
+    }
+
+    fn energy_error_with(&self, kinetic: f64) -> f64 {
+        (kinetic
+            + self.internal_energy
+            + self.damping_dissipation
+            + self.contact_dissipation
+            + self.smoothing_dissipation
+            - self.initial_energy)
+            .abs()
+            / self.initial_energy
+    }
+
+    /// One step (see the module docs).
+    pub fn step(&mut self) -> Result<()> {
+        if self.geometry.is_none() {
+            let fresh = self.supports_at == self.built_at;
+            self.build_geometry(fresh)?;
+            self.rebuilds -= 1;
+        }
+        let n = self.particles();
+        let dt = self.dt;
+        self.material_state.fit(n);
+        // 1. Forces from σ^n and the viscous stress.
+        let total: Vec<[f64; 6]> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let (d, p, v) = (self.dev[i], self.pressure[i], self.visc[i]);
+                [
+                    d[0] - p + v[0],
+                    d[1] - p + v[1],
+                    d[2] - p + v[2],
+                    d[3] + v[3],
+                    d[4] + v[4],
+                    d[5] + v[5],
+                ]
+            })
+            .collect();
+        let g = self.geometry.as_ref().expect("built above");
+        let mut force = vec![[0.0; 3]; n];
+        g.op.apply(&total, &mut force);
+        // 2-3. Velocities, contact, positions.
+        let d0 = self.d_min0;
+        let (volume, rho, mass) = (&g.op.volume, &self.rho, &self.mass);
+        let kicked: Vec<(f64, bool)> = self
+            .vel
+            .par_iter_mut()
+            .zip(self.contact.par_iter_mut())
+            .enumerate()
+            .map(|(i, (v, touch))| {
+                let f = force[i];
+                let inertia = rho[i] * volume[i];
+                // A node held on the anvil loses the speed it had toward it
+                // (only at impact: afterwards it is zero); the anvil's
+                // reaction on a node at rest does no work.
+                let held = if *touch {
+                    0.5 * mass[i] * v[2] * v[2]
+                } else {
+                    0.0
+                };
+                for d in 0..3 {
+                    v[d] += dt * f[d] / inertia;
+                }
+                let mut released = false;
+                if *touch {
+                    if f[2] > 0.0 {
+                        *touch = false;
+                        released = true;
+                    } else {
+                        v[2] = 0.0;
+                    }
+                }
+                (held, released)
+            })
+            .collect();
+        // Velocity smoothing toward the MLS approximation at the node.
+        let alpha = self.setup.smoothing;
+        if alpha > 0.0 {
+            let shapes = &g.shapes;
+            let vel = &self.vel;
+            let smooth: Vec<[f64; 3]> = (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let mut m = [0.0; 3];
+                    for q in shapes.row(i) {
+                        let vj = vel[shapes.nodes[q]];
+                        for d in 0..3 {
+                            m[d] += shapes.phi[q] * vj[d];
+                        }
+                    }
+                    let mut v: [f64; 3] =
+                        std::array::from_fn(|d| vel[i][d] + alpha * (m[d] - vel[i][d]));
+                    if self.contact[i] {
+                        v[2] = 0.0;
+                    }
+                    v
+                })
+                .collect();
+            let before = kinetic(&self.vel, mass);
+            self.vel = smooth;
+            self.smoothing_dissipation += before - kinetic(&self.vel, mass);
+        }
+        let moved: Vec<(f64, f64, bool, Option<f64>)> = self
+            .vel
+            .par_iter_mut()
+            .zip(self.pos.par_iter_mut())
+            .zip(self.contact.par_iter_mut())
+            .zip(kicked.par_iter())
+            .enumerate()
+            .map(|(i, (((v, x), touch), &(held, released)))| {
+                let mut through = None;
+                for d in 0..3 {
+                    x[d] += dt * v[d];
+                }
+                let mut lost = 0.0;
+                if !*touch && x[2] < 0.0 {
+                    if x[2] < -0.5 * d0 {
+                        through = Some(x[2]);
+                    }
+                    x[2] = 0.0;
+                    lost = 0.5 * mass[i] * v[2] * v[2];
+                    v[2] = 0.0;
+                    *touch = true;
+                }
+                (held, lost, released, through)
+            })
+            .collect();
+        self.time += dt;
+        self.steps += 1;
+        for (i, &(held, lost, released, through)) in moved.iter().enumerate() {
+            self.contact_dissipation += held + lost;
+            if released {
+                self.last_release = self.time;
+            }
+            if let Some(z) = through {
+                return Err(Error::ThroughBoundary {
+                    particle: i,
+                    boundary: "anvil",
+                    time: self.time,
+                    position: z,
+                });
+            }
+        }
+        // 4. The geometry follows the body.
+        let d_min = self.nearest_distance();
+        let ratio = d_min / self.d_min0;
+        self.min_spacing = self.min_spacing.min(ratio);
+        if ratio < SPACING_COLLAPSE_BOUND {
+            return Err(Error::SpacingCollapse {
+                ratio,
+                bound: SPACING_COLLAPSE_BOUND,
+                time: self.time,
+                hint: "",
+            });
+        }
+        if self.supports().recompute_reason(&self.pos).is_some() {
+            self.supports_at.clone_from(&self.pos);
+            self.built_at.clone_from(&self.pos);
+            self.build_geometry(true)?;
+        } else if self.strain_since_build() > self.setup.rebuild_strain {
+            self.built_at.clone_from(&self.pos);
+            self.build_geometry(false)?;
+        }
+        // 5. Velocity gradients and the material.
+        let g = self.geometry.as_ref().expect("built above");
+        let mut grad = vec![[[0.0; 3]; 3]; n];
+        g.shapes.velocity_gradients(&self.vel, &mut grad);
+        let material = self.material;
+        let c = self.damping_time;
+        let (mass, vel) = (&self.mass, &self.vel);
+        let results: Vec<std::result::Result<Tally, (usize, Error)>> = self
+            .dev
+            .par_iter_mut()
+            .zip(self.pressure.par_iter_mut())
+            .zip(self.eps_p.par_iter_mut())
+            .zip(self.temp.par_iter_mut())
+            .zip(self.rho.par_iter_mut())
+            .zip(self.visc.par_iter_mut())
+            .zip(self.material_state.points_mut().par_iter_mut())
+            .enumerate()
+            .map(|(i, ((((((dev, p), eps), temp), rho), visc), state))| {
+                let l = &grad[i];
+                let d = |a: usize, b: usize| 0.5 * (l[a][b] + l[b][a]);
+                let w = |a: usize, b: usize| 0.5 * (l[a][b] - l[b][a]);
+                let rate: Full = [d(0, 0), d(1, 1), d(2, 2), d(0, 1), d(1, 2), d(2, 0)];
+                let tr = rate[0] + rate[1] + rate[2];
+                let rho_new = *rho * (1.0 - dt * tr);
+                let load = Loading {
+                    dt,
+                    rate,
+                    spin: [w(0, 1), w(1, 2), w(2, 0)],
+                    density: rho_new,
+                };
+                let before = Point {
+                    deviator: *dev,
+                    pressure: *p,
+                    plastic_strain: *eps,
+                    temperature: *temp,
+                };
+                let new = material.update(&load, &before, state).map_err(|l| {
+                    (
+                        i,
+                        Error::CompressionLimit {
+                            particle: i,
+                            time: 0.0,
+                            compression: l.compression,
+                            limit: l.limit,
+                        },
+                    )
+                })?;
+                let stress =
+                    |s: &Full, p: f64| -> Full { [s[0] - p, s[1] - p, s[2] - p, s[3], s[4], s[5]] };
+                let mid: Full = {
+                    let (a, b) = (stress(dev, *p), stress(&new.deviator, new.pressure));
+                    std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
+                };
+                let volume = mass[i] / rho_new;
+                let bulk = material.eos.bulk_modulus(rho_new, new.pressure);
+                let mu = material.shear_modulus;
+                let v: Full = std::array::from_fn(|k| {
+                    let dev_rate = if k < 3 { rate[k] - tr / 3.0 } else { rate[k] };
+                    let vol = if k < 3 { bulk * tr } else { 0.0 };
+                    c * (vol + 2.0 * mu * dev_rate)
+                });
+                let t = Tally {
+                    internal: dt * volume * mid.double_dot(&rate),
+                    plastic: volume * new.deviator.von_mises() * (new.plastic_strain - *eps),
+                    damping: dt * volume * v.double_dot(&rate),
+                    kinetic: kinetic1(vel[i], mass[i]),
+                    momentum: mass[i] * vel[i][2],
+                    mass: mass[i],
+                    worst_speed: (material.longitudinal_modulus(rho_new, new.pressure) / rho_new)
+                        .sqrt()
+                        + norm(vel[i]),
+                };
+                *dev = new.deviator;
+                *p = new.pressure;
+                *eps = new.plastic_strain;
+                *temp = new.temperature;
+                *rho = rho_new;
+                *visc = v;
+                let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+                let bad = if !finite(&vel[i]) {
+                    Some("velocity")
+                } else if !rho_new.is_finite() {
+                    Some("density")
+                } else if !finite(dev) || !p.is_finite() {
+                    Some("stress")
+                } else if !temp.is_finite() {
+                    Some("temperature")
+                } else {
+                    None
+                };
+                if let Some(field) = bad {
+                    return Err((
+                        i,
+                        Error::NonFinite {
+                            field,
+                            particle: i,
+                            time: 0.0,
+                        },
+                    ));
+                }
+                Ok(t)
+            })
+            .collect();
+        let mut t = Tally::default();
+        for r in results {
+            let s = r.map_err(|(_, e)| with_time(e, self.time))?;
+            t.internal += s.internal;
+            t.plastic += s.plastic;
+            t.damping += s.damping;
+            t.kinetic += s.kinetic;
+            t.momentum += s.momentum;
+            t.mass += s.mass;
+            t.worst_speed = t.worst_speed.max(s.worst_speed);
+        }
+        self.internal_energy += t.internal;
+        self.plastic_work += t.plastic;
+        self.damping_dissipation += t.damping;
+        // 6. Checks and the next step.
+        if let Some(i) = self
+            .pos
+            .iter()
+            .position(|x| !x.iter().all(|v| v.is_finite()))
+        {
+            return Err(Error::NonFinite {
+                field: "position",
+                particle: i,
+                time: self.time,
+            });
+        }
+        let e = self.energy_error_with(t.kinetic);
+        if e > ENERGY_ERROR_BOUND {
+            return Err(Error::EnergyDrift {
+                error: e,
+                bound: ENERGY_ERROR_BOUND,
+                time: self.time,
+            });
+        }
+        self.dt = self.stable_dt(t.worst_speed, d_min);
+        check_time_step(self.dt, self.dt0, self.time)?;
+        let touching = self.contact.iter().any(|&c| c);
+        if -t.momentum / t.mass <= 0.0 && !touching {
+            self.at_rest = true;
+        }
+        if t.kinetic <= QUIET_FRACTION * self.initial_energy {
+            let since = *self.quiet_since.get_or_insert(self.time);
+            let window = QUIET_TRANSITS * self.setup.cylinder.length / self.wave_speed();
+            if self.time - since >= window {
+                self.at_rest = true;
+            }
+        } else {
+            self.quiet_since = None;
+        }
+        Ok(())
+    }
+
+    /// The largest relative motion of a named pair since the last build.
+    fn strain_since_build(&self) -> f64 {
+        let sup = self.supports();
+        let (x, b) = (&self.pos, &self.built_at);
+        (0..x.len())
+            .into_par_iter()
+            .map(|i| {
+                sup.named
+                    .of(i)
+                    .iter()
+                    .map(|&j| {
+                        let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
+                        let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
+                        norm(std::array::from_fn(|d| now[d] - then[d])) / norm(then)
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .collect::<Vec<f64>>()
+            .into_iter()
+            .fold(0.0, f64::max)
+    }
+
+    /// The rod observables of the current state.
+    pub fn rod(&self) -> RodObservables {
+        RodObservables::of::<3>(
+            &self.lattice.sets,
+            &self.pos,
+            &self.vel,
+            self.setup.cylinder.radius,
+        )
+    }
+
+    /// `(max − min) / mean` of the distance from the axis of the face's
+    /// outer ring (the nodes on both the face and the mantle).
+    pub fn mushroom_radius_spread(&self) -> f64 {
+        let (mut lo, mut hi, mut sum, mut k) = (f64::INFINITY, 0.0f64, 0.0, 0usize);
+        for &i in &self.lattice.sets.face {
+            if self.lattice.surfaces[i].has(Surfaces::MANTLE) {
+                let r = radius(&self.pos[i]);
+                lo = lo.min(r);
+                hi = hi.max(r);
+                sum += r;
+                k += 1;
+            }
+        }
+        (hi - lo) / (sum / k as f64)
+    }
+
+    /// Height of the centre of the impact face above the anvil (m).
+    pub fn face_lift(&self) -> f64 {
+        self.pos[0][2]
+    }
+
+    /// Largest effective plastic strain.
+    pub fn max_plastic_strain(&self) -> f64 {
+        self.eps_p.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// Highest temperature (K).
+    pub fn max_temperature(&self) -> f64 {
+        self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Whether the rod has stopped or left the anvil.
+    pub fn at_rest(&self) -> bool {
+        self.at_rest
+    }
+
+    /// The node stresses `σ = S − p I` (Pa), `[xx, yy, zz, xy, yz, zx]`.
+    pub fn stress(&self) -> Vec<Full> {
+        self.dev
+            .iter()
+            .zip(&self.pressure)
+            .map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3], d[4], d[5]])
+            .collect()
+    }
+
+    /// Density (kg/m³), pressure (Pa), plastic strain and temperature (K)
+    /// of every node.
+    pub fn scalars(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
+        (&self.rho, &self.pressure, &self.eps_p, &self.temp)
+    }
+
+    /// The setup of this run.
+    pub fn setup(&self) -> &RodSetup {
+        &self.setup
+    }
+
+    /// The material of the rod.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+}
+
+/// The energies of a run (J) and its relative energy error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Energies {
+    /// Kinetic energy at impact.
+    pub initial: f64,
+    /// Kinetic energy now.
+    pub kinetic: f64,
+    /// Stress work of the material (elastic plus plastic).
+    pub internal: f64,
+    /// The plastic part of `internal` (flow stress times plastic strain).
+    pub plastic_work: f64,
+    /// Work of the damping's viscous stress.
+    pub damping: f64,
+    /// Kinetic energy removed by the anvil when it stops nodes.
+    pub contact: f64,
+    /// Kinetic energy removed by the velocity smoothing.
+    pub smoothing: f64,
+    /// `|kinetic + internal + damping + contact + smoothing − initial| / initial`.
+    pub error: f64,
+}
+
+fn with_time(e: Error, time: f64) -> Error {
+    match e {
+        Error::NonFinite {
+            field, particle, ..
+        } => Error::NonFinite {
+            field,
+            particle,
+            time,
+        },
+        Error::CompressionLimit {
+            particle,
+            compression,
+            limit,
+            ..
+        } => Error::CompressionLimit {
+            particle,
+            time,
+            compression,
+            limit,
+        },
+        e => e,
+    }
+}
+
+fn kinetic1(v: [f64; 3], m: f64) -> f64 {
+    0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+}
+
+fn kinetic(v: &[[f64; 3]], m: &[f64]) -> f64 {
+    v.iter().zip(m).map(|(v, m)| kinetic1(*v, *m)).sum()
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let l = norm(a);
+    a.map(|x| x / l)
+}
+
+/// `a` without its component along the unit vector `u`.
+fn reject(a: [f64; 3], u: [f64; 3]) -> [f64; 3] {
+    let d = a[0] * u[0] + a[1] * u[1] + a[2] * u[2];
+    std::array::from_fn(|k| a[k] - d * u[k])
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The node fields of the 3-D solver.
+pub const MLPG_FIELDS: &[FieldSpec] = &[
+    FieldSpec {
+        name: "position",
+        unit: "m",
+        components: &["x", "y", "z"],
+    },
+    FieldSpec {
+        name: "density",
+        unit: "kg/m3",
+        components: &["rho"],
+    },
+    FieldSpec {
+        name: "velocity",
+        unit: "m/s",
+        components: &["x", "y", "z"],
+    },
+    FieldSpec {
+        name: "pressure",
+        unit: "Pa",
+        components: &["P"],
+    },
+    FieldSpec {
+        name: "stress",
+        unit: "Pa",
+        components: &["xx", "yy", "zz", "xy", "yz", "zx"],
+    },
+    FieldSpec {
+        name: "plastic_strain",
+        unit: "1",
+        components: &["eps_p"],
+    },
+    FieldSpec {
+        name: "temperature",
+        unit: "K",
+        components: &["T"],
+    },
+    FieldSpec {
+        name: "in_contact",
+        unit: "bool",
+        components: &["contact"],
+    },
+];
+
+impl Mlpg3d {
+    /// Current values of [`TAYLOR3D_OBSERVABLES`], in that order.
+    pub fn observables(&self) -> Vec<f64> {
+        let rod = self.rod();
+        let e = self.energies();
+        let values = [
+            rod.rod_length,
+            rod.mushroom_radius,
+            rod.undeformed_length,
+            rod.tail_velocity,
+            self.face_lift(),
+            self.max_plastic_strain(),
+            self.max_temperature(),
+            e.kinetic,
+            e.internal,
+            e.smoothing,
+            e.contact,
+            e.error,
+            if self.at_rest { 1.0 } else { 0.0 },
+            self.mushroom_radius_spread(),
+            e.damping,
+            e.plastic_work,
+        ];
+        debug_assert_eq!(values.len(), TAYLOR3D_OBSERVABLES.len());
+        values.to_vec()
+    }
+
+    /// The values of the node field `name` (one of [`MLPG_FIELDS`]),
+    /// interleaved per node.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        Some(match name {
+            "position" => self.pos.iter().flatten().copied().collect(),
+            "density" => self.rho.clone(),
+            "velocity" => self.vel.iter().flatten().copied().collect(),
+            "pressure" => self.pressure.clone(),
+            "stress" => self.stress().into_iter().flatten().collect(),
+            "plastic_strain" => self.eps_p.clone(),
+            "temperature" => self.temp.clone(),
+            "in_contact" => self.contact.iter().map(|&c| c as u8 as f64).collect(),
+            _ => return None,
+        })
+    }
+
+    /// Checks a restored run against `fresh`, a new run of the same
+    /// parameters: what follows from them (setup, material, lattice, masses,
+    /// first step, damping time, impact energy) must be the same bits, and
+    /// every node field must have one finite value per node.
+    pub(crate) fn check_restored(&self, fresh: &Mlpg3d) -> std::result::Result<(), String> {
+        use crate::solver::axisymmetric::json;
+        let fixed = |s: &Mlpg3d| {
+            json(&(
+                &s.setup,
+                &s.material,
+                &s.lattice,
+                &s.mass,
+                s.dt0,
+                s.d_min0,
+                s.damping_time,
+                s.initial_energy,
+            ))
+        };
+        if fixed(self) != fixed(fresh) {
+            return Err("its lattice, masses or material do not follow from its parameters".into());
+        }
+        let n = fresh.particles();
+        let vectors = [
+            ("positions", &self.pos),
+            ("velocities", &self.vel),
+            ("support positions", &self.supports_at),
+            ("build positions", &self.built_at),
+        ];
+        for (what, f) in vectors {
+            if f.len() != n || !f.iter().flatten().all(|x| x.is_finite()) {
+                return Err(format!("its {what} are not {n} finite vectors"));
+            }
+        }
+        let tensors = [("deviators", &self.dev), ("viscous stresses", &self.visc)];
+        for (what, f) in tensors {
+            if f.len() != n || !f.iter().flatten().all(|x| x.is_finite()) {
+                return Err(format!("its {what} are not {n} finite tensors"));
+            }
+        }
+        let scalars = [
+            ("densities", &self.rho),
+            ("pressures", &self.pressure),
+            ("plastic strains", &self.eps_p),
+            ("temperatures", &self.temp),
+        ];
+        for (what, f) in scalars {
+            if f.len() != n || !f.iter().all(|x| x.is_finite()) {
+                return Err(format!("its {what} are not {n} finite values"));
+            }
+        }
+        if self.contact.len() != n {
+            return Err(format!("its contact flags are not {n}"));
+        }
+        let clock = [self.time, self.dt];
+        if !clock.iter().all(|x| x.is_finite() && *x >= 0.0) || self.dt <= 0.0 {
+            return Err("its clock is not a finite time and a positive step".into());
+        }
+        Ok(())
+    }
+}
+
+impl crate::model::Model for Mlpg3d {
+    crate::model::inherent_basics!();
+    fn field_specs(&self) -> &'static [FieldSpec] {
+        MLPG_FIELDS
+    }
+    /// 64 records per elastic transit of the rod.
+    fn record_interval(&self) -> f64 {
+        self.setup.cylinder.length / self.wave_speed() / 64.0
+    }
+    fn min_spacing_ratio(&self) -> Option<f64> {
+        Some(self.min_spacing_ratio())
+    }
+    fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
+        self.check_restored(crate::model::same_solver(fresh)?)
+    }
+}

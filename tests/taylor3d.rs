@@ -1,0 +1,67 @@
+//! House et al. test 7 in 3-D (`taylor3d`, MLPG mixed method) against the
+//! experiment (Lf = 34.6 mm, Df = 9.5 mm) and the axisymmetric MSPH solver,
+//! run through the scene registry and `Simulation`.
+
+mod common;
+
+use common::{pct, run};
+use meshless_impact::Scene;
+
+/// The issue's bounds on test 7 in 3-D: the final length within 2 % of the
+/// experiment, the face diameter within 8 %, the face's spread around the
+/// axis below 2 %, the energy error below 5 %, the rod at rest.
+fn check(particles_radial: f64) -> f64 {
+    let sim = run(
+        Scene::builtin("taylor3d").unwrap(),
+        &[("particles_radial", particles_radial)],
+    );
+    let o = |name: &str| sim.observable(name).unwrap();
+    let (lf, rf) = (o("rod_length"), o("mushroom_radius"));
+    println!(
+        "{} nodes: Lf {:.3} mm ({:+.2} %), Df {:.3} mm ({:+.2} %), spread {:.2e}, energy error {:.2e}, \
+         smoothing dissipation {:.2} J",
+        sim.particles(),
+        lf * 1e3,
+        pct(lf, 34.6e-3),
+        2e3 * rf,
+        pct(2.0 * rf, 9.5e-3),
+        o("mushroom_radius_spread"),
+        o("energy_error"),
+        o("smoothing_dissipation"),
+    );
+    assert_eq!(o("at_rest"), 1.0, "the rod came to rest");
+    assert!(pct(lf, 34.6e-3).abs() < 2.0, "Lf {lf}");
+    assert!(pct(2.0 * rf, 9.5e-3).abs() < 8.0, "Df {}", 2.0 * rf);
+    assert!(o("mushroom_radius_spread") < 0.02);
+    assert!(o("energy_error") < 0.05);
+    lf
+}
+
+/// 6 nodes across the radius (4641 nodes, about 20 s on two cores):
+/// measured Lf 34.62 mm (+0.05 %), Df 10.22 mm (+7.6 %), spread 0.31 %,
+/// energy error 1.4 %.
+#[test]
+fn test7_in_3d_coarse() {
+    check(6.0);
+}
+
+/// 11 nodes across (10 rings, 33431 nodes; 358 s wall on two shared cores,
+/// `scripts/validate.sh`): measured Lf 34.57 mm (−0.08 %), Df 10.34 mm
+/// (+8.8 %: outside the 8 %, so this test fails on Df), spread 0.14 %,
+/// energy error 0.85 %; the axisymmetric solver at the matched spacing
+/// (`particles_radial` = 11) gives 34.84 mm, 0.76 % longer (within 1 %).
+#[test]
+#[ignore = "heavy: 6 minutes; scripts/validate.sh"]
+fn test7_in_3d_at_11_across() {
+    let lf = check(11.0);
+    let msph = run(
+        Scene::builtin("taylor").unwrap(),
+        &[("particles_radial", 11.0)],
+    );
+    let l2 = msph.observable("rod_length").unwrap();
+    println!("axisymmetric at the matched spacing: {:.3} mm", l2 * 1e3);
+    assert!(
+        pct(lf, l2).abs() < 1.0,
+        "3-D {lf} against axisymmetric {l2}"
+    );
+}
