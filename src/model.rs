@@ -55,6 +55,15 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// observable table.
     fn observables(&self) -> Vec<f64>;
 
+    /// The current value of the `k`-th observable of the table alone, or
+    /// `None` past the table; the bits of `observables()[k]`. A solver
+    /// whose observables cost a pass over the particles each answers this
+    /// without computing the others (an FMU output read, `mi_sim_observable`);
+    /// by default it computes them all.
+    fn observable(&self, k: usize) -> Option<f64> {
+        self.observables().get(k).copied()
+    }
+
     /// The particle fields this run offers, `position` first.
     fn field_specs(&self) -> &'static [FieldSpec];
 

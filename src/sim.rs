@@ -9,6 +9,7 @@ use crate::model::Model;
 use crate::observe::{FieldSpec, History, ObservableSpec, Snapshot};
 use crate::scene::{Scene, SceneKind};
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// Progress of a run, passed to the callback of [`Simulation::run_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,6 +31,28 @@ pub struct Simulation {
     record_interval: f64,
     next_record: f64,
     error: Option<Error>,
+    observed: Observed,
+}
+
+/// The observables of the current step, each computed when first read and
+/// kept until the next step: a host that reads every output after every
+/// communication step costs one evaluation of each (none after a step that
+/// recorded the histories), and a read of one computes that one.
+#[derive(Debug, Clone)]
+struct Observed(Vec<OnceLock<f64>>);
+
+impl Observed {
+    /// Nothing computed yet, for a scene of `kind`.
+    fn new(kind: SceneKind) -> Self {
+        Observed(vec![OnceLock::new(); kind.observable_specs().len()])
+    }
+
+    /// Forgets every value (the run has stepped).
+    fn clear(&mut self) {
+        for cell in &mut self.0 {
+            cell.take();
+        }
+    }
 }
 
 impl Clone for Simulation {
@@ -41,6 +64,7 @@ impl Clone for Simulation {
             record_interval: self.record_interval,
             next_record: self.next_record,
             error: self.error.clone(),
+            observed: self.observed.clone(),
         }
     }
 }
@@ -102,6 +126,7 @@ impl<'de> serde::Deserialize<'de> for Simulation {
             _ => return Err(D::Error::custom("its solver is not its scene's")),
         };
         Ok(Simulation {
+            observed: Observed::new(kind),
             scene: saved.scene,
             solver,
             history: saved.history,
@@ -121,6 +146,7 @@ impl Simulation {
         crate::solver::check_derived("record interval", record_interval, "")?;
         let mut sim = Simulation {
             history: History::new(scene.kind().observable_specs()),
+            observed: Observed::new(scene.kind()),
             scene,
             solver,
             record_interval,
@@ -199,7 +225,16 @@ impl Simulation {
 
     /// Current values of the observables, in [`Simulation::observable_specs`] order.
     pub fn observables(&self) -> Vec<f64> {
-        self.solver.observables()
+        let cells = &self.observed.0;
+        if let Some(values) = cells.iter().map(|c| c.get().copied()).collect() {
+            return values;
+        }
+        let values = self.solver.observables();
+        for (cell, v) in cells.iter().zip(&values) {
+            // The same bits as a value computed alone.
+            let _ = cell.set(*v);
+        }
+        values
     }
 
     /// Current value of one observable.
@@ -208,7 +243,19 @@ impl Simulation {
             .observable_specs()
             .iter()
             .position(|s| s.name == name)?;
-        Some(self.observables()[k])
+        self.observable_at(k)
+    }
+
+    /// Current value of the `k`-th observable (`None` past the table). Only
+    /// that one is computed ([`Model::observable`]), at most once per step:
+    /// the bits of `observables()[k]`.
+    pub fn observable_at(&self, k: usize) -> Option<f64> {
+        let cell = self.observed.0.get(k)?;
+        if let Some(v) = cell.get() {
+            return Some(*v);
+        }
+        let v = self.solver.observable(k)?;
+        Some(*cell.get_or_init(|| v))
     }
 
     /// The particle fields of this run, `position` first.
@@ -247,7 +294,9 @@ impl Simulation {
         if let Some(e) = &self.error {
             return Err(e.clone());
         }
-        if let Err(e) = self.solver.step() {
+        let stepped = self.solver.step();
+        self.observed.clear();
+        if let Err(e) = stepped {
             self.record();
             self.error = Some(e.clone());
             return Err(e);
@@ -350,5 +399,153 @@ impl Simulation {
             Some(e) => Err(e.clone()),
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::{Arc, Mutex};
+
+    /// A Taylor run that notes which observables it is asked for: `Some(k)`
+    /// for one, `None` for all.
+    #[derive(Debug, Clone, serde::Serialize)]
+    struct Counting {
+        inner: crate::solver::axisymmetric::TaylorSolver,
+        #[serde(skip)]
+        asked: Arc<Mutex<Vec<Option<usize>>>>,
+    }
+
+    impl Model for Counting {
+        fn time(&self) -> f64 {
+            self.inner.time()
+        }
+        fn steps(&self) -> u64 {
+            self.inner.steps()
+        }
+        fn particles(&self) -> usize {
+            self.inner.particles()
+        }
+        fn finished(&self) -> bool {
+            self.inner.finished()
+        }
+        fn step(&mut self) -> Result<()> {
+            self.inner.step()
+        }
+        fn observables(&self) -> Vec<f64> {
+            self.asked.lock().unwrap().push(None);
+            self.inner.observables()
+        }
+        fn observable(&self, k: usize) -> Option<f64> {
+            self.asked.lock().unwrap().push(Some(k));
+            self.inner.observable(k)
+        }
+        fn field_specs(&self) -> &'static [FieldSpec] {
+            Model::field_specs(&self.inner)
+        }
+        fn field(&self, name: &str) -> Option<Vec<f64>> {
+            self.inner.field(name)
+        }
+        fn record_interval(&self) -> f64 {
+            Model::record_interval(&self.inner)
+        }
+        fn check_restored(&self, fresh: &dyn Model) -> std::result::Result<(), String> {
+            Model::check_restored(&self.inner, fresh)
+        }
+    }
+
+    /// A coarse Taylor run (4 particles across) whose solver counts.
+    fn counting() -> (Simulation, Arc<Mutex<Vec<Option<usize>>>>) {
+        let mut scene = Scene::builtin("taylor").unwrap();
+        scene.set("particles_radial", 4.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        let asked = Arc::new(Mutex::new(Vec::new()));
+        let inner = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
+            sim.solver.as_ref(),
+        )
+        .unwrap()
+        .clone();
+        sim.solver = Box::new(Counting {
+            inner,
+            asked: Arc::clone(&asked),
+        });
+        (sim, asked)
+    }
+
+    #[test]
+    fn a_read_of_one_observable_computes_that_one_once_per_step() {
+        let (mut sim, asked) = counting();
+        let n = sim.observable_specs().len();
+        // At this resolution every step records the histories (and so
+        // computes the whole set); forget it, as a step between two records
+        // does.
+        sim.step().unwrap();
+        sim.observed.clear();
+        asked.lock().unwrap().clear();
+        let tail = sim.observable_at(3).unwrap();
+        assert_eq!(*asked.lock().unwrap(), [Some(3)], "one asked, alone");
+        assert_eq!(sim.observable("tail_velocity"), Some(tail));
+        assert_eq!(sim.observable_at(3), Some(tail));
+        assert_eq!(*asked.lock().unwrap(), [Some(3)], "then kept");
+        assert_eq!(sim.observable_at(n), None);
+        // Every value read alone has the bits of the whole set; with all of
+        // them known, the set asks the solver for nothing.
+        let alone: Vec<u64> = (0..n)
+            .map(|k| sim.observable_at(k).unwrap().to_bits())
+            .collect();
+        // Each asked once: 3 before, the others now.
+        let asked_alone: Vec<Option<usize>> = std::iter::once(3)
+            .chain((0..n).filter(|&k| k != 3))
+            .map(Some)
+            .collect();
+        assert_eq!(*asked.lock().unwrap(), asked_alone, "each once");
+        let all: Vec<u64> = sim.observables().iter().map(|x| x.to_bits()).collect();
+        assert_eq!(alone, all);
+        assert_eq!(*asked.lock().unwrap(), asked_alone, "all known: none asked");
+        // The next step forgets them (and computes the set to record it).
+        sim.step().unwrap();
+        asked.lock().unwrap().clear();
+        sim.observed.clear();
+        let fresh: Vec<u64> = sim.observables().iter().map(|x| x.to_bits()).collect();
+        assert_ne!(fresh, all, "the rod moved");
+        assert_eq!(*asked.lock().unwrap(), [None]);
+        for k in 0..n {
+            assert_eq!(sim.observable_at(k).unwrap().to_bits(), fresh[k]);
+        }
+        assert_eq!(asked.lock().unwrap().len(), 1, "kept from the set");
+    }
+
+    /// Along a run, each Taylor observable computed alone has the bits of
+    /// the set computed together, and every row of the table has one.
+    #[test]
+    fn taylor_observables_alone_have_the_bits_of_the_set() {
+        let mut scene = Scene::builtin("taylor").unwrap();
+        scene.set("particles_radial", 5.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        let solver = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
+            sim.solver.as_ref(),
+        )
+        .unwrap();
+        let n = crate::TAYLOR_OBSERVABLES.len();
+        assert_eq!(solver.observable(n), None);
+        for t in [0.0, 2e-6, 8e-6, 30e-6] {
+            sim.advance_to(t).unwrap();
+            let solver = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
+                sim.solver.as_ref(),
+            )
+            .unwrap();
+            let all = solver.observables();
+            assert_eq!(all.len(), n);
+            for (k, v) in all.iter().enumerate() {
+                let one = solver.observable(k).unwrap();
+                assert_eq!(
+                    one.to_bits(),
+                    v.to_bits(),
+                    "{} at {t}",
+                    crate::TAYLOR_OBSERVABLES[k].name
+                );
+            }
+        }
+        assert!(sim.observable("max_plastic_strain").unwrap() > 0.0);
     }
 }

@@ -165,7 +165,10 @@ pub unsafe extern "C" fn mi_sim_observable(
         let n = unsafe { text(name, "name") }?;
         need_out(value, "value")?;
         let k = observable_index(s, n)?;
-        let v = s.sim()?.observables()[k];
+        let v = s
+            .sim()?
+            .observable_at(k)
+            .expect("an observable of the table");
         // SAFETY: forwarded contract on `value`.
         unsafe { put(value, v, "value") }
     })

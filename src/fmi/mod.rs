@@ -667,7 +667,10 @@ impl Instance {
                 .expect("the table and the scene agree")),
             VarKind::Output(k, _) => {
                 self.ensure_sim()?;
-                Ok(self.sim.as_ref().expect("built above").observables()[k])
+                let sim = self.sim.as_ref().expect("built above");
+                Ok(sim
+                    .observable_at(k)
+                    .expect("an output of the scene's table"))
             }
         }
     }
@@ -793,21 +796,24 @@ impl Instance {
             let msg = format!("{function}: the solver stopped: {e}");
             return Err(self.fail(&msg));
         }
+        let sim = self.sim.as_ref().expect("built at initialization");
         let sim_time = self.start_time + sim.time();
         let steps = sim.steps();
-        // The scene's first observable (for a rod, its length).
-        let first = &sim.observable_specs()[0];
-        let value = sim.observables()[0];
         let finished = sim.finished();
-        let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
-        self.log(
-            Status::Ok,
-            CAT_PROGRESS,
-            &format!(
-                "t = {sim_time:.6e} s, {steps} steps, {} = {value:.6e} {}",
-                first.name, first.unit
-            ),
-        );
+        if self.categories[CAT_PROGRESS] {
+            // The scene's first observable (for a rod, its length), computed
+            // only for a host that listens.
+            let first = &sim.observable_specs()[0];
+            let value = sim.observable_at(0).expect("every scene has observables");
+            self.log(
+                Status::Ok,
+                CAT_PROGRESS,
+                &format!(
+                    "t = {sim_time:.6e} s, {steps} steps, {} = {value:.6e} {}",
+                    first.name, first.unit
+                ),
+            );
+        }
         if !finished {
             self.time = target;
             self.last_successful_time = target;
@@ -818,6 +824,8 @@ impl Instance {
             });
         }
         self.at_end = true;
+        let sim = self.sim.as_ref().expect("built at initialization");
+        let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
         let why = if at_rest {
             "the rod is at rest"
         } else {
