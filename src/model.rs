@@ -14,8 +14,10 @@ pub trait ModelState {
     /// A copy of this run.
     fn boxed_clone(&self) -> Box<dyn Model>;
 
-    /// The run's state, restored by its registry row's `restore`.
-    fn save(&self) -> serde_json::Value;
+    /// The run's state, for any serde format (JSON in the C ABI's saved
+    /// states, postcard in the FMU's), restored by its registry row's
+    /// `restore`.
+    fn save(&self) -> &dyn erased_serde::Serialize;
 
     /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s
     /// own type.
@@ -26,8 +28,8 @@ impl<T: Model + Clone + serde::Serialize> ModelState for T {
     fn boxed_clone(&self) -> Box<dyn Model> {
         Box::new(self.clone())
     }
-    fn save(&self) -> serde_json::Value {
-        serde_json::to_value(self).expect("the state holds only finite numbers")
+    fn save(&self) -> &dyn erased_serde::Serialize {
+        self
     }
     fn as_any(&self) -> &dyn Any {
         self

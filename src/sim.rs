@@ -8,7 +8,6 @@ use crate::isa::Isa;
 use crate::model::Model;
 use crate::observe::{FieldSpec, History, ObservableSpec, Snapshot};
 use crate::scene::{Scene, SceneKind};
-use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
 /// Progress of a run, passed to the callback of [`Simulation::run_with`].
@@ -71,11 +70,12 @@ impl Clone for Simulation {
 
 /// A [`Simulation`] as saved: the solver's state under its kind's key, as
 /// the scene's parameters are (`{"Taylor": {...}}`). A stopped run's error
-/// is not part of the state.
+/// is not part of the state. The same shape in every serde format: JSON for
+/// [`Simulation::serialize_state`], postcard inside the FMU state.
 #[derive(serde::Serialize)]
 struct SavedRef<'a> {
     scene: &'a Scene,
-    solver: BTreeMap<String, serde_json::Value>,
+    solver: SolverRef<'a>,
     history: &'a History,
     record_interval: f64,
     next_record: f64,
@@ -86,10 +86,83 @@ struct SavedRef<'a> {
 #[serde(deny_unknown_fields)]
 struct Saved {
     scene: Scene,
-    solver: BTreeMap<String, serde_json::Value>,
+    solver: SolverState,
     history: History,
     record_interval: f64,
     next_record: f64,
+}
+
+/// A solver's state as a map of one entry, under its kind's key.
+struct SolverRef<'a>(SceneKind, &'a dyn Model);
+
+impl serde::Serialize for SolverRef<'_> {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap as _;
+        let mut map = serializer.serialize_map(Some(1))?;
+        map.serialize_entry(&self.0.saved_key(), self.1.save())?;
+        map.end()
+    }
+}
+
+/// [`SolverRef`] read back: the kind its key names and its solver, restored
+/// by that kind's row (not yet checked).
+struct SolverState(SceneKind, Box<dyn Model>);
+
+/// Why a solver state is refused when its key does not name one kind.
+const NOT_THE_SCENES: &str = "its solver is not its scene's";
+
+impl<'de> serde::Deserialize<'de> for SolverState {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        deserializer.deserialize_map(SolverVisitor)
+    }
+}
+
+/// Reads the one entry of a [`SolverRef`] map.
+struct SolverVisitor;
+
+impl<'de> serde::de::Visitor<'de> for SolverVisitor {
+    type Value = SolverState;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a solver state under its scene kind's key")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> std::result::Result<SolverState, A::Error> {
+        use serde::de::Error as _;
+        let kind = map
+            .next_key::<String>()?
+            .and_then(|key| SceneKind::with_saved_key(&key))
+            .ok_or_else(|| A::Error::custom(NOT_THE_SCENES))?;
+        let solver = map.next_value_seed(Restore(kind))?;
+        if map.next_key::<serde::de::IgnoredAny>()?.is_some() {
+            return Err(A::Error::custom(NOT_THE_SCENES));
+        }
+        Ok(SolverState(kind, solver))
+    }
+}
+
+/// Restores a solver of one kind through its row, from any format.
+struct Restore(SceneKind);
+
+impl<'de> serde::de::DeserializeSeed<'de> for Restore {
+    type Value = Box<dyn Model>;
+
+    fn deserialize<D: serde::Deserializer<'de>>(
+        self,
+        deserializer: D,
+    ) -> std::result::Result<Box<dyn Model>, D::Error> {
+        use serde::de::Error as _;
+        let mut erased = <dyn erased_serde::Deserializer>::erase(deserializer);
+        (self.0.row().restore)(&mut erased).map_err(D::Error::custom)
+    }
 }
 
 impl serde::Serialize for Simulation {
@@ -99,7 +172,7 @@ impl serde::Serialize for Simulation {
     ) -> std::result::Result<S::Ok, S::Error> {
         SavedRef {
             scene: &self.scene,
-            solver: BTreeMap::from([(self.scene.kind().saved_key(), self.solver.save())]),
+            solver: SolverRef(self.scene.kind(), self.solver.as_ref()),
             history: &self.history,
             record_interval: self.record_interval,
             next_record: self.next_record,
@@ -118,13 +191,10 @@ impl<'de> serde::Deserialize<'de> for Simulation {
         use serde::de::Error as _;
         let saved = Saved::deserialize(deserializer)?;
         let kind = saved.scene.kind();
-        let mut states = saved.solver.into_iter();
-        let solver = match (states.next(), states.next()) {
-            (Some((key, state)), None) if key == kind.saved_key() => {
-                (kind.row().restore)(state).map_err(D::Error::custom)?
-            }
-            _ => return Err(D::Error::custom("its solver is not its scene's")),
-        };
+        let SolverState(solver_kind, solver) = saved.solver;
+        if solver_kind != kind {
+            return Err(D::Error::custom(NOT_THE_SCENES));
+        }
         Ok(Simulation {
             observed: Observed::new(kind),
             scene: saved.scene,

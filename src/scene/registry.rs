@@ -43,7 +43,9 @@ pub struct SceneRow {
     pub build: fn(&Scene) -> Result<Box<dyn Model>>,
     /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked
     /// afterwards ([`Model::check_restored`]).
-    pub restore: fn(serde_json::Value) -> std::result::Result<Box<dyn Model>, String>,
+    /// Reads from any serde format (the deserializer type-erased).
+    pub restore:
+        fn(&mut dyn erased_serde::Deserializer<'_>) -> std::result::Result<Box<dyn Model>, String>,
     /// The FMU of this kind, if it has one.
     pub fmu: Option<FmuIdentity>,
 }
@@ -64,11 +66,13 @@ pub fn row(name: &str) -> Result<&'static SceneRow> {
 }
 
 /// [`SceneRow::restore`] for a solver type that serde restores whole.
-pub(crate) fn restore<T>(state: serde_json::Value) -> std::result::Result<Box<dyn Model>, String>
+pub(crate) fn restore<T>(
+    state: &mut dyn erased_serde::Deserializer<'_>,
+) -> std::result::Result<Box<dyn Model>, String>
 where
     T: Model + serde::de::DeserializeOwned,
 {
-    serde_json::from_value::<T>(state)
+    erased_serde::deserialize::<T>(state)
         .map(|m| Box::new(m) as Box<dyn Model>)
         .map_err(|e| e.to_string())
 }
