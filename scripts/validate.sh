@@ -2,7 +2,10 @@
 # Heavy validation, beyond the test command: the refinement study of test 7
 # (20, 31 and 41 particles across the radius), run as the ignored integration
 # tests (about 2 minutes on two cores), and test 7 at 600 m/s with the
-# large-strain scheme (173 s on one thread).
+# large-strain scheme (173 s on one thread); then the boundary costs at 10^6
+# particles (an FMU output read, a C field read, the FMU state; about a
+# minute and 4 GB), whose figures are in BENCHMARKS.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo test --release --test taylor -- --ignored --nocapture
+cargo test --release --test boundary -- --ignored --nocapture

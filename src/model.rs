@@ -19,6 +19,11 @@ pub trait ModelState {
     /// `restore`.
     fn save(&self) -> &dyn erased_serde::Serialize;
 
+    /// The run's state in postcard, encoded by its own type (no dynamic
+    /// call per value): what the FMU state holds, restored by its row's
+    /// `restore` from [`crate::scene::registry::SavedSolver::Postcard`].
+    fn save_compact(&self) -> Vec<u8>;
+
     /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s
     /// own type.
     fn as_any(&self) -> &dyn Any;
@@ -31,9 +36,33 @@ impl<T: Model + Clone + serde::Serialize> ModelState for T {
     fn save(&self) -> &dyn erased_serde::Serialize {
         self
     }
+    fn save_compact(&self) -> Vec<u8> {
+        // Counted first, so that the vector is made once at its size.
+        let mut out = Vec::with_capacity(postcard_len(self));
+        postcard::to_io(self, &mut out).expect("a state encodes into a vector");
+        out
+    }
     fn as_any(&self) -> &dyn Any {
         self
     }
+}
+
+/// The number of bytes of `value` in postcard, counted without making them.
+pub(crate) fn postcard_len<T: serde::Serialize + ?Sized>(value: &T) -> usize {
+    /// Counts what is written.
+    struct Count(usize);
+    impl std::io::Write for Count {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            self.0 += buf.len();
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let mut count = Count(0);
+    postcard::to_io(value, &mut count).expect("a value encodes into a counter");
+    count.0
 }
 
 /// One solver's run of one scene.

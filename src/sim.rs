@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::model::Model;
 use crate::observe::{FieldSpec, History, ObservableSpec, Snapshot};
+use crate::scene::registry::SavedSolver;
 use crate::scene::{Scene, SceneKind};
 use std::sync::OnceLock;
 
@@ -101,9 +102,28 @@ impl serde::Serialize for SolverRef<'_> {
         serializer: S,
     ) -> std::result::Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap as _;
+        let human = serializer.is_human_readable();
         let mut map = serializer.serialize_map(Some(1))?;
-        map.serialize_entry(&self.0.saved_key(), self.1.save())?;
+        if human {
+            map.serialize_entry(&self.0.saved_key(), self.1.save())?;
+        } else {
+            // A binary format (postcard, the FMU state): the solver's own
+            // postcard bytes, encoded by its type.
+            map.serialize_entry(&self.0.saved_key(), &Bytes(&self.1.save_compact()))?;
+        }
         map.end()
+    }
+}
+
+/// Bytes serialized as one byte string.
+struct Bytes<'a>(&'a [u8]);
+
+impl serde::Serialize for Bytes<'_> {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        serializer.serialize_bytes(self.0)
     }
 }
 
@@ -160,8 +180,25 @@ impl<'de> serde::de::DeserializeSeed<'de> for Restore {
         deserializer: D,
     ) -> std::result::Result<Box<dyn Model>, D::Error> {
         use serde::de::Error as _;
-        let mut erased = <dyn erased_serde::Deserializer>::erase(deserializer);
-        (self.0.row().restore)(&mut erased).map_err(D::Error::custom)
+        if deserializer.is_human_readable() {
+            let mut erased = <dyn erased_serde::Deserializer>::erase(deserializer);
+            (self.0.row().restore)(SavedSolver::Serde(&mut erased)).map_err(D::Error::custom)
+        } else {
+            deserializer.deserialize_bytes(self)
+        }
+    }
+}
+
+/// The solver's postcard bytes inside a binary format.
+impl<'de> serde::de::Visitor<'de> for Restore {
+    type Value = Box<dyn Model>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("the bytes of a solver state")
+    }
+
+    fn visit_bytes<E: serde::de::Error>(self, bytes: &[u8]) -> std::result::Result<Self::Value, E> {
+        (self.0.row().restore)(SavedSolver::Postcard(bytes)).map_err(E::custom)
     }
 }
 

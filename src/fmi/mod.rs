@@ -936,20 +936,7 @@ impl Saved {
     /// The length of [`Saved::serialize`]'s bytes, counted without making
     /// them.
     pub(crate) fn serialized_len(&self, fmu: Fmu) -> usize {
-        /// Counts what is written.
-        struct Count(usize);
-        impl std::io::Write for Count {
-            fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-                self.0 += buf.len();
-                Ok(buf.len())
-            }
-            fn flush(&mut self) -> std::io::Result<()> {
-                Ok(())
-            }
-        }
-        let mut count = Count(state_header(fmu).len());
-        postcard::to_io(self, &mut count).expect("a state encodes into a counter");
-        count.0
+        state_header(fmu).len() + crate::model::postcard_len(self)
     }
 
     /// Writes [`Saved::serialize`]'s bytes into `out` (a host's buffer),
