@@ -600,6 +600,8 @@ mi_result mi_sim_field_info(mi_sim *sim, size_t index, mi_field_info *info);
  * Copies the current values of the particle field `name` by the buffer
  * convention: `particles * components` doubles, interleaved per particle
  * (for `"stress"`: RR, ZZ, TT, RZ of particle 0, then of particle 1, ...).
+ * Only this field is made (not the whole snapshot), and a size query
+ * (`buf` NULL) or a buffer too small makes none.
  *
  * # Safety
  * As `mi_sim_history`.

@@ -14,8 +14,15 @@ pub trait ModelState {
     /// A copy of this run.
     fn boxed_clone(&self) -> Box<dyn Model>;
 
-    /// The run's state, restored by its registry row's `restore`.
-    fn save(&self) -> serde_json::Value;
+    /// The run's state, for any serde format (JSON in the C ABI's saved
+    /// states, postcard in the FMU's), restored by its registry row's
+    /// `restore`.
+    fn save(&self) -> &dyn erased_serde::Serialize;
+
+    /// The run's state in postcard, encoded by its own type (no dynamic
+    /// call per value): what the FMU state holds, restored by its row's
+    /// `restore` from [`crate::scene::registry::SavedSolver::Postcard`].
+    fn save_compact(&self) -> Vec<u8>;
 
     /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s
     /// own type.
@@ -26,12 +33,36 @@ impl<T: Model + Clone + serde::Serialize> ModelState for T {
     fn boxed_clone(&self) -> Box<dyn Model> {
         Box::new(self.clone())
     }
-    fn save(&self) -> serde_json::Value {
-        serde_json::to_value(self).expect("the state holds only finite numbers")
+    fn save(&self) -> &dyn erased_serde::Serialize {
+        self
+    }
+    fn save_compact(&self) -> Vec<u8> {
+        // Counted first, so that the vector is made once at its size.
+        let mut out = Vec::with_capacity(postcard_len(self));
+        postcard::to_io(self, &mut out).expect("a state encodes into a vector");
+        out
     }
     fn as_any(&self) -> &dyn Any {
         self
     }
+}
+
+/// The number of bytes of `value` in postcard, counted without making them.
+pub(crate) fn postcard_len<T: serde::Serialize + ?Sized>(value: &T) -> usize {
+    /// Counts what is written.
+    struct Count(usize);
+    impl std::io::Write for Count {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            self.0 += buf.len();
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let mut count = Count(0);
+    postcard::to_io(value, &mut count).expect("a value encodes into a counter");
+    count.0
 }
 
 /// One solver's run of one scene.
@@ -54,6 +85,15 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// Current values of the scene's observables, in the order of its
     /// observable table.
     fn observables(&self) -> Vec<f64>;
+
+    /// The current value of the `k`-th observable of the table alone, or
+    /// `None` past the table; the bits of `observables()[k]`. A solver
+    /// whose observables cost a pass over the particles each answers this
+    /// without computing the others (an FMU output read, `mi_sim_observable`);
+    /// by default it computes them all.
+    fn observable(&self, k: usize) -> Option<f64> {
+        self.observables().get(k).copied()
+    }
 
     /// The particle fields this run offers, `position` first.
     fn field_specs(&self) -> &'static [FieldSpec];

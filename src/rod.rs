@@ -57,40 +57,56 @@ impl RodObservables {
     /// The observables of a rod of initial radius `r0` whose particles are
     /// at `pos` with velocities `vel`.
     pub fn of<const D: usize>(sets: &RodSets, pos: &[[f64; D]], vel: &[[f64; D]], r0: f64) -> Self {
-        let (zmin, zmax) = pos
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(axial(x)), hi.max(axial(x)))
-            });
-        let mushroom_radius = sets
-            .face
-            .iter()
-            .map(|&i| radius(&pos[i]))
-            .fold(0.0, f64::max);
-        // Undeformed length: walk down the mantle from the free end to the
-        // first particle strained past the threshold, and interpolate.
-        let mantle = &sets.mantle;
-        let strain = |k: usize| radius(&pos[mantle[k]]) / r0 - 1.0;
-        let z_of = |k: usize| axial(&pos[mantle[k]]);
-        let last = mantle.len() - 1;
-        let z_top = z_of(last);
-        let mut undeformed_length = z_top - z_of(0);
-        for k in (0..last).rev() {
-            if strain(k) >= UNDEFORMED_STRAIN {
-                let (s0, s1) = (strain(k + 1), strain(k));
-                let frac = ((UNDEFORMED_STRAIN - s0) / (s1 - s0)).clamp(0.0, 1.0);
-                let z = z_of(k + 1) + frac * (z_of(k) - z_of(k + 1));
-                undeformed_length = z_top - z;
-                break;
-            }
-        }
         RodObservables {
-            rod_length: zmax - zmin,
-            mushroom_radius,
-            undeformed_length,
-            tail_velocity: -axial(&vel[sets.tail]),
+            rod_length: rod_length(pos),
+            mushroom_radius: mushroom_radius(&sets.face, pos),
+            undeformed_length: undeformed_length(&sets.mantle, pos, r0),
+            tail_velocity: tail_velocity(sets.tail, vel),
         }
     }
+}
+
+/// [`RodObservables::rod_length`]: the extent of the particles at `pos`
+/// along the axis (one pass over them, nothing allocated).
+pub fn rod_length<const D: usize>(pos: &[[f64; D]]) -> f64 {
+    let (zmin, zmax) = pos
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(axial(x)), hi.max(axial(x)))
+        });
+    zmax - zmin
+}
+
+/// [`RodObservables::mushroom_radius`]: the largest distance from the axis
+/// of the `face` particles.
+pub fn mushroom_radius<const D: usize>(face: &[usize], pos: &[[f64; D]]) -> f64 {
+    face.iter().map(|&i| radius(&pos[i])).fold(0.0, f64::max)
+}
+
+/// [`RodObservables::undeformed_length`] of a rod of initial radius `r0`
+/// along the `mantle` generator (from the face to the free end): walks down
+/// from the free end to the first particle strained past
+/// [`UNDEFORMED_STRAIN`], and interpolates.
+pub fn undeformed_length<const D: usize>(mantle: &[usize], pos: &[[f64; D]], r0: f64) -> f64 {
+    let strain = |k: usize| radius(&pos[mantle[k]]) / r0 - 1.0;
+    let z_of = |k: usize| axial(&pos[mantle[k]]);
+    let last = mantle.len() - 1;
+    let z_top = z_of(last);
+    for k in (0..last).rev() {
+        if strain(k) >= UNDEFORMED_STRAIN {
+            let (s0, s1) = (strain(k + 1), strain(k));
+            let frac = ((UNDEFORMED_STRAIN - s0) / (s1 - s0)).clamp(0.0, 1.0);
+            let z = z_of(k + 1) + frac * (z_of(k) - z_of(k + 1));
+            return z_top - z;
+        }
+    }
+    z_top - z_of(0)
+}
+
+/// [`RodObservables::tail_velocity`]: the speed of the particle `tail`
+/// toward the anvil.
+pub fn tail_velocity<const D: usize>(tail: usize, vel: &[[f64; D]]) -> f64 {
+    -axial(&vel[tail])
 }
 
 #[cfg(test)]

@@ -7,8 +7,9 @@ use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::model::Model;
 use crate::observe::{FieldSpec, History, ObservableSpec, Snapshot};
+use crate::scene::registry::SavedSolver;
 use crate::scene::{Scene, SceneKind};
-use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// Progress of a run, passed to the callback of [`Simulation::run_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,6 +31,28 @@ pub struct Simulation {
     record_interval: f64,
     next_record: f64,
     error: Option<Error>,
+    observed: Observed,
+}
+
+/// The observables of the current step, each computed when first read and
+/// kept until the next step: a host that reads every output after every
+/// communication step costs one evaluation of each (none after a step that
+/// recorded the histories), and a read of one computes that one.
+#[derive(Debug, Clone)]
+struct Observed(Vec<OnceLock<f64>>);
+
+impl Observed {
+    /// Nothing computed yet, for a scene of `kind`.
+    fn new(kind: SceneKind) -> Self {
+        Observed(vec![OnceLock::new(); kind.observable_specs().len()])
+    }
+
+    /// Forgets every value (the run has stepped).
+    fn clear(&mut self) {
+        for cell in &mut self.0 {
+            cell.take();
+        }
+    }
 }
 
 impl Clone for Simulation {
@@ -41,17 +64,19 @@ impl Clone for Simulation {
             record_interval: self.record_interval,
             next_record: self.next_record,
             error: self.error.clone(),
+            observed: self.observed.clone(),
         }
     }
 }
 
 /// A [`Simulation`] as saved: the solver's state under its kind's key, as
 /// the scene's parameters are (`{"Taylor": {...}}`). A stopped run's error
-/// is not part of the state.
+/// is not part of the state. The same shape in every serde format: JSON for
+/// [`Simulation::serialize_state`], postcard inside the FMU state.
 #[derive(serde::Serialize)]
 struct SavedRef<'a> {
     scene: &'a Scene,
-    solver: BTreeMap<String, serde_json::Value>,
+    solver: SolverRef<'a>,
     history: &'a History,
     record_interval: f64,
     next_record: f64,
@@ -62,10 +87,119 @@ struct SavedRef<'a> {
 #[serde(deny_unknown_fields)]
 struct Saved {
     scene: Scene,
-    solver: BTreeMap<String, serde_json::Value>,
+    solver: SolverState,
     history: History,
     record_interval: f64,
     next_record: f64,
+}
+
+/// A solver's state as a map of one entry, under its kind's key.
+struct SolverRef<'a>(SceneKind, &'a dyn Model);
+
+impl serde::Serialize for SolverRef<'_> {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap as _;
+        let human = serializer.is_human_readable();
+        let mut map = serializer.serialize_map(Some(1))?;
+        if human {
+            map.serialize_entry(&self.0.saved_key(), self.1.save())?;
+        } else {
+            // A binary format (postcard, the FMU state): the solver's own
+            // postcard bytes, encoded by its type.
+            map.serialize_entry(&self.0.saved_key(), &Bytes(&self.1.save_compact()))?;
+        }
+        map.end()
+    }
+}
+
+/// Bytes serialized as one byte string.
+struct Bytes<'a>(&'a [u8]);
+
+impl serde::Serialize for Bytes<'_> {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        serializer.serialize_bytes(self.0)
+    }
+}
+
+/// [`SolverRef`] read back: the kind its key names and its solver, restored
+/// by that kind's row (not yet checked).
+struct SolverState(SceneKind, Box<dyn Model>);
+
+/// Why a solver state is refused when its key does not name one kind.
+const NOT_THE_SCENES: &str = "its solver is not its scene's";
+
+impl<'de> serde::Deserialize<'de> for SolverState {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        deserializer.deserialize_map(SolverVisitor)
+    }
+}
+
+/// Reads the one entry of a [`SolverRef`] map.
+struct SolverVisitor;
+
+impl<'de> serde::de::Visitor<'de> for SolverVisitor {
+    type Value = SolverState;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a solver state under its scene kind's key")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> std::result::Result<SolverState, A::Error> {
+        use serde::de::Error as _;
+        let kind = map
+            .next_key::<String>()?
+            .and_then(|key| SceneKind::with_saved_key(&key))
+            .ok_or_else(|| A::Error::custom(NOT_THE_SCENES))?;
+        let solver = map.next_value_seed(Restore(kind))?;
+        if map.next_key::<serde::de::IgnoredAny>()?.is_some() {
+            return Err(A::Error::custom(NOT_THE_SCENES));
+        }
+        Ok(SolverState(kind, solver))
+    }
+}
+
+/// Restores a solver of one kind through its row, from any format.
+struct Restore(SceneKind);
+
+impl<'de> serde::de::DeserializeSeed<'de> for Restore {
+    type Value = Box<dyn Model>;
+
+    fn deserialize<D: serde::Deserializer<'de>>(
+        self,
+        deserializer: D,
+    ) -> std::result::Result<Box<dyn Model>, D::Error> {
+        use serde::de::Error as _;
+        if deserializer.is_human_readable() {
+            let mut erased = <dyn erased_serde::Deserializer>::erase(deserializer);
+            (self.0.row().restore)(SavedSolver::Serde(&mut erased)).map_err(D::Error::custom)
+        } else {
+            deserializer.deserialize_bytes(self)
+        }
+    }
+}
+
+/// The solver's postcard bytes inside a binary format.
+impl<'de> serde::de::Visitor<'de> for Restore {
+    type Value = Box<dyn Model>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("the bytes of a solver state")
+    }
+
+    fn visit_bytes<E: serde::de::Error>(self, bytes: &[u8]) -> std::result::Result<Self::Value, E> {
+        (self.0.row().restore)(SavedSolver::Postcard(bytes)).map_err(E::custom)
+    }
 }
 
 impl serde::Serialize for Simulation {
@@ -75,7 +209,7 @@ impl serde::Serialize for Simulation {
     ) -> std::result::Result<S::Ok, S::Error> {
         SavedRef {
             scene: &self.scene,
-            solver: BTreeMap::from([(self.scene.kind().saved_key(), self.solver.save())]),
+            solver: SolverRef(self.scene.kind(), self.solver.as_ref()),
             history: &self.history,
             record_interval: self.record_interval,
             next_record: self.next_record,
@@ -94,14 +228,12 @@ impl<'de> serde::Deserialize<'de> for Simulation {
         use serde::de::Error as _;
         let saved = Saved::deserialize(deserializer)?;
         let kind = saved.scene.kind();
-        let mut states = saved.solver.into_iter();
-        let solver = match (states.next(), states.next()) {
-            (Some((key, state)), None) if key == kind.saved_key() => {
-                (kind.row().restore)(state).map_err(D::Error::custom)?
-            }
-            _ => return Err(D::Error::custom("its solver is not its scene's")),
-        };
+        let SolverState(solver_kind, solver) = saved.solver;
+        if solver_kind != kind {
+            return Err(D::Error::custom(NOT_THE_SCENES));
+        }
         Ok(Simulation {
+            observed: Observed::new(kind),
             scene: saved.scene,
             solver,
             history: saved.history,
@@ -121,6 +253,7 @@ impl Simulation {
         crate::solver::check_derived("record interval", record_interval, "")?;
         let mut sim = Simulation {
             history: History::new(scene.kind().observable_specs()),
+            observed: Observed::new(scene.kind()),
             scene,
             solver,
             record_interval,
@@ -199,7 +332,16 @@ impl Simulation {
 
     /// Current values of the observables, in [`Simulation::observable_specs`] order.
     pub fn observables(&self) -> Vec<f64> {
-        self.solver.observables()
+        let cells = &self.observed.0;
+        if let Some(values) = cells.iter().map(|c| c.get().copied()).collect() {
+            return values;
+        }
+        let values = self.solver.observables();
+        for (cell, v) in cells.iter().zip(&values) {
+            // The same bits as a value computed alone.
+            let _ = cell.set(*v);
+        }
+        values
     }
 
     /// Current value of one observable.
@@ -208,7 +350,19 @@ impl Simulation {
             .observable_specs()
             .iter()
             .position(|s| s.name == name)?;
-        Some(self.observables()[k])
+        self.observable_at(k)
+    }
+
+    /// Current value of the `k`-th observable (`None` past the table). Only
+    /// that one is computed ([`Model::observable`]), at most once per step:
+    /// the bits of `observables()[k]`.
+    pub fn observable_at(&self, k: usize) -> Option<f64> {
+        let cell = self.observed.0.get(k)?;
+        if let Some(v) = cell.get() {
+            return Some(*v);
+        }
+        let v = self.solver.observable(k)?;
+        Some(*cell.get_or_init(|| v))
     }
 
     /// The particle fields of this run, `position` first.
@@ -247,7 +401,9 @@ impl Simulation {
         if let Some(e) = &self.error {
             return Err(e.clone());
         }
-        if let Err(e) = self.solver.step() {
+        let stepped = self.solver.step();
+        self.observed.clear();
+        if let Err(e) = stepped {
             self.record();
             self.error = Some(e.clone());
             return Err(e);
@@ -350,5 +506,176 @@ impl Simulation {
             Some(e) => Err(e.clone()),
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::{Arc, Mutex};
+
+    /// A Taylor run that notes which observables it is asked for: `Some(k)`
+    /// for one, `None` for all.
+    #[derive(Debug, Clone, serde::Serialize)]
+    struct Counting {
+        inner: crate::solver::axisymmetric::TaylorSolver,
+        #[serde(skip)]
+        asked: Arc<Mutex<Vec<Option<usize>>>>,
+    }
+
+    impl Model for Counting {
+        fn time(&self) -> f64 {
+            self.inner.time()
+        }
+        fn steps(&self) -> u64 {
+            self.inner.steps()
+        }
+        fn particles(&self) -> usize {
+            self.inner.particles()
+        }
+        fn finished(&self) -> bool {
+            self.inner.finished()
+        }
+        fn step(&mut self) -> Result<()> {
+            self.inner.step()
+        }
+        fn observables(&self) -> Vec<f64> {
+            self.asked.lock().unwrap().push(None);
+            self.inner.observables()
+        }
+        fn observable(&self, k: usize) -> Option<f64> {
+            self.asked.lock().unwrap().push(Some(k));
+            self.inner.observable(k)
+        }
+        fn field_specs(&self) -> &'static [FieldSpec] {
+            Model::field_specs(&self.inner)
+        }
+        fn field(&self, name: &str) -> Option<Vec<f64>> {
+            self.inner.field(name)
+        }
+        fn record_interval(&self) -> f64 {
+            Model::record_interval(&self.inner)
+        }
+        fn check_restored(&self, fresh: &dyn Model) -> std::result::Result<(), String> {
+            Model::check_restored(&self.inner, fresh)
+        }
+    }
+
+    /// A coarse Taylor run (4 particles across) whose solver counts.
+    fn counting() -> (Simulation, Arc<Mutex<Vec<Option<usize>>>>) {
+        let mut scene = Scene::builtin("taylor").unwrap();
+        scene.set("particles_radial", 4.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        let asked = Arc::new(Mutex::new(Vec::new()));
+        let inner = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
+            sim.solver.as_ref(),
+        )
+        .unwrap()
+        .clone();
+        sim.solver = Box::new(Counting {
+            inner,
+            asked: Arc::clone(&asked),
+        });
+        (sim, asked)
+    }
+
+    #[test]
+    fn a_read_of_one_observable_computes_that_one_once_per_step() {
+        let (mut sim, asked) = counting();
+        let n = sim.observable_specs().len();
+        // At this resolution every step records the histories (and so
+        // computes the whole set); forget it, as a step between two records
+        // does.
+        sim.step().unwrap();
+        sim.observed.clear();
+        asked.lock().unwrap().clear();
+        let tail = sim.observable_at(3).unwrap();
+        assert_eq!(*asked.lock().unwrap(), [Some(3)], "one asked, alone");
+        assert_eq!(sim.observable("tail_velocity"), Some(tail));
+        assert_eq!(sim.observable_at(3), Some(tail));
+        assert_eq!(*asked.lock().unwrap(), [Some(3)], "then kept");
+        assert_eq!(sim.observable_at(n), None);
+        // Every value read alone has the bits of the whole set; with all of
+        // them known, the set asks the solver for nothing.
+        let alone: Vec<u64> = (0..n)
+            .map(|k| sim.observable_at(k).unwrap().to_bits())
+            .collect();
+        // Each asked once: 3 before, the others now.
+        let asked_alone: Vec<Option<usize>> = std::iter::once(3)
+            .chain((0..n).filter(|&k| k != 3))
+            .map(Some)
+            .collect();
+        assert_eq!(*asked.lock().unwrap(), asked_alone, "each once");
+        let all: Vec<u64> = sim.observables().iter().map(|x| x.to_bits()).collect();
+        assert_eq!(alone, all);
+        assert_eq!(*asked.lock().unwrap(), asked_alone, "all known: none asked");
+        // The next step forgets them (and computes the set to record it).
+        sim.step().unwrap();
+        asked.lock().unwrap().clear();
+        sim.observed.clear();
+        let fresh: Vec<u64> = sim.observables().iter().map(|x| x.to_bits()).collect();
+        assert_ne!(fresh, all, "the rod moved");
+        assert_eq!(*asked.lock().unwrap(), [None]);
+        for k in 0..n {
+            assert_eq!(sim.observable_at(k).unwrap().to_bits(), fresh[k]);
+        }
+        assert_eq!(asked.lock().unwrap().len(), 1, "kept from the set");
+    }
+
+    /// A copy (an FMU state got to roll back to) holds no solver buffers,
+    /// and steps on with the bits of the original.
+    #[test]
+    fn a_copy_steps_on_with_the_bits_of_the_original() {
+        let mut scene = Scene::builtin("taylor").unwrap();
+        scene.set("particles_radial", 5.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        sim.advance_to(4e-6).unwrap();
+        let mut copy = sim.clone();
+        for s in [&mut sim, &mut copy] {
+            s.advance_to(12e-6).unwrap();
+        }
+        let bits = |s: &Simulation| -> Vec<u64> {
+            let mut v = s.observables();
+            for f in s.field_specs() {
+                v.extend(s.field(f.name).unwrap());
+            }
+            v.iter().map(|x| x.to_bits()).collect()
+        };
+        assert_eq!(sim.steps(), copy.steps());
+        assert_eq!(bits(&sim), bits(&copy));
+    }
+
+    /// Along a run, each Taylor observable computed alone has the bits of
+    /// the set computed together, and every row of the table has one.
+    #[test]
+    fn taylor_observables_alone_have_the_bits_of_the_set() {
+        let mut scene = Scene::builtin("taylor").unwrap();
+        scene.set("particles_radial", 5.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        let solver = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
+            sim.solver.as_ref(),
+        )
+        .unwrap();
+        let n = crate::TAYLOR_OBSERVABLES.len();
+        assert_eq!(solver.observable(n), None);
+        for t in [0.0, 2e-6, 8e-6, 30e-6] {
+            sim.advance_to(t).unwrap();
+            let solver = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
+                sim.solver.as_ref(),
+            )
+            .unwrap();
+            let all = solver.observables();
+            assert_eq!(all.len(), n);
+            for (k, v) in all.iter().enumerate() {
+                let one = solver.observable(k).unwrap();
+                assert_eq!(
+                    one.to_bits(),
+                    v.to_bits(),
+                    "{} at {t}",
+                    crate::TAYLOR_OBSERVABLES[k].name
+                );
+            }
+        }
+        assert!(sim.observable("max_plastic_strain").unwrap() > 0.0);
     }
 }

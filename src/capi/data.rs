@@ -4,7 +4,7 @@
 use super::error::{Fail, mi_result};
 use super::handle::{FieldMeta, index_error, mi_sim};
 use super::panic::with_sim;
-use super::ptr::{check_buf, copy_out, need_out, put, text};
+use super::ptr::{check_buf, copy_out, need_out, put, room_for, text};
 use crate::sim::Simulation;
 use std::ffi::{CString, c_char};
 
@@ -165,7 +165,10 @@ pub unsafe extern "C" fn mi_sim_observable(
         let n = unsafe { text(name, "name") }?;
         need_out(value, "value")?;
         let k = observable_index(s, n)?;
-        let v = s.sim()?.observables()[k];
+        let v = s
+            .sim()?
+            .observable_at(k)
+            .expect("an observable of the table");
         // SAFETY: forwarded contract on `value`.
         unsafe { put(value, v, "value") }
     })
@@ -342,6 +345,8 @@ pub unsafe extern "C" fn mi_sim_field_info(
 /// Copies the current values of the particle field `name` by the buffer
 /// convention: `particles * components` doubles, interleaved per particle
 /// (for `"stress"`: RR, ZZ, TT, RZ of particle 0, then of particle 1, ...).
+/// Only this field is made (not the whole snapshot), and a size query
+/// (`buf` NULL) or a buffer too small makes none.
 ///
 /// # Safety
 /// As `mi_sim_history`.
@@ -357,7 +362,13 @@ pub unsafe extern "C" fn mi_sim_field(
         // SAFETY: forwarded contract on `name`.
         let n = unsafe { text(name, "name") }?;
         check_buf(buf, len, "buf")?;
-        let Some(v) = s.sim()?.field(n) else {
+        let sim = s.sim()?;
+        let components = sim
+            .field_specs()
+            .iter()
+            .find(|f| f.name == n)
+            .map(|f| f.components.len());
+        let Some(components) = components else {
             let names: Vec<String> = field_meta(s)?
                 .iter()
                 .map(|f| f.name.to_string_lossy().into_owned())
@@ -371,6 +382,15 @@ pub unsafe extern "C" fn mi_sim_field(
                 ),
             ));
         };
+        // A size query or a buffer too small is answered without making the
+        // field; otherwise only this field is made, and copied once.
+        let sim = s.sim()?;
+        let count = sim.particles() * components;
+        // SAFETY: forwarded contract on `buf`, `len`, `needed`.
+        if !unsafe { room_for(count, buf, len, needed, "buf") }? {
+            return Ok(());
+        }
+        let v = sim.field(n).expect("a field of the run's field specs");
         // SAFETY: forwarded contract on `buf`, `len`, `needed`.
         unsafe { copy_out(&v, buf, len, needed, "buf") }
     })

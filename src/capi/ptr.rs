@@ -78,27 +78,45 @@ pub(crate) unsafe fn copy_out<T: Copy>(
     needed: *mut usize,
     what: &str,
 ) -> Result<(), Fail> {
-    check_buf(buf, len, what)?;
-    if !needed.is_null() {
-        // SAFETY: non-NULL and, by this function's contract, valid for writes.
-        unsafe { needed.write(data.len()) };
-    }
-    if buf.is_null() {
+    // SAFETY: forwarded contract.
+    if !unsafe { room_for(data.len(), buf, len, needed, what) }? {
         return Ok(());
-    }
-    if len < data.len() {
-        return Err(Fail::new(
-            mi_result::MI_BUFFER_TOO_SMALL,
-            format!(
-                "buffer `{what}` holds {len} elements; {} needed",
-                data.len()
-            ),
-        ));
     }
     // SAFETY: `buf` is non-NULL and valid for `len >= data.len()` elements;
     // `data` is a Rust slice, so the two cannot overlap.
     unsafe { std::ptr::copy_nonoverlapping(data.as_ptr(), buf, data.len()) };
     Ok(())
+}
+
+/// The buffer convention before `count` elements are made: writes `count`
+/// to `needed`, then says whether `buf` is there to be filled (`false` for
+/// a size query with a NULL buffer), or refuses a buffer too small. A
+/// caller can so answer a size query without making the data.
+///
+/// # Safety
+/// As [`copy_out`].
+pub(crate) unsafe fn room_for<T>(
+    count: usize,
+    buf: *mut T,
+    len: usize,
+    needed: *mut usize,
+    what: &str,
+) -> Result<bool, Fail> {
+    check_buf(buf, len, what)?;
+    if !needed.is_null() {
+        // SAFETY: non-NULL and, by this function's contract, valid for writes.
+        unsafe { needed.write(count) };
+    }
+    if buf.is_null() {
+        return Ok(false);
+    }
+    if len < count {
+        return Err(Fail::new(
+            mi_result::MI_BUFFER_TOO_SMALL,
+            format!("buffer `{what}` holds {len} elements; {count} needed"),
+        ));
+    }
+    Ok(true)
 }
 
 /// Copies `s` as a NUL-terminated string by the buffer convention (`len` and

@@ -830,7 +830,7 @@ pub(crate) unsafe fn serialized_size(
                 return inst.fail(&format!("{function}: FMUState or size is NULL"));
             }
             // SAFETY: a live `Box<Saved>`; `size` writable.
-            *size = (*(state as *const Saved)).serialize(inst.fmu).len();
+            *size = (*(state as *const Saved)).serialized_len(inst.fmu);
             Status::Ok
         })
     }
@@ -854,18 +854,14 @@ pub(crate) unsafe fn serialize(
                 return inst.fail(&format!("{function}: FMUState is NULL"));
             }
             // SAFETY: a live `Box<Saved>`.
-            let data = (*(state as *const Saved)).serialize(inst.fmu);
-            if data.len() != size {
-                return inst.fail(&format!(
-                    "{function}: size = {size} but the serialized state has {} bytes",
-                    data.len()
-                ));
-            }
+            let saved = &*(state as *const Saved);
             let Some(out) = slice_mut(bytes, size) else {
                 return inst.fail(&format!("{function}: serializedState is NULL"));
             };
-            out.copy_from_slice(&data);
-            Status::Ok
+            match saved.serialize_into(inst.fmu, out) {
+                Ok(()) => Status::Ok,
+                Err(e) => inst.fail(&format!("{function}: {e}")),
+            }
         })
     }
 }

@@ -128,13 +128,6 @@ impl Fmu {
         out
     }
 
-    /// The variable with value reference `vr`.
-    fn variable(self, vr: u32) -> Option<Variable> {
-        // The table is small (tens of rows); a linear lookup keeps one
-        // source of truth.
-        self.variables().into_iter().find(|v| v.vr == vr)
-    }
-
     /// The instantiation token (FMI 3) / GUID (FMI 2): a deterministic hash
     /// of the model identifier, the crate version and the generated
     /// variable list, formatted as a GUID.
@@ -162,6 +155,25 @@ impl Fmu {
             &s[16..20],
             &s[20..32]
         )
+    }
+
+    /// A serialized state of this FMU (`fmi3SerializeFMUState`,
+    /// `fmi2SerializeFMUstate`) as JSON, to read it, or to forge one in a
+    /// test: decoded field by field, not checked. An error says why the
+    /// bytes are not a state of this version of the FMU.
+    pub fn state_to_json(self, bytes: &[u8]) -> Result<serde_json::Value, String> {
+        let saved = Saved::decode(self, bytes)?;
+        serde_json::to_value(&saved).map_err(|e| format!("the state as JSON: {e}"))
+    }
+
+    /// Serialized state bytes of this FMU from JSON of the shape
+    /// [`Fmu::state_to_json`] gives, encoded as the FMU encodes them but not
+    /// checked: `fmi3DeserializeFMUState` checks them. An error says which
+    /// part does not have the type of its field.
+    pub fn state_from_json(self, json: serde_json::Value) -> Result<Vec<u8>, String> {
+        let saved: Saved =
+            serde_json::from_value(json).map_err(|e| format!("not an FMU state: {e}"))?;
+        Ok(saved.serialize(self))
     }
 
     /// The FMU an instantiation asks for: the one whose token it gives, or
@@ -399,14 +411,21 @@ pub(crate) struct Saved {
     last_successful_time: f64,
 }
 
-/// The first line of a serialized state, after the model identifier.
-const STATE_MAGIC: &[u8] = b" FMU state v1\n";
+/// The first line of a serialized state, after the model identifier: the
+/// version of its encoding. Version 2 is postcard; version 1 (JSON) is
+/// refused with a message saying so.
+const STATE_MAGIC: &[u8] = b" FMU state v2 postcard\n";
+
+/// The first line of a version 1 (JSON) state, after the model identifier.
+const STATE_MAGIC_V1: &[u8] = b" FMU state v1\n";
 
 /// One FMU instance (FMI 3 or FMI 2).
 pub(crate) struct Instance {
     pub standard: Standard,
     /// The FMU this instance is.
     pub fmu: Fmu,
+    /// Its variables ([`Fmu::variables`]), made once.
+    variables: Vec<Variable>,
     pub name: CString,
     log: LogSink,
     categories: [bool; 4],
@@ -440,6 +459,7 @@ impl Instance {
         Instance {
             standard,
             fmu,
+            variables: fmu.variables(),
             name: CString::new(name.replace('\0', "")).unwrap_or_default(),
             log,
             categories: [logging_on; 4],
@@ -645,7 +665,9 @@ impl Instance {
 
     /// Looks up `vr` and checks its type.
     fn lookup(&mut self, vr: u32, ty: VarType, function: &str) -> Result<Variable, Status> {
-        match self.fmu.variable(vr) {
+        // The table is small (tens of rows): a linear lookup in the
+        // instance's copy of [`Fmu::variables`], which allocates nothing.
+        match self.variables.iter().find(|v| v.vr == vr).copied() {
             Some(v)
                 if v.ty == ty && !(self.standard == Standard::Fmi2 && v.kind == VarKind::Time) =>
             {
@@ -669,7 +691,10 @@ impl Instance {
                 .expect("the table and the scene agree")),
             VarKind::Output(k, _) => {
                 self.ensure_sim()?;
-                Ok(self.sim.as_ref().expect("built above").observables()[k])
+                let sim = self.sim.as_ref().expect("built above");
+                Ok(sim
+                    .observable_at(k)
+                    .expect("an output of the scene's table"))
             }
         }
     }
@@ -795,21 +820,24 @@ impl Instance {
             let msg = format!("{function}: the solver stopped: {e}");
             return Err(self.fail(&msg));
         }
+        let sim = self.sim.as_ref().expect("built at initialization");
         let sim_time = self.start_time + sim.time();
         let steps = sim.steps();
-        // The scene's first observable (for a rod, its length).
-        let first = &sim.observable_specs()[0];
-        let value = sim.observables()[0];
         let finished = sim.finished();
-        let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
-        self.log(
-            Status::Ok,
-            CAT_PROGRESS,
-            &format!(
-                "t = {sim_time:.6e} s, {steps} steps, {} = {value:.6e} {}",
-                first.name, first.unit
-            ),
-        );
+        if self.categories[CAT_PROGRESS] {
+            // The scene's first observable (for a rod, its length), computed
+            // only for a host that listens.
+            let first = &sim.observable_specs()[0];
+            let value = sim.observable_at(0).expect("every scene has observables");
+            self.log(
+                Status::Ok,
+                CAT_PROGRESS,
+                &format!(
+                    "t = {sim_time:.6e} s, {steps} steps, {} = {value:.6e} {}",
+                    first.name, first.unit
+                ),
+            );
+        }
         if !finished {
             self.time = target;
             self.last_successful_time = target;
@@ -820,6 +848,8 @@ impl Instance {
             });
         }
         self.at_end = true;
+        let sim = self.sim.as_ref().expect("built at initialization");
+        let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
         let why = if at_rest {
             "the rod is at rest"
         } else {
@@ -884,32 +914,83 @@ impl Instance {
     }
 }
 
+/// The first two lines of a serialized state of `fmu`: the model
+/// identifier and [`STATE_MAGIC`], then the instantiation token.
+fn state_header(fmu: Fmu) -> Vec<u8> {
+    let mut out = fmu.identity().model_identifier.as_bytes().to_vec();
+    out.extend_from_slice(STATE_MAGIC);
+    out.extend_from_slice(fmu.token().as_bytes());
+    out.push(b'\n');
+    out
+}
+
 impl Saved {
     /// Bytes of this state of an instance of `fmu`: a magic line (the model
-    /// identifier), the instantiation token, JSON.
+    /// identifier and the version of the encoding), the instantiation
+    /// token, then the state in postcard (8 bytes per double, lengths and
+    /// counts as varints; the same fields as [`Fmu::state_to_json`] shows).
     pub(crate) fn serialize(&self, fmu: Fmu) -> Vec<u8> {
-        let mut out = fmu.identity().model_identifier.as_bytes().to_vec();
-        out.extend_from_slice(STATE_MAGIC);
-        out.extend_from_slice(fmu.token().as_bytes());
-        out.push(b'\n');
-        out.extend(serde_json::to_vec(self).expect("the state holds only finite numbers"));
+        let mut out = state_header(fmu);
+        postcard::to_io(self, &mut out).expect("a state encodes into a vector");
         out
     }
 
-    /// Parses [`Saved::serialize`] bytes of an instance of `fmu`.
-    pub(crate) fn deserialize(fmu: Fmu, bytes: &[u8]) -> Result<Saved, String> {
+    /// The length of [`Saved::serialize`]'s bytes, counted without making
+    /// them.
+    pub(crate) fn serialized_len(&self, fmu: Fmu) -> usize {
+        state_header(fmu).len() + crate::model::postcard_len(self)
+    }
+
+    /// Writes [`Saved::serialize`]'s bytes into `out` (a host's buffer),
+    /// or says why not if it is not exactly their length.
+    pub(crate) fn serialize_into(&self, fmu: Fmu, out: &mut [u8]) -> Result<(), String> {
+        let len = self.serialized_len(fmu);
+        if out.len() != len {
+            return Err(format!(
+                "size = {} but the serialized state has {len} bytes",
+                out.len()
+            ));
+        }
+        let header = state_header(fmu);
+        let (head, body) = out.split_at_mut(header.len());
+        head.copy_from_slice(&header);
+        postcard::to_slice(self, body).expect("the length counted above");
+        Ok(())
+    }
+
+    /// The state in [`Saved::serialize`] bytes of an instance of `fmu`,
+    /// decoded but not checked: a message for the log if the bytes are not
+    /// such a state of this version of `fmu`.
+    fn decode(fmu: Fmu, bytes: &[u8]) -> Result<Saved, String> {
         let id = fmu.identity().model_identifier;
-        let rest = bytes
-            .strip_prefix(id.as_bytes())
+        let after_id = bytes.strip_prefix(id.as_bytes());
+        if after_id.is_some_and(|r| r.starts_with(STATE_MAGIC_V1)) {
+            return Err(format!(
+                "the bytes are a version 1 (JSON) {id} FMU state of an older build; this one reads version 2 (postcard)"
+            ));
+        }
+        let rest = after_id
             .and_then(|r| r.strip_prefix(STATE_MAGIC))
             .ok_or_else(|| format!("the bytes are not a serialized {id} FMU state"))?;
-        let token = fmu.token();
         let rest = rest
-            .strip_prefix(token.as_bytes())
+            .strip_prefix(fmu.token().as_bytes())
             .and_then(|r| r.strip_prefix(b"\n"))
             .ok_or("the serialized state comes from a different version of the FMU")?;
-        let saved: Saved =
-            serde_json::from_slice(rest).map_err(|e| format!("invalid serialized state: {e}"))?;
+        let (saved, left) = postcard::take_from_bytes::<Saved>(rest)
+            .map_err(|e| format!("invalid serialized state: {e}"))?;
+        if !left.is_empty() {
+            return Err(format!(
+                "invalid serialized state: {} bytes follow its end",
+                left.len()
+            ));
+        }
+        Ok(saved)
+    }
+
+    /// Parses [`Saved::serialize`] bytes of an instance of `fmu`, and checks
+    /// the state as a new instance's values and run are checked.
+    pub(crate) fn deserialize(fmu: Fmu, bytes: &[u8]) -> Result<Saved, String> {
+        let saved = Saved::decode(fmu, bytes)?;
         if saved.state & ANY_STATE == 0 || saved.state.count_ones() != 1 {
             return Err("invalid serialized state: unknown instance state".into());
         }
@@ -931,6 +1012,13 @@ impl Saved {
                 "invalid serialized state: its parameters are not the `{}` scene's",
                 fmu.kind().name()
             ));
+        }
+        // An FMU's scene keeps the reference values of its kind (no
+        // variable sets them): anything else, a NaN say, is forged.
+        if saved.scene.reference != Scene::default_of(fmu.kind()).reference {
+            return Err(
+                "invalid serialized state: its reference values are not the scene's".into(),
+            );
         }
         // The run is there exactly when an instance in that state has one,
         // and it is the run of the instance's parameters (those it reports).
@@ -1247,21 +1335,12 @@ mod tests {
         assert!(inst.do_step("doStep", 0.0, 1.8e-6 * (1.0 + 1e-6)).is_ok());
     }
 
-    /// Serialized state bytes with their JSON edited by `edit`.
+    /// Serialized state bytes decoded to the typed state, edited by `edit`
+    /// in its JSON form, and encoded again (unchecked).
     fn forge(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
-        let header = bytes
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| **b == b'\n')
-            .nth(1)
-            .unwrap()
-            .0
-            + 1;
-        let mut json: serde_json::Value = serde_json::from_slice(&bytes[header..]).unwrap();
+        let mut json = taylor_fmu().state_to_json(bytes).unwrap();
         edit(&mut json);
-        let mut out = bytes[..header].to_vec();
-        out.extend(serde_json::to_vec(&json).unwrap());
-        out
+        taylor_fmu().state_from_json(json).unwrap()
     }
 
     /// Found by the FMU call-order fuzzer: a state in step mode without its
@@ -1372,6 +1451,146 @@ mod tests {
             Saved::deserialize(taylor_fmu(), &old).unwrap().stop_time,
             None
         );
+    }
+
+    /// The bytes of a coarse FMI 3 state after one step.
+    fn stepped_bytes() -> Vec<u8> {
+        let mut inst = coarse(Standard::Fmi3);
+        inst.enter_initialization_mode();
+        inst.exit_initialization_mode();
+        inst.do_step("doStep", 0.0, 1e-6).unwrap();
+        inst.save().serialize(taylor_fmu())
+    }
+
+    #[test]
+    fn cut_lengthened_foreign_and_old_states_are_refused() {
+        let fmu = taylor_fmu();
+        let bytes = stepped_bytes();
+        let header = state_header(fmu).len();
+        assert!(bytes.starts_with(b"TaylorImpact FMU state v2 postcard\n{"));
+        assert_eq!(
+            Saved::serialize(&Saved::deserialize(fmu, &bytes).unwrap(), fmu),
+            bytes
+        );
+        let cuts = (0..bytes.len())
+            .step_by(37)
+            .chain(bytes.len() - 40..bytes.len());
+        for len in cuts {
+            let e = Saved::deserialize(fmu, &bytes[..len]).unwrap_err();
+            let named = if len < header {
+                e == "the bytes are not a serialized TaylorImpact FMU state"
+                    || e == "the serialized state comes from a different version of the FMU"
+            } else {
+                e.starts_with("invalid serialized state: ")
+            };
+            assert!(named, "cut to {len}: {e}");
+        }
+        let mut longer = bytes.clone();
+        longer.push(0);
+        let e = Saved::deserialize(fmu, &longer).unwrap_err();
+        assert!(e.contains("1 bytes follow its end"), "{e}");
+        // A state of another FMU, of another build, of the JSON encoding.
+        let foreign = [b"NohImpact".as_slice(), &bytes[12..]].concat();
+        let e = Saved::deserialize(fmu, &foreign).unwrap_err();
+        assert_eq!(e, "the bytes are not a serialized TaylorImpact FMU state");
+        let mut other = bytes.clone();
+        other[header - 3] ^= 1;
+        let e = Saved::deserialize(fmu, &other).unwrap_err();
+        assert!(e.contains("different version"), "{e}");
+        let json = fmu.state_to_json(&bytes).unwrap();
+        let v1 = format!("TaylorImpact FMU state v1\n{}\n{json}", fmu.token());
+        let e = Saved::deserialize(fmu, v1.as_bytes()).unwrap_err();
+        assert!(e.contains("version 1 (JSON)"), "{e}");
+    }
+
+    /// The forgeries the fmpy tests made when the state was JSON, now made
+    /// on the typed state: each refused, naming what is wrong.
+    #[test]
+    fn forged_parameters_masses_particles_and_records_are_refused() {
+        let bytes = stepped_bytes();
+        type Edit = fn(&mut serde_json::Value);
+        let edits: [(Edit, &str); 4] = [
+            (
+                |j| j["scene"]["params"]["Taylor"]["density"] = serde_json::json!(-5.0),
+                "density",
+            ),
+            (
+                |j| j["sim"]["solver"]["Taylor"]["mass"][0] = serde_json::json!(1.0),
+                "masses",
+            ),
+            (
+                |j| {
+                    j["sim"]["solver"]["Taylor"]["vel"]
+                        .as_array_mut()
+                        .unwrap()
+                        .pop();
+                },
+                "velocities",
+            ),
+            (
+                |j| j["sim"]["record_interval"] = serde_json::json!(0.0),
+                "record",
+            ),
+        ];
+        for (edit, why) in edits {
+            match Saved::deserialize(taylor_fmu(), &forge(&bytes, edit)) {
+                Ok(_) => panic!("{why}: the forged state was accepted"),
+                Err(e) => assert!(e.contains(why), "{e} should name {why}"),
+            }
+        }
+        assert!(Saved::deserialize(taylor_fmu(), &forge(&bytes, |_| {})).is_ok());
+    }
+
+    /// Doubles can be NaN or infinite in postcard (not in JSON): each of a
+    /// state's doubles, replaced by one of them wherever its bits stand,
+    /// makes a state that is refused.
+    #[test]
+    fn non_finite_numbers_anywhere_in_a_state_are_refused() {
+        let fmu = taylor_fmu();
+        let bytes = stepped_bytes();
+        let header = state_header(fmu).len();
+        fn floats(v: &serde_json::Value, out: &mut Vec<f64>) {
+            match v {
+                serde_json::Value::Number(n) if n.is_f64() => out.push(n.as_f64().unwrap()),
+                serde_json::Value::Array(a) => a.iter().for_each(|x| floats(x, out)),
+                serde_json::Value::Object(o) => o.values().for_each(|x| floats(x, out)),
+                _ => {}
+            }
+        }
+        let mut values = Vec::new();
+        floats(&fmu.state_to_json(&bytes).unwrap(), &mut values);
+        // Whole numbers (0, 1, ...) also stand in the bytes of larger ones.
+        values.retain(|x| x.fract() != 0.0);
+        values.sort_by(f64::total_cmp);
+        values.dedup();
+        assert!(values.len() > 500, "{}", values.len());
+        let mut forged = 0;
+        for (k, v) in values.iter().enumerate() {
+            let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY][k % 3];
+            let pattern = v.to_le_bytes();
+            let mut data = bytes.clone();
+            let mut at = header;
+            let mut found = false;
+            while at + 8 <= data.len() {
+                if data[at..at + 8] == pattern {
+                    data[at..at + 8].copy_from_slice(&bad.to_le_bytes());
+                    found = true;
+                    at += 8;
+                } else {
+                    at += 1;
+                }
+            }
+            assert!(found, "{v} is in the bytes");
+            forged += 1;
+            match Saved::deserialize(fmu, &data) {
+                Ok(_) => panic!("{v} -> {bad}: the state was accepted"),
+                Err(e) => assert!(
+                    e.starts_with("invalid serialized state: "),
+                    "{v} -> {bad}: {e}"
+                ),
+            }
+        }
+        assert_eq!(forged, values.len());
     }
 
     #[test]

@@ -131,6 +131,14 @@ impl SceneKind {
             .map(|f| f.to_uppercase().chain(c).collect())
             .unwrap_or_default()
     }
+
+    /// The kind whose [`SceneKind::saved_key`] is `key`.
+    pub(crate) fn with_saved_key(key: &str) -> Option<SceneKind> {
+        registry::SCENES
+            .iter()
+            .map(|row| SceneKind::default_of_row(row))
+            .find(|k| k.saved_key() == key)
+    }
 }
 
 /// A complete, validated-on-demand description of one run: a kind of scene
@@ -200,10 +208,7 @@ impl<'de> Deserialize<'de> for Scene {
         let (Some((key, params)), None) = (entries.next(), entries.next()) else {
             return Err(D::Error::custom("a scene has the parameters of one kind"));
         };
-        let mut kind = registry::SCENES
-            .iter()
-            .map(|row| SceneKind::default_of_row(row))
-            .find(|k| k.saved_key() == key)
+        let mut kind = SceneKind::with_saved_key(&key)
             .ok_or_else(|| D::Error::custom(format!("unknown kind of scene `{key}`")))?;
         if let Some(choice) = saved.material {
             kind = kind.with_material(choice).map_err(D::Error::custom)?;

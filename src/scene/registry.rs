@@ -60,9 +60,19 @@ pub struct SceneRow {
     pub build: fn(&Scene) -> Result<Box<dyn Model>>,
     /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked
     /// afterwards ([`Model::check_restored`]).
-    pub restore: fn(serde_json::Value) -> std::result::Result<Box<dyn Model>, String>,
+    pub restore: fn(SavedSolver<'_, '_>) -> std::result::Result<Box<dyn Model>, String>,
     /// The FMU of this kind (of its default material choice), if it has one.
     pub fmu: Option<FmuIdentity>,
+}
+
+/// A solver's saved state as its row's `restore` reads it.
+pub enum SavedSolver<'a, 'de> {
+    /// In a self-describing format (JSON), through a type-erased
+    /// deserializer.
+    Serde(&'a mut dyn erased_serde::Deserializer<'de>),
+    /// The postcard bytes of [`crate::model::ModelState::save_compact`],
+    /// decoded by the solver's own type (no dynamic call per value).
+    Postcard(&'a [u8]),
 }
 
 /// Every FMU the registry declares, with the kind of scene (material choice
@@ -100,13 +110,19 @@ pub fn row(name: &str) -> Result<&'static SceneRow> {
 }
 
 /// [`SceneRow::restore`] for a solver type that serde restores whole.
-pub(crate) fn restore<T>(state: serde_json::Value) -> std::result::Result<Box<dyn Model>, String>
+pub(crate) fn restore<T>(state: SavedSolver<'_, '_>) -> std::result::Result<Box<dyn Model>, String>
 where
     T: Model + serde::de::DeserializeOwned,
 {
-    serde_json::from_value::<T>(state)
-        .map(|m| Box::new(m) as Box<dyn Model>)
-        .map_err(|e| e.to_string())
+    let solver = match state {
+        SavedSolver::Serde(d) => erased_serde::deserialize::<T>(d).map_err(|e| e.to_string())?,
+        SavedSolver::Postcard(bytes) => match postcard::take_from_bytes::<T>(bytes) {
+            Ok((solver, [])) => solver,
+            Ok((_, left)) => return Err(format!("{} bytes follow its solver", left.len())),
+            Err(e) => return Err(e.to_string()),
+        },
+    };
+    Ok(Box::new(solver))
 }
 
 /// No named variants.

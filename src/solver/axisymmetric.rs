@@ -46,7 +46,7 @@ use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Loading, Material, MaterialState, Point};
 use crate::neighbors::padded_rows;
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
-use crate::rod::{RodObservables, RodSets};
+use crate::rod::{self, RodSets};
 use crate::scene::taylor::TaylorParams;
 
 /// Smallest distance between two neighbouring particles (every pair, mirror
@@ -208,8 +208,8 @@ struct Tally {
 
 /// Buffers reused from step to step (no allocation in the time loop but when
 /// the neighbour lists are rebuilt). Not part of the state: rebuilt from the
-/// positions after a restore.
-#[derive(Debug, Clone, Default)]
+/// positions after a restore, and after a copy (see its `Clone`).
+#[derive(Debug, Default)]
 struct Workspace {
     /// Mirror images; image `k` has index `n + k`.
     images: Vec<Image>,
@@ -1496,24 +1496,43 @@ impl TaylorSolver {
 
     /// Current values of [`TAYLOR_OBSERVABLES`], in that order.
     pub fn observables(&self) -> Vec<f64> {
-        let rod = RodObservables::of(&self.rod_sets(), &self.pos, &self.vel, self.r0);
-        let values = [
-            rod.rod_length,
-            rod.mushroom_radius,
-            rod.undeformed_length,
-            rod.tail_velocity,
-            self.pos[0][1],
-            self.eps_p.iter().copied().fold(0.0, f64::max),
-            self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            self.kinetic_energy(),
-            self.internal_energy,
-            self.smoothing_dissipation,
-            self.contact_dissipation,
-            self.energy_error(),
-            if self.at_rest { 1.0 } else { 0.0 },
-        ];
-        debug_assert_eq!(values.len(), TAYLOR_OBSERVABLES.len());
-        values.to_vec()
+        (0..TAYLOR_OBSERVABLES.len())
+            .map(|k| self.observable(k).expect("one value per row of the table"))
+            .collect()
+    }
+
+    /// The current value of the `k`-th of [`TAYLOR_OBSERVABLES`] alone
+    /// (`None` past the table): the rod's length and the largest plastic
+    /// strain and temperature take one pass over the particles, the
+    /// kinetic energy and the energy error one sum; the others read the
+    /// face, the mantle generator, the tail or a total kept by the step.
+    /// Nothing is allocated; the bits are those of
+    /// [`TaylorSolver::observables`].
+    pub fn observable(&self, k: usize) -> Option<f64> {
+        Some(match TAYLOR_OBSERVABLES.get(k)?.name {
+            "rod_length" => rod::rod_length(&self.pos),
+            "mushroom_radius" => rod::mushroom_radius(&self.face.particles, &self.pos),
+            "undeformed_length" => {
+                rod::undeformed_length(&self.mantle.particles, &self.pos, self.r0)
+            }
+            "tail_velocity" => rod::tail_velocity((self.nz - 1) * self.nr, &self.vel),
+            "face_lift" => self.pos[0][1],
+            "max_plastic_strain" => self.eps_p.iter().copied().fold(0.0, f64::max),
+            "max_temperature" => self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            "kinetic_energy" => self.kinetic_energy(),
+            "internal_energy" => self.internal_energy,
+            "smoothing_dissipation" => self.smoothing_dissipation,
+            "contact_dissipation" => self.contact_dissipation,
+            "energy_error" => self.energy_error(),
+            "at_rest" => {
+                if self.at_rest {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            other => unreachable!("the Taylor observable `{other}` has no formula"),
+        })
     }
 
     /// The values of the particle field `name` (one of [`TAYLOR_FIELDS`]),
@@ -1582,8 +1601,21 @@ pub const TAYLOR_FIELDS: &[FieldSpec] = &[
     },
 ];
 
+/// A copy of a run (an FMU state got to roll back to) starts with empty
+/// buffers, as a restored run does, and rebuilds them at its next step with
+/// the same bits: at 10^6 particles the buffers are 1.5 GB, the state
+/// itself 0.14 GB (BENCHMARKS.md).
+impl Clone for Workspace {
+    fn clone(&self) -> Self {
+        Workspace::default()
+    }
+}
+
 impl crate::model::Model for TaylorSolver {
     crate::model::inherent_basics!();
+    fn observable(&self, k: usize) -> Option<f64> {
+        Self::observable(self, k)
+    }
     fn field_specs(&self) -> &'static [FieldSpec] {
         TAYLOR_FIELDS
     }

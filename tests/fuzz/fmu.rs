@@ -682,10 +682,12 @@ fn vr(name: &str) -> u32 {
         .vr
 }
 
-/// Mangles serialized bytes: a byte changed, a cut, a JSON leaf edited, a
-/// field replaced by a forged one (another run's simulation or scene, an
-/// impossible instance state, a hostile time) or a wrong header. Returns
-/// what was done.
+/// Mangles serialized bytes: a byte changed, a cut, a leaf of the typed
+/// state edited, a field replaced by a forged one (another run's simulation
+/// or scene, an impossible instance state, a hostile time) or a wrong
+/// header. The typed edits decode the state ([`fmi::Fmu::state_to_json`]),
+/// edit its JSON form and encode it again; an edit that the state's types
+/// cannot hold changes a byte instead. Returns what was done.
 fn corrupt(rng: &mut Rng, data: &mut Vec<u8>, sims: &[serde_json::Value]) -> String {
     let header = data
         .iter()
@@ -693,7 +695,8 @@ fn corrupt(rng: &mut Rng, data: &mut Vec<u8>, sims: &[serde_json::Value]) -> Str
         .filter(|(_, b)| **b == b'\n')
         .nth(1)
         .map_or(0, |(k, _)| k + 1);
-    let json: Option<serde_json::Value> = serde_json::from_slice(&data[header..]).ok();
+    let fmu = fmi::Fmu::named("TaylorImpact").unwrap();
+    let json = fmu.state_to_json(data).ok();
     let edit = match (rng.below(6), json) {
         (0, _) | (_, None) if !data.is_empty() => {
             let at = rng.below(data.len());
@@ -735,9 +738,17 @@ fn corrupt(rng: &mut Rng, data: &mut Vec<u8>, sims: &[serde_json::Value]) -> Str
         }
         _ => return "nothing to corrupt".into(),
     };
-    data.truncate(header);
-    data.extend(serde_json::to_vec(&edit.0).unwrap());
-    edit.1
+    match fmu.state_from_json(edit.0) {
+        Ok(bytes) => {
+            *data = bytes;
+            edit.1
+        }
+        Err(e) => {
+            let at = rng.below(data.len());
+            data[at] = rng.next() as u8;
+            format!("{} ({e}): byte {at} changed instead", edit.1)
+        }
+    }
 }
 
 /// One case: instantiate, up to [`CALLS`] random calls, free.
