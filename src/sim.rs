@@ -229,7 +229,9 @@ impl<'de> serde::Deserialize<'de> for Simulation {
         let saved = Saved::deserialize(deserializer)?;
         let kind = saved.scene.kind();
         let SolverState(solver_kind, solver) = saved.solver;
-        if solver_kind != kind {
+        // The key names the row; the material choice is the scene's, and
+        // the restore check holds the solver to it.
+        if solver_kind.saved_key() != kind.saved_key() {
             return Err(D::Error::custom(NOT_THE_SCENES));
         }
         Ok(Simulation {
