@@ -308,16 +308,13 @@ impl PlateImpact {
     /// One central-difference step of `dt`.
     pub fn step(&mut self, dt: f64) -> Result<()> {
         let n = self.state.len();
-        let mut force = vec![0.0; self.x.len()];
-        for c in 0..n {
-            let (a, b) = self.nodes(c);
-            force[a] += self.stress[c];
-            force[b] -= self.stress[c];
-        }
         let (f, t) = (self.flyer_cells, self.flyer_cells + 1);
         let closing = self.v[f] - self.v[t];
-        for i in 0..self.x.len() {
-            self.v[i] += force[i] / self.mass[i] * dt;
+        // Each cell pulls its two nodes (tension positive).
+        for c in 0..n {
+            let (a, b) = self.nodes(c);
+            self.v[a] += self.stress[c] / self.mass[a] * dt;
+            self.v[b] -= self.stress[c] / self.mass[b] * dt;
         }
         // The contact pair moves as one node while pressed together. Pairs
         // that met with different velocities collide inelastically: the
@@ -330,12 +327,6 @@ impl PlateImpact {
             self.v[t] = common;
             self.contact_loss += 0.5 * mf * mt / (mf + mt) * closing * closing;
         }
-        let old: Vec<f64> = (0..n)
-            .map(|c| {
-                let (a, b) = self.nodes(c);
-                self.x[b] - self.x[a]
-            })
-            .collect();
         for i in 0..self.x.len() {
             self.x[i] += self.v[i] * dt;
         }
@@ -351,7 +342,9 @@ impl PlateImpact {
                     position: self.x[a],
                 });
             }
-            let d = (self.v[b] - self.v[a]) / (0.5 * (old[c] + len));
+            // The length at the middle of the step: the cell grew by
+            // (v_b - v_a) dt.
+            let d = (self.v[b] - self.v[a]) / (len - 0.5 * (self.v[b] - self.v[a]) * dt);
             let rho = self.density0[c] * self.length0[c] / len;
             let load = Loading::<Full> {
                 dt,
