@@ -116,6 +116,11 @@ struct RunArgs {
     /// Write the observable time histories as CSV.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
+    /// Write the rod's final outline as CSV: axial position and radius (m) of
+    /// one generator of the mantle, from the impact face to the free end
+    /// (scenes with a rod).
+    #[arg(long, value_name = "FILE")]
+    profile: Option<PathBuf>,
     /// Directory for VTK (.vtu) particle snapshots.
     #[arg(long, value_name = "DIR")]
     vtk_dir: Option<PathBuf>,
@@ -300,6 +305,15 @@ fn run(a: RunArgs) -> Result<(), Stop> {
     if let Some(path) = &a.csv {
         check_output_file("--csv", path)?;
     }
+    if let Some(path) = &a.profile {
+        check_output_file("--profile", path)?;
+        if sim.rod_profile().is_none() {
+            return Err(Stop::failed(format!(
+                "--profile: scene `{}` has no rod to outline",
+                sim.kind().name()
+            )));
+        }
+    }
     if let Some(dir) = &a.vtk_dir {
         check_output_dir("--vtk-dir", dir, "particles.pvd")?;
     }
@@ -393,6 +407,11 @@ fn run(a: RunArgs) -> Result<(), Stop> {
     {
         failures.push(format!("--csv: {e}"));
     }
+    if let Some(path) = &a.profile
+        && let Err(e) = write_profile(path, &sim)
+    {
+        failures.push(format!("--profile: {e}"));
+    }
     if let Some(path) = &a.json {
         let json = observe::final_json(
             sim.observable_specs(),
@@ -412,6 +431,17 @@ fn run(a: RunArgs) -> Result<(), Stop> {
         print_summary(&sim, wall)
     };
     outcome(failures, printed)
+}
+
+/// The rod's outline as CSV (`z_m,r_m`, one row per point of the mantle's
+/// generator, from the impact face up).
+fn write_profile(path: &std::path::Path, sim: &Simulation) -> std::io::Result<()> {
+    use std::fmt::Write as _;
+    let mut text = String::from("z_m,r_m\n");
+    for [z, r] in sim.rod_profile().unwrap_or_default() {
+        let _ = writeln!(text, "{z:e},{r:e}");
+    }
+    std::fs::write(path, text)
 }
 
 /// The end of a command that attempted all its outputs: `failures` (one line
@@ -564,8 +594,10 @@ fn params(scene: &str, material: &MaterialArgs) -> Result<(), Stop> {
 }
 
 fn scenes() -> Result<(), Stop> {
-    for name in meshless_impact::scene::builtin_names() {
-        outln!("{:<12} {}", name, Scene::builtin(&name)?.title)?;
+    let names = meshless_impact::scene::builtin_names();
+    let width = names.iter().map(|n| n.len()).max().unwrap_or(0);
+    for name in names {
+        outln!("{:<width$} {}", name, Scene::builtin(&name)?.title)?;
     }
     Ok(())
 }

@@ -106,6 +106,13 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// Simulated time between two records of the observables' histories.
     fn record_interval(&self) -> f64;
 
+    /// The outline of a rod, `(axial, radius)` along one generator of its
+    /// mantle from the impact face to the free end ([`crate::rod::profile`]),
+    /// for the scenes that have a rod.
+    fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
+        None
+    }
+
     /// Smallest distance between neighbouring particles over the run so
     /// far, relative to the initial spacing, where the solver tracks it.
     fn min_spacing_ratio(&self) -> Option<f64> {

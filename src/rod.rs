@@ -109,6 +109,47 @@ pub fn tail_velocity<const D: usize>(tail: usize, vel: &[[f64; D]]) -> f64 {
     -axial(&vel[tail])
 }
 
+/// The rod's outline: `(axial, radius)` of each particle of the `mantle`
+/// generator, from the impact face to the free end.
+pub fn profile<const D: usize>(mantle: &[usize], pos: &[[f64; D]]) -> Vec<[f64; 2]> {
+    mantle
+        .iter()
+        .map(|&i| [axial(&pos[i]), radius(&pos[i])])
+        .collect()
+}
+
+/// The radius of an outline (as [`profile`] gives it, in increasing axial
+/// order) at height `z`, linear between its points; `None` outside it.
+pub fn profile_radius(outline: &[[f64; 2]], z: f64) -> Option<f64> {
+    outline.windows(2).find_map(|w| {
+        let ([z0, r0], [z1, r1]) = (w[0], w[1]);
+        (z0 <= z && z <= z1).then(|| {
+            if z1 > z0 {
+                r0 + (z - z0) / (z1 - z0) * (r1 - r0)
+            } else {
+                r0.max(r1)
+            }
+        })
+    })
+}
+
+/// How far the outline `a` lies from the outline `b`: the largest
+/// `|r_a(z) / r_b(z) − 1|` over `samples` heights spread evenly over the
+/// span the two share (their ends excluded, where one outline may hold a
+/// corner the other has just passed), and the heights' span. `None` when
+/// the outlines share no span.
+pub fn profile_deviation(a: &[[f64; 2]], b: &[[f64; 2]], samples: usize) -> Option<f64> {
+    let lo = a.first()?[0].max(b.first()?[0]);
+    let hi = a.last()?[0].min(b.last()?[0]);
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) || samples == 0 {
+        return None;
+    }
+    (1..=samples)
+        .map(|k| lo + (hi - lo) * k as f64 / (samples + 1) as f64)
+        .map(|z| Some((profile_radius(a, z)? / profile_radius(b, z)? - 1.0).abs()))
+        .try_fold(0.0f64, |m, d| Some(m.max(d?)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,5 +232,30 @@ mod tests {
         check::<3>();
         assert_eq!(radius(&[3.0, 4.0, -7.0]), 5.0);
         assert_eq!(radius(&[0.25, -7.0]), 0.25);
+    }
+
+    /// The outline of the bulged rod follows its mantle; the radius between
+    /// two points is the chord's; an outline 2 % wider everywhere deviates
+    /// by 2 %, and one that bulges only at the face by the bulge where the
+    /// samples meet it.
+    #[test]
+    fn outlines_interpolate_and_compare() {
+        let bulge = |k: usize| [0.3, 0.1, 0.001].get(k).copied().unwrap_or(0.0);
+        let (sets, pos) = rod::<3>(bulge);
+        let o = profile(&sets.mantle, &pos);
+        assert_eq!(o.len(), 21);
+        assert_eq!((o[0], o[20]), ([0.0, 1.3], [10.0, 1.0]));
+        // Between Z = 0 (1.3) and 0.5 (1.1): at 0.125, 1.3 - 0.25 * 0.2.
+        assert!((profile_radius(&o, 0.125).unwrap() - 1.25).abs() < 1e-15);
+        assert_eq!(profile_radius(&o, 10.5), None);
+        let wider: Vec<[f64; 2]> = o.iter().map(|&[z, r]| [z, 1.02 * r]).collect();
+        let d = profile_deviation(&wider, &o, 50).unwrap();
+        assert!((d - 0.02).abs() < 1e-14, "{d}");
+        // Against the straight rod: the largest bulge a sample meets. With
+        // 9 samples over (0, 10) the first is at Z = 1 (0.1 %).
+        let (_, straight) = rod::<3>(|_| 0.0);
+        let d = profile_deviation(&o, &profile(&sets.mantle, &straight), 9).unwrap();
+        assert!((d - 0.001).abs() < 1e-14, "{d}");
+        assert_eq!(profile_deviation(&o, &[[20.0, 1.0], [30.0, 1.0]], 9), None);
     }
 }

@@ -321,6 +321,13 @@ impl Simulation {
         self.error.as_ref()
     }
 
+    /// The rod's outline now, `(axial, radius)` from the impact face to the
+    /// free end along one generator of the mantle, for the scenes that have
+    /// a rod ([`crate::rod::profile`]).
+    pub fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
+        self.solver.rod_profile()
+    }
+
     /// Smallest distance between neighbouring particles over the run so far,
     /// relative to the initial spacing, where the solver tracks it (Taylor).
     pub fn min_spacing_ratio(&self) -> Option<f64> {

@@ -1207,6 +1207,9 @@ impl crate::model::Model for Mlpg3d {
     fn record_interval(&self) -> f64 {
         self.setup.cylinder.length / self.wave_speed() / 64.0
     }
+    fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
+        Some(crate::rod::profile(&self.lattice.sets.mantle, &self.pos))
+    }
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.min_spacing_ratio())
     }

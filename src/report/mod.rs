@@ -16,6 +16,7 @@ mod benchmarks;
 mod convergence;
 mod figures;
 pub mod plot;
+mod profiles;
 pub mod runner;
 mod sensitivity;
 mod stability;
@@ -281,6 +282,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     let (noh, noh_order) = convergence::noh(&plan, &mut doc)?;
     let (taylor, figure_run) = convergence::taylor(&plan, &mut doc)?;
     figures::test7(&plan, &mut doc, figure_run)?;
+    profiles::aisi310(&plan, &mut doc)?;
     sensitivity::smoothing(&plan, &mut doc)?;
     sensitivity::table1(&plan, &mut doc)?;
     let stability = stability::matrix(&plan, &mut doc)?;

@@ -606,7 +606,7 @@ mod tests {
                         )),
                         "{msg}"
                     );
-                    assert!(msg.ends_with("table1-12"), "{msg}");
+                    assert!(msg.ends_with("table1-12, taylor3d-aisi310"), "{msg}");
                 }
                 other => panic!("`{name}` accepted or refused oddly: {other:?}"),
             }
@@ -624,10 +624,16 @@ mod tests {
                     scene,
                     Scene::default_of(SceneKind::named("taylor3d").unwrap())
                 ),
-                _ => assert_eq!(scene, rows[k - 3].scene(), "{name}"),
+                3..15 => assert_eq!(scene, rows[k - 3].scene(), "{name}"),
+                _ => {
+                    assert_eq!(name, "taylor3d-aisi310");
+                    assert_eq!(scene.kind().name(), "taylor3d");
+                    assert_eq!(scene.get("yield_stress").unwrap(), 310.26e6);
+                    assert_eq!(scene.get("initial_diameter").unwrap(), 7.62e-3);
+                }
             }
         }
-        assert_eq!(builtin_names().len(), 15);
+        assert_eq!(builtin_names().len(), 16);
     }
 
     /// A `[material]` table chooses the models; the table then lists only

@@ -220,3 +220,52 @@ macro_rules! param_struct {
     };
 }
 pub(crate) use param_struct;
+
+/// Declares the parameter table of a scene for each material choice (its
+/// rows `before`, the block of the choice's models, its rows `after`;
+/// [`crate::material::choice::compose`]) as the four named constants, and
+/// `fn $pick(choice) -> &'static [ParamSpec]` that picks one.
+macro_rules! choice_tables {
+    (
+        $before:expr, $after:expr, $pick:ident;
+        $(#[$jl_meta:meta])* $jl:ident,
+        $(#[$bl_meta:meta])* $bl:ident,
+        $(#[$jm_meta:meta])* $jm:ident,
+        $(#[$bm_meta:meta])* $bm:ident $(,)?
+    ) => {
+        /// The length of the table of a choice.
+        const fn table_len(choice: $crate::material::choice::MaterialChoice) -> usize {
+            $before.len() + $crate::material::choice::block_len(choice) + $after.len()
+        }
+        $(#[$jl_meta])*
+        pub const $jl: &[$crate::scene::params::ParamSpec] = &$crate::material::choice::compose::<
+            { table_len($crate::material::choice::MaterialChoice::JOHNSON_COOK_LINEAR) },
+        >($before, $crate::material::choice::MaterialChoice::JOHNSON_COOK_LINEAR, $after);
+        $(#[$bl_meta])*
+        pub const $bl: &[$crate::scene::params::ParamSpec] = &$crate::material::choice::compose::<
+            { table_len($crate::material::choice::MaterialChoice::BILINEAR_LINEAR) },
+        >($before, $crate::material::choice::MaterialChoice::BILINEAR_LINEAR, $after);
+        $(#[$jm_meta])*
+        pub const $jm: &[$crate::scene::params::ParamSpec] = &$crate::material::choice::compose::<
+            { table_len($crate::material::choice::MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN) },
+        >($before, $crate::material::choice::MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN, $after);
+        $(#[$bm_meta])*
+        pub const $bm: &[$crate::scene::params::ParamSpec] = &$crate::material::choice::compose::<
+            { table_len($crate::material::choice::MaterialChoice::BILINEAR_MIE_GRUNEISEN) },
+        >($before, $crate::material::choice::MaterialChoice::BILINEAR_MIE_GRUNEISEN, $after);
+
+        /// The parameter table of a choice.
+        fn $pick(
+            choice: $crate::material::choice::MaterialChoice,
+        ) -> &'static [$crate::scene::params::ParamSpec] {
+            use $crate::material::choice::{EosKind::*, StrengthKind::*};
+            match (choice.strength, choice.eos) {
+                (JohnsonCook, Linear) => $jl,
+                (Bilinear, Linear) => $bl,
+                (JohnsonCook, MieGruneisen) => $jm,
+                (Bilinear, MieGruneisen) => $bm,
+            }
+        }
+    };
+}
+pub(crate) use choice_tables;

@@ -12,9 +12,9 @@
 //! `TaylorImpactBilinearMieGruneisen`.
 
 use super::Scene;
-use super::params::{ParamSpec, Range, param_struct};
+use super::params::{ParamSpec, Range, choice_tables, param_struct};
 use super::registry::{FmuIdentity, MaterialSlot, SceneRow, restore};
-use crate::material::choice::{MaterialChoice, Prefix, block_len, compose};
+use crate::material::choice::{MaterialChoice, Prefix};
 use crate::observe::TAYLOR_OBSERVABLES;
 use crate::solver::axisymmetric::TaylorSolver;
 
@@ -87,7 +87,7 @@ fn material_choice(s: &Scene) -> MaterialChoice {
 }
 
 /// The rod's speed and geometry: the rows before the material block.
-const BEFORE: &[ParamSpec] = &[
+pub(super) const BEFORE: &[ParamSpec] = &[
     spec(
         "impact_speed",
         "m/s",
@@ -149,16 +149,19 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(0.0, 1.0),
         "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper",
     ),
-    spec(
-        "end_time",
-        "s",
-        400.0e-6,
-        Range::closed(1.0e-9, 1.0),
-        "latest simulated time; the run normally ends earlier, when the rod is at rest",
-    ),
+    END_TIME,
 ];
 
-const fn spec(
+/// The end time of a rod scene.
+pub(super) const END_TIME: ParamSpec = spec(
+    "end_time",
+    "s",
+    400.0e-6,
+    Range::closed(1.0e-9, 1.0),
+    "latest simulated time; the run normally ends earlier, when the rod is at rest",
+);
+
+pub(super) const fn spec(
     name: &'static str,
     unit: &'static str,
     default: f64,
@@ -174,50 +177,19 @@ const fn spec(
     }
 }
 
-/// The length of the table of a choice.
-const fn len(choice: MaterialChoice) -> usize {
-    BEFORE.len() + block_len(choice) + AFTER.len()
-}
-
-/// The parameter table of the `taylor` scene with Johnson-Cook and the
-/// linear EOS (the default): speed and geometry, the material block, the
-/// numerical parameters. Defaults are House et al. test 7 with the 4340
-/// steel constants of Batra & Zhang (2008).
-pub const TAYLOR_PARAMS: &[ParamSpec] = &compose::<{ len(MaterialChoice::JOHNSON_COOK_LINEAR) }>(
-    BEFORE,
-    MaterialChoice::JOHNSON_COOK_LINEAR,
-    AFTER,
-);
-/// The table with bilinear strength and the linear EOS.
-pub const TAYLOR_BILINEAR_PARAMS: &[ParamSpec] = &compose::<{ len(MaterialChoice::BILINEAR_LINEAR) }>(
-    BEFORE,
-    MaterialChoice::BILINEAR_LINEAR,
-    AFTER,
-);
-/// The table with Johnson-Cook and Mie-Grüneisen.
-pub const TAYLOR_MIE_GRUNEISEN_PARAMS: &[ParamSpec] =
-    &compose::<{ len(MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN) }>(
-        BEFORE,
-        MaterialChoice::JOHNSON_COOK_MIE_GRUNEISEN,
-        AFTER,
-    );
-/// The table with bilinear strength and Mie-Grüneisen.
-pub const TAYLOR_BILINEAR_MIE_GRUNEISEN_PARAMS: &[ParamSpec] =
-    &compose::<{ len(MaterialChoice::BILINEAR_MIE_GRUNEISEN) }>(
-        BEFORE,
-        MaterialChoice::BILINEAR_MIE_GRUNEISEN,
-        AFTER,
-    );
-
-/// The parameter table of a choice.
-fn params_of(choice: MaterialChoice) -> &'static [ParamSpec] {
-    use crate::material::choice::{EosKind::*, StrengthKind::*};
-    match (choice.strength, choice.eos) {
-        (JohnsonCook, Linear) => TAYLOR_PARAMS,
-        (Bilinear, Linear) => TAYLOR_BILINEAR_PARAMS,
-        (JohnsonCook, MieGruneisen) => TAYLOR_MIE_GRUNEISEN_PARAMS,
-        (Bilinear, MieGruneisen) => TAYLOR_BILINEAR_MIE_GRUNEISEN_PARAMS,
-    }
+choice_tables! {
+    BEFORE, AFTER, params_of;
+    /// The parameter table of the `taylor` scene with Johnson-Cook and the
+    /// linear EOS (the default): speed and geometry, the material block, the
+    /// numerical parameters. Defaults are House et al. test 7 with the 4340
+    /// steel constants of Batra & Zhang (2008).
+    TAYLOR_PARAMS,
+    /// The table with bilinear strength and the linear EOS.
+    TAYLOR_BILINEAR_PARAMS,
+    /// The table with Johnson-Cook and Mie-Grüneisen.
+    TAYLOR_MIE_GRUNEISEN_PARAMS,
+    /// The table with bilinear strength and Mie-Grüneisen.
+    TAYLOR_BILINEAR_MIE_GRUNEISEN_PARAMS,
 }
 
 param_struct! {
@@ -286,7 +258,7 @@ mod tests {
         );
         for c in MaterialChoice::ALL {
             let t = params_of(c);
-            assert_eq!(t.len(), len(c));
+            assert_eq!(t.len(), table_len(c));
             assert_eq!(t[..3], *BEFORE);
             assert_eq!(t[t.len() - AFTER.len()..], *AFTER);
         }

@@ -1,94 +1,160 @@
 //! The `taylor3d` scene: House et al. test 7 in 3-D by the MLPG mixed
 //! method (seed 004, [`crate::mlpg`]): a rod of 4340 steel on the ring
 //! lattice striking a rigid smooth anvil, with the `taylor` scene's
-//! parameter and observable names (its material from the same
-//! [`TaylorSolver::material_of`]), `particles_radial` nodes across the
+//! parameter and observable names, the same choice of material models
+//! ([`crate::material::choice`]; no FMU of its own for the other choices
+//! yet), `particles_radial` nodes across the
 //! radius (axis and mantle included: `particles_radial − 1` rings, the
 //! spacing of a `taylor` run with the same value), and the MLPG solver's
 //! damping ratio.
 
 use super::Scene;
-use super::params::{Range, param_table};
-use super::registry::{SceneRow, no_variants, restore};
-use super::taylor::{TAYLOR_PARAMS, TaylorParams};
+use super::params::{ParamSpec, Range, choice_tables, param_struct};
+use super::registry::{MaterialSlot, SceneRow, restore};
+use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
+use crate::material::Material;
+use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
 use crate::mlpg::{Cylinder, lattice::NodeLattice};
 use crate::observe::TAYLOR3D_OBSERVABLES;
-use crate::solver::axisymmetric::TaylorSolver;
 
 /// The registry row of the `taylor3d` scene.
 pub static ROW: SceneRow = SceneRow {
     name: "taylor3d",
     title: "Taylor impact in 3-D by MLPG, House et al. test 7 (4340 steel, 181 m/s)",
     params: TAYLOR3D_PARAMS,
-    material: None,
+    material: Some(MaterialSlot {
+        default: MaterialChoice::JOHNSON_COOK_LINEAR,
+        params: params_of,
+        fmus: &[],
+    }),
     observables: TAYLOR3D_OBSERVABLES,
     reference: || super::table1::Table1Row::all()[6].reference(),
-    variants: no_variants,
-    check: |s| Taylor3dParams::from_values(s.values()).check_consistency(),
-    build: |s: &Scene| Ok(Box::new(Taylor3dParams::from_values(s.values()).build()?)),
+    variants,
+    check: |s| {
+        material_choice(s).check_consistency(Prefix::None, |n| s.get(n))?;
+        Taylor3dParams::of(s).check_consistency()
+    },
+    build: |s: &Scene| {
+        let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
+        Ok(Box::new(Taylor3dParams::of(s).build_with(material)?))
+    },
     restore: restore::<Mlpg3d>,
     fmu: None,
 };
 
-param_table! {
-    /// Parameters of the 3-D Taylor impact scene (SI units): the `taylor`
-    /// scene's names and defaults for the rod and its material, the
-    /// resolution, and the MLPG damping.
-    Taylor3dParams, TAYLOR3D_PARAMS {
-        impact_speed: "m/s" = 181.0, Range::closed(0.01, 2000.0),
-            "speed of the rod toward the anvil";
-        initial_length: "m" = 0.03797, Range::closed(1.0e-4, 10.0),
-            "rod length L0";
-        initial_diameter: "m" = 0.007595, Range::closed(1.0e-4, 10.0),
-            "rod diameter D0";
-        density: "kg/m3" = 7830.0, Range::closed(100.0, 1.0e5),
-            "reference mass density";
-        shear_modulus: "Pa" = 82.9e9, Range::closed(1.0e6, 1.0e14),
-            "shear modulus mu";
-        bulk_modulus: "Pa" = 169.1e9, Range::closed(1.0e6, 1.0e15),
-            "bulk modulus K of the linear EOS P = K(rho/rho0 - 1)";
-        specific_heat: "J/(kg.K)" = 460.0, Range::closed(1.0, 1.0e5),
-            "specific heat C";
-        taylor_quinney: "1" = 1.0, Range::closed(0.0, 1.0),
-            "Taylor-Quinney coefficient: the fraction of plastic work that becomes heat";
-        jc_a: "Pa" = 792.0e6, Range::closed(0.0, 1.0e11),
-            "Johnson-Cook a (initial yield stress)";
-        jc_b: "Pa" = 510.0e6, Range::closed(0.0, 1.0e11),
-            "Johnson-Cook b (hardening modulus)";
-        jc_n: "1" = 0.26, Range::open_closed(0.0, 5.0),
-            "Johnson-Cook n (hardening exponent)";
-        jc_c: "1" = 0.014, Range::closed(0.0, 1.0),
-            "Johnson-Cook c (strain-rate sensitivity)";
-        jc_m: "1" = 1.03, Range::open_closed(0.0, 10.0),
-            "Johnson-Cook m (thermal softening exponent)";
-        melt_temperature: "K" = 1293.0, Range::closed(1.0, 1.0e5),
-            "melting temperature T_M";
-        room_temperature: "K" = 293.0, Range::closed(1.0, 1.0e5),
-            "room temperature T_room";
-        initial_temperature: "K" = 293.0, Range::closed(1.0, 1.0e5),
-            "rod temperature at impact";
-        ref_strain_rate: "1/s" = 1.0, Range::closed(1.0e-6, 1.0e12),
-            "reference strain rate of Johnson-Cook";
-        particles_radial: "1" = 6.0, Range::integer(3.0, 60.0),
-            "nodes across the radius, axis and mantle included (rings + 1); axial spacing matches";
-        damping: "1" = DAMPING, Range::closed(0.0, 0.5),
-            "damping ratio at the highest frequency of the stiffness-proportional damping (README, 3-D MLPG)";
-        smoothing_coefficient: "1" = SMOOTHING, Range::closed(0.0, 0.5),
-            "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, 3-D MLPG)";
-        rebuild_strain: "1" = REBUILD_STRAIN, Range::closed(1.0e-4, 0.2),
-            "relative motion of neighbours past which the MLPG shapes, test spheres and traction operator are rebuilt";
-        end_time: "s" = 400.0e-6, Range::closed(1.0e-9, 1.0),
-            "latest simulated time; the run normally ends earlier, when the rod is at rest";
+/// The material models of a `taylor3d` scene.
+fn material_choice(s: &Scene) -> MaterialChoice {
+    s.kind()
+        .material()
+        .expect("the taylor3d scene has a material choice")
+}
+
+/// The numerical parameters and the end time: the rows after the material
+/// block.
+const AFTER: &[ParamSpec] = &[
+    spec(
+        "particles_radial",
+        "1",
+        6.0,
+        Range::integer(3.0, 60.0),
+        "nodes across the radius, axis and mantle included (rings + 1); axial spacing matches",
+    ),
+    spec(
+        "damping",
+        "1",
+        DAMPING,
+        Range::closed(0.0, 0.5),
+        "damping ratio at the highest frequency of the stiffness-proportional damping (README, 3-D MLPG)",
+    ),
+    spec(
+        "smoothing_coefficient",
+        "1",
+        SMOOTHING,
+        Range::closed(0.0, 0.5),
+        "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, 3-D MLPG)",
+    ),
+    spec(
+        "rebuild_strain",
+        "1",
+        REBUILD_STRAIN,
+        Range::closed(1.0e-4, 0.2),
+        "relative motion of neighbours past which the MLPG shapes, test spheres and traction operator are rebuilt",
+    ),
+    END_TIME,
+];
+
+choice_tables! {
+    BEFORE, AFTER, params_of;
+    /// Parameters of the 3-D Taylor impact scene with Johnson-Cook and the
+    /// linear EOS (the default; SI units): the `taylor` scene's names and
+    /// defaults for the rod and its material, the resolution, and the MLPG
+    /// damping, smoothing and rebuild strain.
+    TAYLOR3D_PARAMS,
+    /// The table with bilinear strength and the linear EOS.
+    TAYLOR3D_BILINEAR_PARAMS,
+    /// The table with Johnson-Cook and Mie-Grüneisen.
+    TAYLOR3D_MIE_GRUNEISEN_PARAMS,
+    /// The table with bilinear strength and Mie-Grüneisen.
+    TAYLOR3D_BILINEAR_MIE_GRUNEISEN_PARAMS,
+}
+
+/// The built-in variant `taylor3d-aisi310`: the seed's own 3-D Taylor case
+/// (004, section 5.1), the `aisi310_bilinear` preset at 300 m/s. The seed
+/// prints the rod as "length 12.7 cm, radius 76.2 cm", which cannot be a
+/// Taylor rod; **assumed** here: L0 = 12.7 mm and D0 = 7.62 mm (the
+/// misprint read as a length in mm and a diameter in mm). A rigid-plastic
+/// estimate stops that rod in about 35 µs; the seed shows its profile at
+/// 50 µs, which is the end time.
+pub fn variants() -> Vec<(String, Scene)> {
+    let mut s = Scene::builtin("taylor3d").expect("taylor3d is a built-in scene");
+    s.choose_material(None, None, Some("aisi310_bilinear"))
+        .expect("the aisi310_bilinear preset fits the taylor3d scene");
+    for (name, v) in [
+        ("impact_speed", 300.0),
+        ("initial_length", 0.0127),
+        ("initial_diameter", 0.00762),
+        ("end_time", 50.0e-6),
+    ] {
+        s.set(name, v).expect("a parameter of taylor3d, in range");
+    }
+    s.title = "The seed's 3-D Taylor impact (AISI 310, bilinear, 300 m/s): L0 = 12.7 mm, \
+               D0 = 7.62 mm (assumed; the seed misprints them), to 50 us"
+        .to_string();
+    s.reference = Default::default();
+    vec![("taylor3d-aisi310".to_string(), s)]
+}
+
+param_struct! {
+    /// The parameters of a 3-D Taylor run (SI units): those of
+    /// [`TAYLOR3D_PARAMS`]. A run of another material choice takes its
+    /// geometry and numerical parameters from here and its material from
+    /// the scene's material block; the other material fields then keep
+    /// their defaults and are not used.
+    Taylor3dParams, TAYLOR3D_PARAMS, {
+        impact_speed, initial_length, initial_diameter, density, shear_modulus,
+        bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
+        melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
+        particles_radial, damping, smoothing_coefficient, rebuild_strain, end_time,
     }
 }
 
 impl Taylor3dParams {
+    /// The parameters of a `taylor3d` scene, any material choice: every
+    /// row of its table that is a field here, the others at their defaults.
+    pub fn of(scene: &Scene) -> Taylor3dParams {
+        let mut p = Taylor3dParams::default();
+        for (spec, v) in scene.param_specs().iter().zip(scene.values()) {
+            p.set(spec.name, *v);
+        }
+        p
+    }
+
     /// The `taylor` parameters of the same names (its own defaults for the
-    /// rest), from which the material and the checks follow.
+    /// rest).
     pub fn taylor(&self) -> TaylorParams {
         let mut p = TaylorParams::default();
-        for s in TAYLOR_PARAMS {
+        for s in super::taylor::TAYLOR_PARAMS {
             if let Some(v) = self.get(s.name) {
                 p.set(s.name, v);
             }
@@ -96,10 +162,22 @@ impl Taylor3dParams {
         p
     }
 
-    /// The `taylor` scene's cross-parameter checks (temperatures, nodes
-    /// along the axis at the matched spacing).
+    /// The geometric check of the `taylor` scene (nodes along the axis at
+    /// the matched spacing; the material's are
+    /// [`MaterialChoice::check_consistency`]).
     pub fn check_consistency(&self) -> crate::Result<()> {
         self.taylor().check_consistency()
+    }
+
+    /// The material of the default choice (Johnson-Cook, linear EOS) from
+    /// these fields.
+    pub fn material(&self) -> Material {
+        MaterialChoice::JOHNSON_COOK_LINEAR
+            .material(Prefix::None, |name| {
+                self.get(name)
+                    .ok_or_else(|| crate::Error::Inconsistent(format!("no parameter {name}")))
+            })
+            .expect("Taylor3dParams has every parameter of Johnson-Cook and the linear EOS")
     }
 
     /// The rod and the numerical choices.
@@ -119,9 +197,15 @@ impl Taylor3dParams {
         s
     }
 
-    /// The run at the instant of impact.
+    /// The run at the instant of impact, of the default material choice.
     pub fn build(&self) -> crate::Result<Mlpg3d> {
-        Mlpg3d::new(self.setup(), TaylorSolver::material_of(&self.taylor()))
+        self.build_with(self.material())
+    }
+
+    /// The run at the instant of impact, of `material` (whose reference
+    /// density sets the node masses).
+    pub fn build_with(&self, material: Material) -> crate::Result<Mlpg3d> {
+        Mlpg3d::new(self.setup(), material)
     }
 
     /// The lattice the run would use.
@@ -129,4 +213,35 @@ impl Taylor3dParams {
         let s = self.setup();
         NodeLattice::cylinder(s.cylinder, s.rings)
     }
+}
+
+/// The `taylor` scene of a `taylor3d` scene: the same rod, speed, material
+/// choice and constants and end time, for the axisymmetric MSPH solver at
+/// `particles_radial` across the radius (its own numerical defaults: the
+/// two solvers' other numerical parameters differ in meaning).
+pub fn axisymmetric_twin(s: &Scene, particles_radial: f64) -> crate::Result<Scene> {
+    let choice = match s.kind().material() {
+        Some(c) if s.kind().name() == ROW.name => c,
+        _ => {
+            return Err(crate::Error::Inconsistent(format!(
+                "scene `{}` is not a taylor3d scene",
+                s.kind().name()
+            )));
+        }
+    };
+    let mut twin = Scene::builtin("taylor")?;
+    twin.set_material(choice)?;
+    let material = choice.param_specs(Prefix::None);
+    for spec in s.param_specs() {
+        let shared = BEFORE.iter().any(|b| b.name == spec.name)
+            || material.iter().any(|m| m.name == spec.name)
+            || spec.name == "end_time";
+        if shared {
+            twin.set(spec.name, s.get(spec.name)?)?;
+        }
+    }
+    twin.set("particles_radial", particles_radial)?;
+    twin.title = format!("{} (axisymmetric MSPH twin)", s.title);
+    twin.reference = s.reference.clone();
+    Ok(twin)
 }

@@ -1623,6 +1623,9 @@ impl crate::model::Model for TaylorSolver {
     fn record_interval(&self) -> f64 {
         self.p.initial_length / self.wave_speed() / 64.0
     }
+    fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
+        Some(crate::rod::profile(&self.rod_sets().mantle, &self.pos))
+    }
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.min_spacing_ratio())
     }
