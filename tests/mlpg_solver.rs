@@ -6,6 +6,7 @@ use meshless_impact::material::bilinear::Bilinear;
 use meshless_impact::material::eos::LinearEos;
 use meshless_impact::material::{Damage, Eos, Material, Strength};
 use meshless_impact::mlpg::{Cylinder, Mlpg3d, RodSetup};
+use meshless_impact::Scene;
 
 /// House test 7's 4340 steel constants (Pa, kg/m³).
 const K: f64 = 169.1e9;
@@ -229,17 +230,36 @@ fn one_thread_and_two_give_the_same_bits() {
 }
 
 /// Exploration: `taylor3d` at its defaults but without the velocity
-/// smoothing until it stops; prints the closest pair of nodes with their
-/// reference places.
+/// smoothing until it stops (or the scene file `MI_SCENE_FILE` with its own
+/// settings, `--set`-like overrides in `MI_SET`, "name=value,..."); prints
+/// the closest pair of nodes with their reference places.
 #[test]
 #[ignore = "exploration"]
 fn explore_taylor3d_stop() {
     use meshless_impact::scene::taylor3d::Taylor3dParams;
-    let p = Taylor3dParams {
-        smoothing_coefficient: 0.0,
-        ..Taylor3dParams::default()
+    let mut s = match std::env::var("MI_SCENE_FILE") {
+        Ok(path) => {
+            let mut scene = Scene::from_file(&path).unwrap();
+            for kv in std::env::var("MI_SET").unwrap_or_default().split(',') {
+                if let Some((k, v)) = kv.split_once('=') {
+                    scene.set(k, v.parse().unwrap()).unwrap();
+                }
+            }
+            let choice = scene.kind().material().unwrap();
+            let material = choice
+                .material(meshless_impact::material::choice::Prefix::None, |n| {
+                    scene.get(n)
+                })
+                .unwrap();
+            Taylor3dParams::of(&scene).build_with(material).unwrap()
+        }
+        Err(_) => Taylor3dParams {
+            smoothing_coefficient: 0.0,
+            ..Taylor3dParams::default()
+        }
+        .build()
+        .unwrap(),
     };
-    let mut s = p.build().unwrap();
     let err = loop {
         if s.finished() {
             break None;
