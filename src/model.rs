@@ -21,7 +21,7 @@ pub trait ModelState {
 
     /// The run's state in postcard, encoded by its own type (no dynamic
     /// call per value): what the FMU state holds, restored by its row's
-    /// `restore` from [`crate::scene::registry::SavedSolver::Postcard`].
+    /// `restore` from `SavedSolver::Postcard` (`src/scene/registry.rs`).
     fn save_compact(&self) -> Vec<u8>;
 
     /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s

@@ -2,10 +2,8 @@
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
-use meshless_impact::material::bilinear::Bilinear;
-use meshless_impact::material::eos::LinearEos;
-use meshless_impact::material::{Damage, Eos, Material, Strength};
-use meshless_impact::mlpg::{Cylinder, Mlpg3d, RodSetup};
+use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup};
+use meshless_impact::materials::{Bilinear, Damage, Eos, LinearEos, Material, Strength};
 
 /// House test 7's 4340 steel constants (Pa, kg/m³).
 const K: f64 = 169.1e9;
@@ -173,7 +171,7 @@ fn elastic_rebound(rings: usize, smoothing: f64) -> (Mlpg3d, [f64; 2]) {
 #[test]
 fn elastic_wave_speed_and_rebound() {
     let cbar = (youngs() / RHO).sqrt();
-    let (smoothed, _) = elastic_rebound(5, meshless_impact::mlpg::solver::SMOOTHING);
+    let (smoothed, _) = elastic_rebound(5, meshless_impact::internals::mlpg::SMOOTHING);
     println!(
         "default smoothing: contact / (2 L0 / c_bar) - 1 = {:.3e}, energy error {:.3e}",
         smoothed.last_release() / (2.0 * ROD.length / cbar) - 1.0,
@@ -234,7 +232,7 @@ fn one_thread_and_two_give_the_same_bits() {
 #[test]
 #[ignore = "exploration"]
 fn explore_taylor3d_stop() {
-    use meshless_impact::scene::taylor3d::Taylor3dParams;
+    use meshless_impact::Taylor3dParams;
     let p = Taylor3dParams {
         smoothing_coefficient: 0.0,
         ..Taylor3dParams::default()

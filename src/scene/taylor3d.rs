@@ -11,8 +11,8 @@ use super::Scene;
 use super::params::{Range, param_table};
 use super::registry::{SceneRow, no_variants, restore};
 use super::taylor::{TAYLOR_PARAMS, TaylorParams};
+use crate::mlpg::Cylinder;
 use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
-use crate::mlpg::{Cylinder, lattice::NodeLattice};
 use crate::observe::TAYLOR3D_OBSERVABLES;
 use crate::solver::axisymmetric::TaylorSolver;
 
@@ -103,7 +103,7 @@ impl Taylor3dParams {
     }
 
     /// The rod and the numerical choices.
-    pub fn setup(&self) -> RodSetup {
+    pub(crate) fn setup(&self) -> RodSetup {
         let mut s = RodSetup::new(
             Cylinder {
                 radius: 0.5 * self.initial_diameter,
@@ -119,14 +119,10 @@ impl Taylor3dParams {
         s
     }
 
-    /// The run at the instant of impact.
+    /// The run at the instant of impact. Its type is not part of the
+    /// public API (the tests reach it through `internals`).
+    #[doc(hidden)]
     pub fn build(&self) -> crate::Result<Mlpg3d> {
         Mlpg3d::new(self.setup(), TaylorSolver::material_of(&self.taylor()))
-    }
-
-    /// The lattice the run would use.
-    pub fn lattice(&self) -> NodeLattice {
-        let s = self.setup();
-        NodeLattice::cylinder(s.cylinder, s.rings)
     }
 }
