@@ -6,9 +6,7 @@
 //! `cargo bench --bench solver`; figures in BENCHMARKS.md.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use meshless_impact::kernel::kernel2;
-use meshless_impact::msph::{Neighbourhood, Row2};
-use meshless_impact::neighbors::{cell_list, naive, padded_rows};
+use meshless_impact::internals::{Neighbourhood, Row2, cell_list, kernel2, naive, padded_rows};
 use meshless_impact::{Scene, Simulation};
 use std::hint::black_box;
 
@@ -51,7 +49,7 @@ fn kernel(c: &mut Criterion) {
         },
     );
     let mut hood = Neighbourhood::with_capacity(s.len());
-    let mut wr = vec![0.0; s.len().next_multiple_of(meshless_impact::lanes::W)];
+    let mut wr = vec![0.0; s.len().next_multiple_of(meshless_impact::internals::W)];
     let mut wz = wr.clone();
     let mut wk = wr.clone();
     let name = format!("msph moments + solve + weights ({} pairs)", s.len());

@@ -9,6 +9,8 @@ echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --all-targets --release -- -D warnings
+# The library and the program without the report (cargo feature `report`).
+cargo clippy --all-targets --release --no-default-features -- -D warnings
 echo "== cargo doc (broken or private links fail)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 echo "== cargo test (release)"

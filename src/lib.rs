@@ -1,9 +1,10 @@
 //! # meshless-impact
 //!
-//! A meshless particle solver for high-speed impact of solids. This release
-//! implements the axisymmetric Modified SPH (MSPH) method of Batra & Zhang
-//! (2008): the Taylor rod impact test with Johnson-Cook thermo-viscoplasticity,
-//! and the cylindrical Noh problem.
+//! A meshless particle solver for high-speed impact of solids: the
+//! axisymmetric Modified SPH (MSPH) method of Batra & Zhang (2008) for the
+//! Taylor rod impact test with Johnson-Cook thermo-viscoplasticity and the
+//! cylindrical Noh problem, the 3-D MLPG mixed method (`taylor3d`), and plate
+//! impact in uniaxial strain.
 //!
 //! ```no_run
 //! use meshless_impact::{Scene, Simulation};
@@ -14,6 +15,45 @@
 //! println!("final length {} m", sim.observable("rod_length").unwrap());
 //! # Ok::<(), meshless_impact::Error>(())
 //! ```
+//!
+//! ## The public API
+//!
+//! The crate's modules are private: the API is what this page re-exports.
+//!
+//! - Running: [`Scene`] (a kind of scene, [`SceneKind`], with a value for
+//!   each of its parameters), [`builtin_names`], [`Simulation`] and its
+//!   [`Progress`], [`Isa`] (the compiled copy of the hot loops to use).
+//! - Parameters: [`ParamSpec`] and [`Range`]; typed views of a scene's
+//!   parameters, [`TaylorParams`], [`NohParams`] and [`Taylor3dParams`];
+//!   [`Table1Row`], a row of House et al.'s Table 1.
+//! - Results: [`ObservableSpec`] (with the tables [`TAYLOR_OBSERVABLES`] and
+//!   [`NOH_OBSERVABLES`]), [`History`], [`Snapshot`], [`Field`],
+//!   [`FieldSpec`], [`write_pvd`]; a rod's outline
+//!   ([`Simulation::rod_profile`]) read at a height ([`profile_radius`]) and
+//!   compared with another ([`profile_deviation`]), as the 3-D Taylor run
+//!   with its axisymmetric twin ([`axisymmetric_twin`]).
+//! - Errors: [`Error`] (with [`MomentMethod`]) and [`Result`].
+//! - The interface every solver implements: [`Model`], [`ModelState`].
+//! - Plate impact in uniaxial strain: [`PlateImpact`] of [`Layer`]s.
+//! - [`materials`]: the models a [`materials::Material`] is composed of
+//!   (equation of state, strength, damage), their choice by name, the
+//!   presets, and the Rajendran-Grove ceramic.
+//! - [`VERSION`].
+//!
+//! The C ABI (`mi_*`, `include/meshless_impact.h`) and the FMI 3.0 / 2.0
+//! functions are symbols of the `cdylib` and `staticlib`, not Rust API.
+//!
+//! The module `internals`, hidden from this documentation, re-exports what
+//! the integration tests, the benchmarks and `xtask` reach inside the crate
+//! for (the C ABI and the FMI glue as Rust functions, the kernel, the
+//! neighbour search, MSPH and MLPG parts, solver constants). It is **not**
+//! part of the public API and may change in any release.
+//!
+//! The verification report (`meshless-impact report`) belongs to the
+//! program, not to the library. It and its plotting dependency are the cargo
+//! feature `report`, on by default; a library user who wants no plotting
+//! crates depends with `default-features = false` (the library's API is the
+//! same either way).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 // Index loops over fixed-size arrays read more clearly in numerical kernels.
@@ -21,34 +61,91 @@
 
 // The C ABI and the FMI glue are the only places with unsafe code.
 #[allow(unsafe_code)]
-pub mod capi;
-pub mod error;
+mod capi;
+mod error;
 #[allow(unsafe_code)]
-pub mod fmi;
-pub mod isa;
-pub mod kernel;
-pub mod lanes;
-pub mod material;
-pub mod mlpg;
-pub mod model;
-pub mod msph;
-pub mod neighbors;
-pub mod observe;
-pub mod report;
-pub mod rod;
-pub mod scene;
+mod fmi;
+mod isa;
+mod kernel;
+mod lanes;
+mod material;
+mod mlpg;
+mod model;
+mod msph;
+mod neighbors;
+mod observe;
+mod rod;
+mod scene;
 mod sim;
-pub mod solver;
-pub mod uniaxial;
+mod solver;
+mod uniaxial;
 
-pub use error::{Error, Result};
+pub use error::{Error, MomentMethod, Result};
 pub use isa::Isa;
 pub use model::{Model, ModelState};
-pub use observe::{Field, History, NOH_OBSERVABLES, ObservableSpec, Snapshot, TAYLOR_OBSERVABLES};
+pub use observe::{
+    Field, FieldSpec, History, NOH_OBSERVABLES, ObservableSpec, Snapshot, TAYLOR_OBSERVABLES,
+    write_pvd,
+};
+pub use rod::{profile_deviation, profile_radius};
+pub use scene::noh::NohParams;
 pub use scene::params::{ParamSpec, Range};
 pub use scene::table1::Table1Row;
-pub use scene::{Scene, SceneKind};
+pub use scene::taylor::TaylorParams;
+pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
+pub use scene::{Scene, SceneKind, builtin_names};
 pub use sim::{Progress, Simulation};
+pub use uniaxial::{Layer, PlateImpact};
+
+/// Material models and their composition into a [`Material`](materials::Material):
+/// an equation of state ([`Eos`](materials::Eos)), a strength model
+/// ([`Strength`](materials::Strength)) and a damage model
+/// ([`Damage`](materials::Damage)); the models by name
+/// ([`MaterialChoice`](materials::MaterialChoice)) and the named materials
+/// ([`PRESETS`](materials::PRESETS)); the Rajendran-Grove ceramic at a
+/// material point, with its state ([`CeramicPoint`](materials::CeramicPoint)).
+pub mod materials {
+    pub use crate::material::bilinear::Bilinear;
+    pub use crate::material::choice::{EosKind, MaterialChoice, Prefix, StrengthKind};
+    pub use crate::material::eos::LinearEos;
+    pub use crate::material::ideal_gas::IdealGas;
+    pub use crate::material::johnson_cook::JohnsonCook;
+    pub use crate::material::mie_gruneisen::{CompressionLimit, MieGruneisen};
+    pub use crate::material::presets::{PRESETS, Preset};
+    pub use crate::material::rajendran_grove::{CeramicPoint, Pulverized, RajendranGrove};
+    pub use crate::material::{Damage, Eos, Material, Strength};
+}
+
+/// **Not part of the public API**, and may change in any release: what the
+/// integration tests, the benchmarks and `xtask` reach inside the crate for.
+#[doc(hidden)]
+pub mod internals {
+    /// The C ABI, as C calls it.
+    pub mod capi {
+        pub use crate::capi::*;
+    }
+    /// The FMI glue, as hosts call it, and the model description.
+    pub mod fmi {
+        pub use crate::fmi::*;
+    }
+    /// The 3-D MLPG method's parts.
+    pub mod mlpg {
+        pub use crate::mlpg::mls::distance;
+        pub use crate::mlpg::solver::SMOOTHING;
+        pub use crate::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
+        pub use crate::mlpg::step::{OMEGA_FACTOR, largest_eigenvalue, stable_step};
+        pub use crate::mlpg::weak::VOIGT;
+        pub use crate::mlpg::{
+            Cylinder, Mlpg3d, NodalShapes, NodeLattice, RodSetup, SphereRule, SupportParams,
+            Supports, TestSphere, TractionOperator,
+        };
+    }
+    pub use crate::kernel::kernel2;
+    pub use crate::lanes::W;
+    pub use crate::msph::{Neighbourhood, Row2};
+    pub use crate::neighbors::{cell_list, naive, padded_rows};
+    pub use crate::solver::axisymmetric::{SPACING_COLLAPSE_BOUND, TaylorSolver};
+}
 
 /// The library version (the crate version).
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

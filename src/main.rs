@@ -2,12 +2,17 @@
 
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use meshless_impact::{Error, Isa, Scene, Simulation, Table1Row, observe};
+use meshless_impact::{Error, Isa, ObservableSpec, Scene, Simulation, Table1Row};
 use rayon::prelude::*;
 use std::fs::{File, OpenOptions};
 use std::io::{ErrorKind, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+// The verification report, with its plotting dependency, is the program's
+// alone: the library knows nothing of it. Cargo feature `report` (default).
+#[cfg(feature = "report")]
+mod report;
 
 /// Meshless (MSPH) solver for high-speed impact of solids.
 ///
@@ -327,7 +332,7 @@ fn run(a: RunArgs) -> Result<(), Stop> {
             let name = format!("particles_{:04}.vtu", written.len());
             sim.snapshot().write_vtu(&dir.join(&name))?;
             written.push((sim.time(), name));
-            observe::write_pvd(&dir.join("particles.pvd"), written)?;
+            meshless_impact::write_pvd(&dir.join("particles.pvd"), written)?;
         }
         Ok(())
     };
@@ -413,7 +418,7 @@ fn run(a: RunArgs) -> Result<(), Stop> {
         failures.push(format!("--profile: {e}"));
     }
     if let Some(path) = &a.json {
-        let json = observe::final_json(
+        let json = final_json(
             sim.observable_specs(),
             &sim.observables(),
             sim.particles(),
@@ -421,7 +426,7 @@ fn run(a: RunArgs) -> Result<(), Stop> {
             sim.time(),
             wall,
         );
-        if let Err(e) = observe::write_json(path, &json) {
+        if let Err(e) = write_json(path, &json) {
             failures.push(format!("--json: {e}"));
         }
     }
@@ -556,9 +561,10 @@ fn print_summary(sim: &Simulation, wall: f64) -> Result<(), Stop> {
     Ok(())
 }
 
+#[cfg(feature = "report")]
 fn report(out: PathBuf, quick: bool) -> Result<(), Stop> {
     check_output_dir("--out", &out, "index.md")?;
-    let r = meshless_impact::report::generate(&meshless_impact::report::ReportOptions {
+    let r = report::generate(&report::ReportOptions {
         out: out.clone(),
         quick,
     })?;
@@ -568,6 +574,13 @@ fn report(out: PathBuf, quick: bool) -> Result<(), Stop> {
         r.files.len(),
         r.wall_s
     )
+}
+
+#[cfg(not(feature = "report"))]
+fn report(_out: PathBuf, _quick: bool) -> Result<(), Stop> {
+    Err(Stop::failed(
+        "this program was built without the report (cargo feature `report`)".into(),
+    ))
 }
 
 fn params(scene: &str, material: &MaterialArgs) -> Result<(), Stop> {
@@ -594,7 +607,7 @@ fn params(scene: &str, material: &MaterialArgs) -> Result<(), Stop> {
 }
 
 fn scenes() -> Result<(), Stop> {
-    let names = meshless_impact::scene::builtin_names();
+    let names = meshless_impact::builtin_names();
     let width = names.iter().map(|n| n.len()).max().unwrap_or(0);
     for name in names {
         outln!("{:<width$} {}", name, Scene::builtin(&name)?.title)?;
@@ -603,12 +616,12 @@ fn scenes() -> Result<(), Stop> {
 }
 
 fn materials() -> Result<(), Stop> {
-    use meshless_impact::material::presets::PRESETS;
+    use meshless_impact::materials::{PRESETS, Prefix};
     for p in PRESETS {
         outln!("{:<24} {}", p.name, p.choice)?;
         let values: Vec<String> = p
             .choice
-            .param_specs(meshless_impact::material::choice::Prefix::None)
+            .param_specs(Prefix::None)
             .iter()
             .map(|spec| {
                 let v = p
@@ -831,4 +844,37 @@ fn write_csv_records(out: &Path, header: &[&str], records: &[Vec<String>]) -> Re
         w.write_record(rec).map_err(|e| Error::io(out, e))?;
     }
     w.flush().map_err(|e| Error::io(out, e))
+}
+
+/// Final values of a run as a JSON object: every observable by name, plus
+/// `particles`, `steps`, `end_time` and `wall_time_s`.
+fn final_json(
+    specs: &[ObservableSpec],
+    values: &[f64],
+    particles: usize,
+    steps: u64,
+    end_time: f64,
+    wall_time_s: f64,
+) -> serde_json::Value {
+    let mut m = serde_json::Map::new();
+    for (s, v) in specs.iter().zip(values) {
+        let val = if s.is_bool() {
+            serde_json::Value::Bool(*v != 0.0)
+        } else {
+            serde_json::json!(v)
+        };
+        m.insert(s.name.to_string(), val);
+    }
+    m.insert("particles".into(), particles.into());
+    m.insert("steps".into(), steps.into());
+    m.insert("end_time".into(), serde_json::json!(end_time));
+    m.insert("wall_time_s".into(), serde_json::json!(wall_time_s));
+    serde_json::Value::Object(m)
+}
+
+/// Writes a JSON value to a file, pretty-printed.
+fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), Error> {
+    let mut f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    serde_json::to_writer_pretty(&mut f, value).map_err(|e| Error::io(path, e))?;
+    writeln!(f).map_err(|e| Error::io(path, e))
 }

@@ -21,7 +21,7 @@ pub trait ModelState {
 
     /// The run's state in postcard, encoded by its own type (no dynamic
     /// call per value): what the FMU state holds, restored by its row's
-    /// `restore` from [`crate::scene::registry::SavedSolver::Postcard`].
+    /// `restore` from `SavedSolver::Postcard` (`src/scene/registry.rs`).
     fn save_compact(&self) -> Vec<u8>;
 
     /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s
@@ -107,7 +107,7 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     fn record_interval(&self) -> f64;
 
     /// The outline of a rod, `(axial, radius)` along one generator of its
-    /// mantle from the impact face to the free end ([`crate::rod::profile`]),
+    /// mantle from the impact face to the free end,
     /// for the scenes that have a rod.
     fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
         None

@@ -108,7 +108,7 @@ pub fn cell_list_first<const D: usize>(
     NeighborList { offsets, indices }
 }
 
-/// The neighbour lists of [`cell_list_first`] written straight into rows of
+/// The neighbour lists of `cell_list_first` written straight into rows of
 /// a fixed length: the neighbours of point `i` are
 /// `rows[i * stride..][..len[i]]`, ascending, and `stride` is the longest
 /// list rounded up to a multiple of `align`. The buffers are reused; a first

@@ -312,36 +312,3 @@ pub fn write_pvd(path: &Path, snapshots: &[(f64, String)]) -> Result<()> {
     writeln!(f).map_err(|e| Error::io(path, e))?;
     f.flush().map_err(|e| Error::io(path, e))
 }
-
-/// Final values of a run as a JSON object: every observable by name, plus
-/// `particles`, `steps`, `end_time` and `wall_time_s`.
-pub fn final_json(
-    specs: &[ObservableSpec],
-    values: &[f64],
-    particles: usize,
-    steps: u64,
-    end_time: f64,
-    wall_time_s: f64,
-) -> serde_json::Value {
-    let mut m = serde_json::Map::new();
-    for (s, v) in specs.iter().zip(values) {
-        let val = if s.is_bool() {
-            serde_json::Value::Bool(*v != 0.0)
-        } else {
-            serde_json::json!(v)
-        };
-        m.insert(s.name.to_string(), val);
-    }
-    m.insert("particles".into(), particles.into());
-    m.insert("steps".into(), steps.into());
-    m.insert("end_time".into(), serde_json::json!(end_time));
-    m.insert("wall_time_s".into(), serde_json::json!(wall_time_s));
-    serde_json::Value::Object(m)
-}
-
-/// Writes a JSON value to a file, pretty-printed.
-pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
-    let mut f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    serde_json::to_writer_pretty(&mut f, value).map_err(|e| Error::io(path, e))?;
-    writeln!(f).map_err(|e| Error::io(path, e))
-}

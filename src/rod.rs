@@ -118,7 +118,7 @@ pub fn profile<const D: usize>(mantle: &[usize], pos: &[[f64; D]]) -> Vec<[f64; 
         .collect()
 }
 
-/// The radius of an outline (as [`profile`] gives it, in increasing axial
+/// The radius of an outline (as `profile` gives it, in increasing axial
 /// order) at height `z`, linear between its points; `None` outside it.
 pub fn profile_radius(outline: &[[f64; 2]], z: f64) -> Option<f64> {
     outline.windows(2).find_map(|w| {

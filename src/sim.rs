@@ -323,7 +323,7 @@ impl Simulation {
 
     /// The rod's outline now, `(axial, radius)` from the impact face to the
     /// free end along one generator of the mantle, for the scenes that have
-    /// a rod ([`crate::rod::profile`]).
+    /// a rod.
     pub fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
         self.solver.rod_profile()
     }

@@ -8,8 +8,8 @@
 //! BENCHMARKS.md; it uses only the C functions, so the same file measures
 //! older builds too.
 
-use meshless_impact::capi::*;
-use meshless_impact::fmi::{Fmu, VarKind, fmi3::*};
+use meshless_impact::internals::capi::*;
+use meshless_impact::internals::fmi::{Fmu, VarKind, fmi3::*};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::ffi::{CString, c_void};

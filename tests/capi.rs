@@ -3,7 +3,7 @@
 //! bit-identical to the Rust API, every result code is produced, buffers
 //! follow the documented convention, and handles run on separate threads.
 
-use meshless_impact::capi::*;
+use meshless_impact::internals::capi::*;
 use meshless_impact::{Scene, Simulation};
 use std::ffi::{CStr, CString, c_void};
 use std::ptr::{null, null_mut};
@@ -855,7 +855,7 @@ fn only_the_documented_scene_names_are_accepted() {
         assert_eq!(n.to_str().unwrap(), "MI_UNKNOWN_SCENE");
         assert_eq!(d.to_str().unwrap(), "unknown scene name");
     }
-    let names = meshless_impact::scene::builtin_names();
+    let names = meshless_impact::builtin_names();
     assert_eq!(names.len(), 15);
     assert_eq!(names[14], "table1-12");
     for name in &names {

@@ -191,7 +191,7 @@ fn scenes_lists_every_built_in_scene_once_with_its_title() {
         .lines()
         .filter_map(|l| l.split_whitespace().next())
         .collect();
-    assert_eq!(names, meshless_impact::scene::builtin_names());
+    assert_eq!(names, meshless_impact::builtin_names());
     assert!(
         text.lines().next().unwrap().contains("House et al. test 7"),
         "{text}"
@@ -466,7 +466,7 @@ fn material_choice_on_the_command_line() {
         String::from_utf8(out.stdout).unwrap()
     };
     let list = text(&["materials"]);
-    for p in meshless_impact::material::presets::PRESETS {
+    for p in meshless_impact::materials::PRESETS {
         assert!(
             list.contains(p.name) && list.contains(p.source),
             "{}",

@@ -8,7 +8,7 @@
 //! The test command runs it for `MI_FUZZ_SECONDS` (default 60) from seed
 //! `MI_FUZZ_SEED` (default 1); `scripts/fuzz.sh` runs it longer.
 
-use meshless_impact::capi::*;
+use meshless_impact::internals::capi::*;
 use meshless_impact::{Scene, Simulation};
 use std::ffi::CString;
 use std::ptr::null_mut;

@@ -2,10 +2,9 @@
 //! strength model against its Johnson-Cook emulation on the Wilkins copper
 //! bar, and the Mie-Grüneisen equation of state.
 
-use meshless_impact::material::mie_gruneisen::MieGruneisen;
-use meshless_impact::material::{Eos, Material};
-use meshless_impact::scene::taylor::TaylorParams;
-use meshless_impact::solver::axisymmetric::TaylorSolver;
+use meshless_impact::TaylorParams;
+use meshless_impact::internals::TaylorSolver;
+use meshless_impact::materials::{Eos, Material, MieGruneisen};
 use meshless_impact::{Error, Scene, Simulation};
 
 /// A scene file of `scenes/` at `particles_radial` across, as a user reads

@@ -4,12 +4,10 @@
 //! fundamental longitudinal mode; and the highest frequency of its discrete
 //! operator behind the stable time step.
 
-use meshless_impact::mlpg::mls::distance;
-use meshless_impact::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE};
-use meshless_impact::mlpg::step::{OMEGA_FACTOR, largest_eigenvalue, stable_step};
-use meshless_impact::mlpg::{
-    Cylinder, NodalShapes, NodeLattice, SphereRule, SupportParams, Supports, TestSphere,
-    TractionOperator,
+use meshless_impact::internals::mlpg::{
+    ALPHA, BOUNDARY_RULE, Cylinder, DEFAULT_RULE, NodalShapes, NodeLattice, OMEGA_FACTOR,
+    SphereRule, SupportParams, Supports, TestSphere, TractionOperator, distance,
+    largest_eigenvalue, stable_step,
 };
 use std::f64::consts::PI;
 
@@ -71,7 +69,7 @@ impl Bar {
             .map(|i| distance(&pts[i], &pts[sup.named.of(i)[0]]))
             .collect();
         let bdist: Vec<f64> = pts.iter().map(|p| cyl.distance_to_surface(p)).collect();
-        let radii = meshless_impact::mlpg::sphere::test_radii(&nearest, &bdist, alpha);
+        let radii = meshless_impact::internals::mlpg::test_radii(&nearest, &bdist, alpha);
         let spheres: Vec<TestSphere> = (0..pts.len())
             .map(|i| {
                 let (frame, cut) = lattice.boundary_frame(i);
@@ -290,7 +288,7 @@ impl Bar {
 /// `P σ P` with `P = I − ν⊗ν`: the stress with no traction on the plane of
 /// unit normal ν.
 fn traction_free(s: &[f64; 6], nu: [f64; 3]) -> [f64; 6] {
-    use meshless_impact::mlpg::weak::VOIGT;
+    use meshless_impact::internals::mlpg::VOIGT;
     let m = |a: usize, b: usize| s[VOIGT[a][b]];
     let p = |a: usize, b: usize| (a == b) as u8 as f64 - nu[a] * nu[b];
     let out = |a: usize, b: usize| -> f64 {
@@ -339,7 +337,8 @@ fn uniform_stress_on_interior_and_boundary_nodes() {
                 let nu = sp.frame[axis].map(|x| x * c as f64);
                 for b in 0..3 {
                     for a in 0..3 {
-                        expected[b] -= area * s[meshless_impact::mlpg::weak::VOIGT[a][b]] * nu[a];
+                        expected[b] -=
+                            area * s[meshless_impact::internals::mlpg::VOIGT[a][b]] * nu[a];
                     }
                 }
             }

@@ -2,11 +2,9 @@
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
-use meshless_impact::material::bilinear::Bilinear;
-use meshless_impact::material::eos::LinearEos;
-use meshless_impact::material::{Damage, Eos, Material, Strength};
-use meshless_impact::mlpg::{Cylinder, Mlpg3d, RodSetup};
 use meshless_impact::Scene;
+use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup};
+use meshless_impact::materials::{Bilinear, Damage, Eos, LinearEos, Material, Strength};
 
 /// House test 7's 4340 steel constants (Pa, kg/m³).
 const K: f64 = 169.1e9;
@@ -174,7 +172,7 @@ fn elastic_rebound(rings: usize, smoothing: f64) -> (Mlpg3d, [f64; 2]) {
 #[test]
 fn elastic_wave_speed_and_rebound() {
     let cbar = (youngs() / RHO).sqrt();
-    let (smoothed, _) = elastic_rebound(5, meshless_impact::mlpg::solver::SMOOTHING);
+    let (smoothed, _) = elastic_rebound(5, meshless_impact::internals::mlpg::SMOOTHING);
     println!(
         "default smoothing: contact / (2 L0 / c_bar) - 1 = {:.3e}, energy error {:.3e}",
         smoothed.last_release() / (2.0 * ROD.length / cbar) - 1.0,
@@ -236,7 +234,7 @@ fn one_thread_and_two_give_the_same_bits() {
 #[test]
 #[ignore = "exploration"]
 fn explore_taylor3d_stop() {
-    use meshless_impact::scene::taylor3d::Taylor3dParams;
+    use meshless_impact::Taylor3dParams;
     let mut s = match std::env::var("MI_SCENE_FILE") {
         Ok(path) => {
             let mut scene = Scene::from_file(&path).unwrap();
@@ -247,9 +245,7 @@ fn explore_taylor3d_stop() {
             }
             let choice = scene.kind().material().unwrap();
             let material = choice
-                .material(meshless_impact::material::choice::Prefix::None, |n| {
-                    scene.get(n)
-                })
+                .material(meshless_impact::materials::Prefix::None, |n| scene.get(n))
                 .unwrap();
             Taylor3dParams::of(&scene).build_with(material).unwrap()
         }

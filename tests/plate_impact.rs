@@ -2,11 +2,10 @@
 //! against the exact solution, and the AD85 ceramic's elastic precursor
 //! against the Hugoniot elastic limit of its constants.
 
-use meshless_impact::material::bilinear::Bilinear;
-use meshless_impact::material::eos::LinearEos;
-use meshless_impact::material::rajendran_grove::RajendranGrove;
-use meshless_impact::material::{Damage, Eos, Material, Strength};
-use meshless_impact::uniaxial::{Layer, PlateImpact};
+use meshless_impact::materials::{
+    Bilinear, Damage, Eos, LinearEos, Material, RajendranGrove, Strength,
+};
+use meshless_impact::{Layer, PlateImpact};
 
 /// A steel with a linear equation of state and a flat yield stress.
 fn steel(yield_stress: f64) -> Material {

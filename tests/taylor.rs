@@ -328,7 +328,7 @@ fn rows_pressed_on_the_anvil_close_evenly_and_stay_above_the_guard() {
     );
     let nr = 10;
     let spacing = 0.0032 / (nr - 1) as f64;
-    let guard = meshless_impact::solver::axisymmetric::SPACING_COLLAPSE_BOUND;
+    let guard = meshless_impact::internals::SPACING_COLLAPSE_BOUND;
     assert!(sim.min_spacing_ratio().unwrap() >= guard);
     let s = sim.snapshot();
     let eps = &s.field("plastic_strain").unwrap().data;
@@ -357,7 +357,7 @@ fn rows_pressed_on_the_anvil_close_evenly_and_stay_above_the_guard() {
 #[test]
 fn wilkins_bar_runs_to_rest_with_the_face_of_the_finite_element_solutions() {
     let sim = run(wilkins_scene(), &[]);
-    let guard = meshless_impact::solver::axisymmetric::SPACING_COLLAPSE_BOUND;
+    let guard = meshless_impact::internals::SPACING_COLLAPSE_BOUND;
     assert!(sim.min_spacing_ratio().unwrap() >= guard);
     check_benchmark(&sim, (0.02142, 2.0), (0.00715, 3.0));
 }
@@ -418,7 +418,7 @@ fn large_strain(sets: &[(&str, f64)]) -> Scene {
 /// Asserts that a run reached rest with no pair closer than the spacing
 /// guard and its energy balanced within 5%.
 fn check_rest(sim: &Simulation) {
-    let guard = meshless_impact::solver::axisymmetric::SPACING_COLLAPSE_BOUND;
+    let guard = meshless_impact::internals::SPACING_COLLAPSE_BOUND;
     assert_eq!(sim.observable("at_rest"), Some(1.0));
     assert!(sim.min_spacing_ratio().unwrap() >= guard);
     let e = sim.observable("energy_error").unwrap();

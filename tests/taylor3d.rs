@@ -73,8 +73,7 @@ fn test7_in_3d_at_11_across() {
 /// within 3 %; the radii are the face's and the outline's at 40 heights.
 /// Returns the three relative differences.
 fn aisi310(n3: f64, n2: f64) -> [f64; 3] {
-    use meshless_impact::rod::profile_deviation;
-    use meshless_impact::scene::taylor3d::axisymmetric_twin;
+    use meshless_impact::{axisymmetric_twin, profile_deviation};
     let s3 = Scene::builtin("taylor3d-aisi310").unwrap();
     let twin = axisymmetric_twin(&s3, n2).unwrap();
     let (a, b) = (run(s3, &[("particles_radial", n3)]), run(twin, &[]));

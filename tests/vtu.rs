@@ -3,7 +3,7 @@
 //! values (two-component vectors padded to three), bit for bit (the arrays
 //! are written as binary).
 
-use meshless_impact::observe::{Field, Snapshot};
+use meshless_impact::{Field, Snapshot};
 use vtkio::model::{Attribute, DataSet, ElementType, VertexNumbers};
 
 #[test]

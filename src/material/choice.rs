@@ -171,7 +171,7 @@ impl MaterialChoice {
     ];
 
     /// Whether this choice's models use a parameter of the block.
-    pub const fn uses(self, uses: Uses) -> bool {
+    pub(crate) const fn uses(self, uses: Uses) -> bool {
         match uses {
             Uses::All => true,
             Uses::Strength(s) => s as u8 == self.strength as u8,
@@ -304,7 +304,7 @@ impl Prefix {
     }
 
     /// The block of every material parameter under this prefix.
-    pub const fn block(self) -> &'static [BlockParam] {
+    pub(crate) const fn block(self) -> &'static [BlockParam] {
         match self {
             Prefix::None => &BLOCK,
             Prefix::Projectile => &PROJECTILE_BLOCK,

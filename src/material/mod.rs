@@ -103,7 +103,7 @@ impl Damage {
     /// after a step of `load` that added `plastic_increment` to its plastic
     /// strain; the damage variables live in `state`.
     #[inline]
-    pub fn apply<T: SymTensor>(
+    pub(crate) fn apply<T: SymTensor>(
         &self,
         load: &Loading<T>,
         plastic_increment: f64,
@@ -276,7 +276,7 @@ impl Material {
     /// density and temperature, then the damage model. Returns the new
     /// state, or the compression limit of the equation of state.
     #[inline]
-    pub fn update<T: SymTensor>(
+    pub(crate) fn update<T: SymTensor>(
         &self,
         load: &Loading<T>,
         old: &Point<T>,

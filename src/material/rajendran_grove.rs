@@ -267,7 +267,7 @@ impl RajendranGrove {
     }
 
     /// The crack-density factors of the matrix's Poisson ratio.
-    pub fn crack_factors(&self) -> CrackFactors {
+    pub(crate) fn crack_factors(&self) -> CrackFactors {
         CrackFactors::of(self.poisson_ratio())
     }
 
@@ -365,7 +365,12 @@ impl RajendranGrove {
     /// One step of a point under `load` (`load.density` is the density at
     /// the end of the step), with specific internal energy `energy` (J/kg,
     /// from the initial state). Returns the plastic work per unit volume.
-    pub fn update(&self, load: &Loading<Full>, energy: f64, point: &mut CeramicPoint) -> f64 {
+    pub(crate) fn update(
+        &self,
+        load: &Loading<Full>,
+        energy: f64,
+        point: &mut CeramicPoint,
+    ) -> f64 {
         if let Some(frozen) = point.pulverized {
             return self.update_pulverized(load, frozen, point);
         }

@@ -97,7 +97,7 @@ pub struct NodeLattice {
     /// The parts of the boundary each node lies on.
     pub surfaces: Vec<Surfaces>,
     /// The face, one mantle generator (angle 0, face to top) and the tail
-    /// (the axis node of the top layer), for [`crate::rod::RodObservables`].
+    /// (the axis node of the top layer), for `RodObservables` (`src/rod.rs`).
     pub sets: RodSets,
     /// Radial spacing Δ = R0 / rings (m).
     pub radial_spacing: f64,

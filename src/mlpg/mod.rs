@@ -37,8 +37,8 @@ pub mod weak;
 #[cfg(test)]
 mod measure;
 
-pub use lattice::{Cylinder, NodeLattice, Surfaces};
-pub use mls::{NodalShapes, Recompute, ShapeRow, SupportParams, Supports};
-pub use solver::{Energies, Mlpg3d, RodSetup};
+pub use lattice::{Cylinder, NodeLattice};
+pub use mls::{NodalShapes, SupportParams, Supports};
+pub use solver::{Mlpg3d, RodSetup};
 pub use sphere::{SphereRule, TestSphere};
 pub use weak::TractionOperator;

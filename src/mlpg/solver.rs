@@ -118,7 +118,7 @@ pub struct RodSetup {
     pub safety: f64,
     /// Latest simulated time (s).
     pub end_time: f64,
-    /// See [`REBUILD_STRAIN`].
+    /// See `REBUILD_STRAIN`.
     pub rebuild_strain: f64,
     /// α of the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
     /// after each velocity update ([`SMOOTHING`]).

@@ -4,8 +4,8 @@
 
 use super::runner::{Probe, run_case};
 use super::{Doc, Plan, Table, pct, sig};
-use crate::Scene;
-use crate::error::Result;
+use meshless_impact::Result;
+use meshless_impact::Scene;
 
 /// The benchmark scene files, as shipped in `scenes/`.
 const SCENES: [(&str, &str); 2] = [

@@ -4,7 +4,7 @@
 use super::plot::{Axes, Series};
 use super::runner::{CaseRun, Probe, run_case, scene};
 use super::{Doc, Plan, Table, pct, sig};
-use crate::error::Result;
+use meshless_impact::Result;
 use std::fmt::Write as _;
 
 /// Exact shock radius of the cylindrical Noh problem at t = 0.6.
@@ -92,7 +92,7 @@ fn local_orders(resolution: &[f64], error: &[f64]) -> Vec<String> {
 }
 
 /// The Noh convergence study.
-pub(super) fn noh(plan: &Plan, doc: &mut Doc) -> Result<(Vec<NohPoint>, f64)> {
+pub(super) fn noh(plan: &Plan, doc: &mut Doc) -> Result<()> {
     let mut points = Vec::new();
     for &n in &plan.noh {
         super::progress!("report: Noh, {n} particles");
@@ -200,7 +200,7 @@ pub(super) fn noh(plan: &Plan, doc: &mut Doc) -> Result<(Vec<NohPoint>, f64)> {
         ),
         &series,
     )?;
-    Ok((points, order_l1))
+    Ok(())
 }
 
 /// Times of the test 7 maps (15 and 30 microseconds).
@@ -208,9 +208,9 @@ pub(super) const MAP_TIMES: [f64; 2] = [15e-6, 30e-6];
 /// End of the per-step face-lift record (3 microseconds).
 pub(super) const FACE_LIFT_WINDOW: f64 = 3e-6;
 
-/// The Taylor test 7 convergence study. Also returns the run at the figures'
+/// The Taylor test 7 convergence study. Returns the run at the figures'
 /// resolution (with its snapshots and face-lift record).
-pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, CaseRun)> {
+pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<CaseRun> {
     let probe = Probe {
         snapshot_times: MAP_TIMES.to_vec(),
         per_step: vec!["face_lift"],
@@ -219,7 +219,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
     };
     let mut points = Vec::new();
     let mut figure_run = None;
-    let reference = crate::Scene::builtin("taylor")?.reference;
+    let reference = meshless_impact::Scene::builtin("taylor")?.reference;
     for &n in &plan.taylor {
         super::progress!("report: Taylor test 7, {n} particles across the radius");
         let run = run_case(scene("taylor", &[("particles_radial", n as f64)]), &probe);
@@ -360,7 +360,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, Ca
         ),
     }
     doc.para(&text);
-    Ok((points, figure_run))
+    Ok(figure_run)
 }
 
 #[cfg(test)]

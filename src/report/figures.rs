@@ -5,7 +5,7 @@ use super::convergence::{FACE_LIFT_WINDOW, MAP_TIMES};
 use super::plot::{self, Axes, Series};
 use super::runner::CaseRun;
 use super::{Doc, Plan, Table, sig};
-use crate::error::Result;
+use meshless_impact::Result;
 
 /// The paper's values quoted beside the maps (section 4.2.1 of the paper).
 const PAPER_PEAK_STRAIN: f64 = 0.84;

@@ -4,8 +4,11 @@
 //! benchmarks beside their references. It is written as `DIR/index.md`
 //! with a CSV file for every table and an SVG file for every figure.
 //!
-//! The report only uses the public [`Simulation`](crate::Simulation) and
-//! [`Scene`](crate::Scene) API; the physics core knows nothing of it.
+//! The report is a module of the program, not of the library (cargo feature
+//! `report`, on by default, with its plotting dependency): it only uses the
+//! library's public API ([`Simulation`](meshless_impact::Simulation),
+//! [`Scene`](meshless_impact::Scene)), and the physics core knows nothing of
+//! it.
 //!
 //! Wall times: the convergence runs go one at a time, each using every core
 //! through the solver's own parallelism, so their wall times are comparable.
@@ -21,14 +24,10 @@ pub mod runner;
 mod sensitivity;
 mod stability;
 
-use crate::error::{Error, Result};
+use meshless_impact::{Error, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-pub use convergence::{NohPoint, TaylorPoint, observed_order};
-pub use runner::{CaseRun, Outcome, Probe, run_case};
-pub use stability::StabilityCase;
 
 /// What to generate.
 #[derive(Debug, Clone)]
@@ -200,17 +199,9 @@ impl Doc<'_> {
     }
 }
 
-/// Everything the report measured, for callers that check it.
+/// What was written.
 #[derive(Debug, Clone)]
 pub struct Report {
-    /// Noh convergence points, coarse to fine.
-    pub noh: Vec<NohPoint>,
-    /// Observed order of the Noh L1 density error.
-    pub noh_order: f64,
-    /// Taylor test 7 convergence points, coarse to fine.
-    pub taylor: Vec<TaylorPoint>,
-    /// The stability matrix.
-    pub stability: Vec<StabilityCase>,
     /// Files written, relative to the output directory (index.md last).
     pub files: Vec<String>,
     /// Wall time of the whole report, seconds.
@@ -271,7 +262,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
          uses every core, so their wall times are comparable with each other. The \
          sensitivity, Table 1 and stability cases run side by side and share the \
          cores: their wall times are indicative only.\n\n",
-        crate::VERSION,
+        meshless_impact::VERSION,
         machine(),
         if opts.quick {
             "quick (coarse resolutions and a reduced stability matrix, for the tests)"
@@ -279,13 +270,13 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
             "full"
         }
     );
-    let (noh, noh_order) = convergence::noh(&plan, &mut doc)?;
-    let (taylor, figure_run) = convergence::taylor(&plan, &mut doc)?;
+    convergence::noh(&plan, &mut doc)?;
+    let figure_run = convergence::taylor(&plan, &mut doc)?;
     figures::test7(&plan, &mut doc, figure_run)?;
     profiles::aisi310(&plan, &mut doc)?;
     sensitivity::smoothing(&plan, &mut doc)?;
     sensitivity::table1(&plan, &mut doc)?;
-    let stability = stability::matrix(&plan, &mut doc)?;
+    stability::matrix(&plan, &mut doc)?;
     benchmarks::run(&plan, &mut doc)?;
     let wall_s = start.elapsed().as_secs_f64();
     let _ = writeln!(doc.text, "---\n\nWhole report: {wall_s:.1} s wall time.");
@@ -293,10 +284,6 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     std::fs::write(&index, &doc.text).map_err(|e| Error::io(&index, e))?;
     doc.files.push("index.md".into());
     Ok(Report {
-        noh,
-        noh_order,
-        taylor,
-        stability,
         files: doc.files,
         wall_s,
     })

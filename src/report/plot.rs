@@ -1,7 +1,7 @@
 //! SVG figures with plotters (SVG backend only: text is written as SVG text
 //! elements, so no system font is needed to draw or to build).
 
-use crate::error::{Error, Result};
+use meshless_impact::{Error, Result};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;

@@ -1,14 +1,11 @@
 //! The seed's 3-D Taylor case (004, section 5.1: AISI 310, bilinear J2,
 //! 300 m/s; scene `taylor3d-aisi310`): the outline of the rod by the 3-D
 //! MLPG solver against the axisymmetric MSPH solver's, with the same
-//! material ([`crate::scene::taylor3d::axisymmetric_twin`]).
+//! material ([`meshless_impact::axisymmetric_twin`]).
 
 use super::plot::{Axes, Series};
 use super::{Doc, Plan, Table, sig};
-use crate::error::Result;
-use crate::rod::profile_deviation;
-use crate::scene::taylor3d::axisymmetric_twin;
-use crate::{Scene, Simulation};
+use meshless_impact::{Result, Scene, Simulation, axisymmetric_twin, profile_deviation};
 use std::time::Instant;
 
 /// Heights at which the two outlines are compared.

@@ -3,7 +3,7 @@
 //! particle spacing seen, snapshots at chosen times and, for the first
 //! moments of a run, observables after every step.
 
-use crate::{Error, History, Scene, Simulation, Snapshot};
+use meshless_impact::{Error, History, Scene, Simulation, Snapshot};
 use std::time::Instant;
 
 /// What to collect besides the final state and the recorded histories.
@@ -118,7 +118,7 @@ impl CaseRun {
 }
 
 /// A built-in scene with parameters set, validated.
-pub fn scene(name: &str, sets: &[(&str, f64)]) -> crate::Result<Scene> {
+pub fn scene(name: &str, sets: &[(&str, f64)]) -> meshless_impact::Result<Scene> {
     let mut s = Scene::builtin(name)?;
     for (k, v) in sets {
         s.set(k, *v)?;
@@ -147,7 +147,7 @@ fn min_radial_gap(snap: &Snapshot) -> f64 {
 }
 
 /// Runs `scene` (or reports why it was refused) and measures it.
-pub fn run_case(scene: crate::Result<Scene>, probe: &Probe) -> CaseRun {
+pub fn run_case(scene: meshless_impact::Result<Scene>, probe: &Probe) -> CaseRun {
     let scene = match scene {
         Ok(s) => s,
         Err(e) => return CaseRun::rejected(e),
@@ -248,7 +248,7 @@ pub fn run_case(scene: crate::Result<Scene>, probe: &Probe) -> CaseRun {
 }
 
 /// Runs cases side by side (they share the cores) with the given wall budget.
-pub fn run_parallel(scenes: Vec<crate::Result<Scene>>, wall_budget: f64) -> Vec<CaseRun> {
+pub fn run_parallel(scenes: Vec<meshless_impact::Result<Scene>>, wall_budget: f64) -> Vec<CaseRun> {
     use rayon::prelude::*;
     let probe = Probe {
         wall_budget,

@@ -5,8 +5,8 @@
 use super::plot::{Axes, Series};
 use super::runner::{CaseRun, run_parallel, scene};
 use super::{Doc, Plan, Table, pct, sig};
-use crate::Table1Row;
-use crate::error::Result;
+use meshless_impact::Result;
+use meshless_impact::Table1Row;
 
 const RATIOS: [f64; 3] = [1.5, 2.0, 2.5];
 const COEFFICIENTS: [f64; 6] = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5];
@@ -33,7 +33,7 @@ pub(super) fn smoothing(plan: &Plan, doc: &mut Doc) -> Result<()> {
             .collect(),
         plan.wall_budget,
     );
-    let reference = crate::Scene::builtin("taylor")?.reference;
+    let reference = meshless_impact::Scene::builtin("taylor")?.reference;
     let mut t = Table::new(
         "sensitivity_smoothing",
         &[

@@ -4,8 +4,8 @@
 
 use super::runner::{CaseRun, Outcome, run_parallel, scene};
 use super::{Doc, Plan, Table, sig};
-use crate::error::Result;
-use crate::scene::taylor::TaylorParams;
+use meshless_impact::Result;
+use meshless_impact::TaylorParams;
 
 /// One row of the stability matrix.
 #[derive(Debug, Clone)]
@@ -177,7 +177,7 @@ fn setup_text(d: &Def) -> String {
     format!("{} {}", d.scene, sets.join(" "))
 }
 
-pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
+pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<()> {
     let defs = cases(plan);
     super::progress!("report: stability matrix, {} cases in parallel", defs.len());
     let runs = run_parallel(
@@ -200,7 +200,6 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
             "message",
         ],
     );
-    let mut out = Vec::new();
     for (d, r) in defs.iter().zip(&runs) {
         let c = StabilityCase {
             name: d.name.to_string(),
@@ -232,9 +231,8 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
             } else {
                 c.non_finite.join("; ")
             },
-            c.message.clone(),
+            c.message,
         ]);
-        out.push(c);
     }
     doc.para(&format!(
         "## 5. Stability on stiff and extreme cases\n\n\
@@ -255,7 +253,7 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<Vec<StabilityCase>> {
     doc.table(&t)?;
     let elastic = &runs[0];
     elastic_section(doc, elastic)?;
-    Ok(out)
+    Ok(())
 }
 
 /// The elastic impact at 10 m/s: rebound, length, contact time, energy.

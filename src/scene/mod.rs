@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// A kind of scene: a handle to its row of the scene registry
-/// ([`registry::SCENES`]) and, for a scene with a body, the choice of its
+/// (`registry::SCENES`) and, for a scene with a body, the choice of its
 /// material models ([`MaterialChoice`]), which sets the parameter table.
 /// Two kinds are equal when they are the same row with the same choice.
 #[derive(Clone, Copy)]
@@ -90,7 +90,7 @@ impl SceneKind {
     }
 
     /// The kind's registry row.
-    pub fn row(self) -> &'static SceneRow {
+    pub(crate) fn row(self) -> &'static SceneRow {
         self.row
     }
 
@@ -112,15 +112,6 @@ impl SceneKind {
     /// Observables this kind of scene reports, in output order.
     pub fn observable_specs(self) -> &'static [ObservableSpec] {
         self.row.observables
-    }
-
-    /// The FMU of this kind (its model identifier, name, description), if
-    /// the registry declares one: one FMU per material choice.
-    pub fn fmu(self) -> Option<registry::FmuIdentity> {
-        registry::fmus()
-            .into_iter()
-            .find(|(k, _)| *k == self)
-            .map(|(_, id)| id)
     }
 
     /// The key of this kind in saved states: its name with a capital

@@ -194,11 +194,11 @@ choice_tables! {
 
 param_struct! {
     /// The parameters of a Taylor run that the solver keeps (SI units):
-    /// those of [`TAYLOR_PARAMS`]. A run of another material choice takes
-    /// its geometry, numerical parameters, density and initial temperature
-    /// from here and its material from the scene's material block
-    /// ([`TaylorSolver::with_material`]); the other material fields then
-    /// keep their defaults and are not used.
+    /// those of the `taylor` scene's table. A run of another material
+    /// choice takes its geometry, numerical parameters, density and initial
+    /// temperature from here and its material from the scene's material
+    /// block (`TaylorSolver::with_material`); the other material fields
+    /// then keep their defaults and are not used.
     TaylorParams, TAYLOR_PARAMS, {
         impact_speed, initial_length, initial_diameter, density, shear_modulus,
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,

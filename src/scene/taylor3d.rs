@@ -14,8 +14,8 @@ use super::registry::{MaterialSlot, SceneRow, restore};
 use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
 use crate::material::Material;
 use crate::material::choice::{MaterialChoice, Prefix};
+use crate::mlpg::Cylinder;
 use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
-use crate::mlpg::{Cylinder, lattice::NodeLattice};
 use crate::observe::TAYLOR3D_OBSERVABLES;
 
 /// The registry row of the `taylor3d` scene.
@@ -127,7 +127,7 @@ pub fn variants() -> Vec<(String, Scene)> {
 
 param_struct! {
     /// The parameters of a 3-D Taylor run (SI units): those of
-    /// [`TAYLOR3D_PARAMS`]. A run of another material choice takes its
+    /// `TAYLOR3D_PARAMS`. A run of another material choice takes its
     /// geometry and numerical parameters from here and its material from
     /// the scene's material block; the other material fields then keep
     /// their defaults and are not used.
@@ -181,7 +181,7 @@ impl Taylor3dParams {
     }
 
     /// The rod and the numerical choices.
-    pub fn setup(&self) -> RodSetup {
+    pub(crate) fn setup(&self) -> RodSetup {
         let mut s = RodSetup::new(
             Cylinder {
                 radius: 0.5 * self.initial_diameter,
@@ -198,20 +198,19 @@ impl Taylor3dParams {
     }
 
     /// The run at the instant of impact, of the default material choice.
+    /// Its type is not part of the public API (the tests reach it through
+    /// `internals`).
+    #[doc(hidden)]
     pub fn build(&self) -> crate::Result<Mlpg3d> {
         self.build_with(self.material())
     }
 
     /// The run at the instant of impact, of `material` (whose reference
-    /// density sets the node masses).
+    /// density sets the node masses; not part of the public API, as
+    /// [`Taylor3dParams::build`]).
+    #[doc(hidden)]
     pub fn build_with(&self, material: Material) -> crate::Result<Mlpg3d> {
         Mlpg3d::new(self.setup(), material)
-    }
-
-    /// The lattice the run would use.
-    pub fn lattice(&self) -> NodeLattice {
-        let s = self.setup();
-        NodeLattice::cylinder(s.cylinder, s.rings)
     }
 }
 

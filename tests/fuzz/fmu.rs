@@ -15,7 +15,7 @@
 
 use super::{Rng, bounded, edit_leaf};
 use meshless_impact::ParamSpec;
-use meshless_impact::fmi::{self, VarKind, VarType, fmi2, fmi3};
+use meshless_impact::internals::fmi::{self, VarKind, VarType, fmi2, fmi3};
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::ptr::{null, null_mut};
 use std::sync::atomic::{AtomicUsize, Ordering};
