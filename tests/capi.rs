@@ -247,7 +247,12 @@ fn c_abi_equals_rust_api_bit_for_bit() {
         bits(&rust.history().times)
     );
     let snap = rust.snapshot();
-    let pos: Vec<f64> = snap.positions.iter().flatten().copied().collect();
+    let pos: Vec<f64> = snap
+        .positions
+        .iter()
+        .flat_map(|p| &p[..2])
+        .copied()
+        .collect();
     assert_eq!(bits(&s.named(mi_sim_field, "position")), bits(&pos));
     for f in &snap.fields {
         assert_eq!(

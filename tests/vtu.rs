@@ -8,7 +8,11 @@ use vtkio::model::{Attribute, DataSet, ElementType, VertexNumbers};
 
 #[test]
 fn snapshot_round_trips_through_the_vtk_reader() {
-    let positions = vec![[0.0, 0.0], [1.5e-3, 2.0e-4], [3.0e-3, -1.25e-5]];
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.5e-3, 2.0e-4, 0.0],
+        [3.0e-3, -1.25e-5, 0.0],
+    ];
     let snap = Snapshot {
         time: 2.5e-6,
         positions: positions.clone(),
@@ -47,7 +51,7 @@ fn snapshot_round_trips_through_the_vtk_reader() {
         .into_loaded_piece_data(None)
         .unwrap();
     let points: Vec<f64> = piece.points.cast_into().unwrap();
-    let expect: Vec<f64> = positions.iter().flat_map(|p| [p[0], p[1], 0.0]).collect();
+    let expect: Vec<f64> = positions.iter().flatten().copied().collect();
     assert_eq!(points, expect);
     let VertexNumbers::XML {
         connectivity,

@@ -28,7 +28,12 @@ pub static ROW: SceneRow = SceneRow {
     check: |s| Taylor3dParams::from_values(s.values()).check_consistency(),
     build: |s: &Scene| Ok(Box::new(Taylor3dParams::from_values(s.values()).build()?)),
     restore: restore::<Mlpg3d>,
-    fmu: None,
+    fmu: Some(super::registry::FmuIdentity {
+        model_identifier: "Taylor3dImpact",
+        model_name: "Taylor3dImpact",
+        description: "Taylor rod impact on a rigid anvil in 3-D: the MLPG mixed method (Han, Liu, Rajendran & Atluri) \
+                      with Johnson-Cook thermo-viscoplasticity; defaults are House et al. (1995) test 7 on 4340 steel",
+    }),
 };
 
 param_table! {
