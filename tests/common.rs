@@ -30,3 +30,29 @@ pub fn tail_slowdown_time(sim: &Simulation) -> f64 {
 pub fn pct(value: f64, reference: f64) -> f64 {
     100.0 * (value - reference) / reference
 }
+
+/// The data sets of a ParaView collection (`.pvd`): (time, file) each, in
+/// order.
+pub fn pvd_datasets(path: &std::path::Path) -> Vec<(f64, String)> {
+    let pvd = std::fs::read_to_string(path).unwrap();
+    let mut reader = quick_xml::Reader::from_str(&pvd);
+    let mut sets = Vec::new();
+    loop {
+        match reader.read_event().unwrap() {
+            quick_xml::events::Event::Empty(e) if e.name().as_ref() == b"DataSet" => {
+                let attr = |k: &str| {
+                    e.try_get_attribute(k)
+                        .unwrap()
+                        .unwrap()
+                        .unescape_value()
+                        .unwrap()
+                        .into_owned()
+                };
+                sets.push((attr("timestep").parse::<f64>().unwrap(), attr("file")));
+            }
+            quick_xml::events::Event::Eof => break,
+            _ => {}
+        }
+    }
+    sets
+}

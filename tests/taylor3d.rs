@@ -65,3 +65,28 @@ fn test7_in_3d_at_11_across() {
         "3-D {lf} against axisymmetric {l2}"
     );
 }
+
+/// The material's cross-checks hold in 3-D as in `taylor`: a melt
+/// temperature not above the room temperature, or a rod hotter than its
+/// melt, is refused before anything runs (before, the 3-D row checked only
+/// the geometry, and such a rod ran until its energy error passed the
+/// bound).
+#[test]
+fn temperatures_are_checked_as_in_taylor() {
+    for (name, value, says) in [
+        ("melt_temperature", 293.0, "must exceed room_temperature"),
+        (
+            "initial_temperature",
+            1500.0,
+            "must be below melt_temperature",
+        ),
+    ] {
+        for kind in ["taylor", "taylor3d"] {
+            let mut scene = Scene::builtin(kind).unwrap();
+            scene.set(name, value).unwrap();
+            let e = meshless_impact::Simulation::new(scene).unwrap_err();
+            assert_eq!(e.name(), "Inconsistent", "{kind}: {e}");
+            assert!(e.to_string().contains(says), "{kind}: {e}");
+        }
+    }
+}

@@ -46,6 +46,8 @@ pub(crate) struct Plan {
     pub noh: Vec<usize>,
     /// Taylor particles across the radius for the convergence study.
     pub taylor: Vec<usize>,
+    /// Nodes across the radius of the 3-D (`taylor3d`) runs of the study.
+    pub taylor3d: Vec<usize>,
     /// Particles across the radius of the sensitivity, Table 1 and stability runs.
     pub resolution: f64,
     /// Resolution of the test 7 time histories and maps.
@@ -61,6 +63,7 @@ impl Plan {
                 quick,
                 noh: vec![100, 200, 400],
                 taylor: vec![4, 6, 8],
+                taylor3d: vec![3],
                 resolution: 6.0,
                 figures: 8.0,
                 wall_budget: 120.0,
@@ -70,6 +73,7 @@ impl Plan {
                 quick,
                 noh: vec![100, 200, 400, 800, 1600, 3200],
                 taylor: vec![8, 10, 15, 20, 31, 41, 61],
+                taylor3d: vec![3, 4, 6],
                 resolution: 20.0,
                 figures: 20.0,
                 wall_budget: 7200.0,
@@ -208,6 +212,8 @@ pub struct Report {
     pub noh_order: f64,
     /// Taylor test 7 convergence points, coarse to fine.
     pub taylor: Vec<TaylorPoint>,
+    /// Taylor test 7 in 3-D (MLPG), coarse to fine.
+    pub taylor3d: Vec<TaylorPoint>,
     /// The stability matrix.
     pub stability: Vec<StabilityCase>,
     /// Files written, relative to the output directory (index.md last).
@@ -280,6 +286,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     );
     let (noh, noh_order) = convergence::noh(&plan, &mut doc)?;
     let (taylor, figure_run) = convergence::taylor(&plan, &mut doc)?;
+    let taylor3d = convergence::taylor3d(&plan, &mut doc, &taylor)?;
     figures::test7(&plan, &mut doc, figure_run)?;
     sensitivity::smoothing(&plan, &mut doc)?;
     sensitivity::table1(&plan, &mut doc)?;
@@ -294,6 +301,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
         noh,
         noh_order,
         taylor,
+        taylor3d,
         stability,
         files: doc.files,
         wall_s,

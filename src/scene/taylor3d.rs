@@ -104,7 +104,14 @@ impl Taylor3dParams {
     /// The `taylor` scene's cross-parameter checks (temperatures, nodes
     /// along the axis at the matched spacing).
     pub fn check_consistency(&self) -> crate::Result<()> {
-        self.taylor().check_consistency()
+        let taylor = self.taylor();
+        // The material's (melt above room and initial temperature), as the
+        // `taylor` row checks its choice's.
+        crate::material::choice::MaterialChoice::JOHNSON_COOK_LINEAR
+            .check_consistency(crate::material::choice::Prefix::None, |n| {
+                Ok(taylor.get(n).unwrap_or(f64::NAN))
+            })?;
+        taylor.check_consistency()
     }
 
     /// The rod and the numerical choices.
