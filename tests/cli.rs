@@ -87,31 +87,17 @@ fn out_of_range_value_names_parameter_value_and_range() {
 fn json_has_every_observable_and_run_facts() {
     let dir = std::env::temp_dir().join(format!("mi-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let json = dir.join("out.json");
-    let csv = dir.join("hist.csv");
-    let vtk = dir.join("vtk");
-    let out = bin()
-        .args([
+    let common::CliOutputs { json, csv, vtk } = common::run_cli_with_outputs(
+        &[
             "run",
             "-q",
             "--set",
             "particles_radial=4",
             "--set",
             "end_time=3e-6",
-        ])
-        .arg("--json")
-        .arg(&json)
-        .arg("--csv")
-        .arg(&csv)
-        .arg("--vtk-dir")
-        .arg(&vtk)
-        .args(["--vtk-times", "1e-6"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        ],
+        &dir,
+        "1e-6",
     );
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();

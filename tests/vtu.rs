@@ -9,7 +9,6 @@ mod common;
 use meshless_impact::observe::{Field, Snapshot};
 use meshless_impact::{Scene, Simulation};
 use std::path::Path;
-use std::process::Command;
 use vtkio::model::{Attribute, DataSet, ElementType, VertexNumbers};
 
 #[test]
@@ -130,28 +129,13 @@ fn taylor3d_snapshots_hold_3d_points_and_the_full_stress() {
     let dir = std::env::temp_dir().join(format!("mi_vtu3d_{}", std::process::id()));
     std::fs::remove_dir_all(&dir).ok();
     std::fs::create_dir_all(&dir).unwrap();
-    let (json, csv, vtk) = (dir.join("out.json"), dir.join("hist.csv"), dir.join("vtk"));
     let sets = [("particles_radial", 3.0), ("end_time", 4e-6)];
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshless-impact"));
-    cmd.args(["run", "taylor3d", "-q"]);
-    for (k, v) in sets {
-        cmd.args(["--set", &format!("{k}={v:e}")]);
+    let sets_text: Vec<String> = sets.iter().map(|(k, v)| format!("{k}={v:e}")).collect();
+    let mut args = vec!["run", "taylor3d", "-q"];
+    for s in &sets_text {
+        args.extend(["--set", s.as_str()]);
     }
-    let out = cmd
-        .arg("--json")
-        .arg(&json)
-        .arg("--csv")
-        .arg(&csv)
-        .arg("--vtk-dir")
-        .arg(&vtk)
-        .args(["--vtk-times", "2e-6"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let common::CliOutputs { json, csv, vtk } = common::run_cli_with_outputs(&args, &dir, "2e-6");
 
     // The same run through the library: its snapshots at 2 us and at the end.
     let mut scene = Scene::builtin("taylor3d").unwrap();
