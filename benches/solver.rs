@@ -30,7 +30,11 @@ fn lattice_neighbourhood() -> Vec<[f64; 2]> {
 /// The (R, Z) positions of the particles of test 7 at 20 across the radius.
 fn test7_points() -> Vec<[f64; 2]> {
     let sim = Simulation::builtin("taylor").unwrap();
-    sim.snapshot().positions
+    sim.snapshot()
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1]])
+        .collect()
 }
 
 fn kernel(c: &mut Criterion) {

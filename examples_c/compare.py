@@ -5,6 +5,13 @@
         must hold exactly the JSON's number (booleans as 0/1).
     python3 compare.py --sweep SWEEP.txt SPEED C_OUTPUT.txt
         the sweep row of SPEED must equal the C output of a single run.
+    python3 compare.py --fields3d C_OUTPUT.txt RUST.json
+        the 3-D fields read by taylor3d.c: `position` has 3 components and
+        `stress` 6, one value of each per node of the Rust run; the extent
+        of the positions along z is the Rust run's rod_length, bit for bit,
+        and below initial_length; no node lies nearer the axis than the
+        face's mushroom_radius says; the mean normal stress is minus the
+        pressure.
 """
 import json
 import sys
@@ -33,6 +40,9 @@ def main():
             checked += 1
         print(f"sweep row {sys.argv[3]} m/s equals the single run ({checked} values)")
         return
+    if sys.argv[1] == "--fields3d":
+        fields3d(read_lines(sys.argv[2]), json.load(open(sys.argv[3])))
+        return
     c = read_lines(sys.argv[1])
     rust = json.load(open(sys.argv[2]))
     checked = 0
@@ -45,6 +55,21 @@ def main():
         checked += 1
     assert checked >= 13, checked
     print(f"{sys.argv[1]}: {checked} values equal the Rust API bit for bit")
+
+
+def fields3d(c, rust):
+    n = rust["particles"]
+    assert c["nodes"] == n, (c["nodes"], n)
+    assert c["position_components"] == 3 and c["stress_components"] == 6, c
+    assert c["position_values"] == 3 * n, (c["position_values"], n)
+    assert c["stress_values"] == 6 * n, (c["stress_values"], n)
+    lf = rust["rod_length"]
+    assert c["position_z_extent"] == lf, f"z extent {c['position_z_extent']!r} != rod_length {lf!r}"
+    assert lf < c["initial_length"], (lf, c["initial_length"])
+    assert c["position_max_radius"] >= rust["mushroom_radius"] * (1 - 1e-12), c
+    assert c["stress_max_abs"] > 0
+    assert c["stress_mean_plus_pressure_max"] <= 1e-9 * c["stress_max_abs"], c
+    print(f"3-D fields of {n} nodes: position (x, y, z), stress (6); z extent = rod_length = {lf!r} m")
 
 
 main()

@@ -46,4 +46,24 @@ static inline void apply_settings(mi_sim *sim, int argc, char **argv) {
     }
 }
 
+/* Prints every observable as `name = value` (%.17g: every double
+ * round-trips), then `steps = ` and `time = `. */
+static inline void print_observables(mi_sim *sim) {
+    size_t count = 0, k;
+    uint64_t steps = 0;
+    double t = 0.0;
+    check(sim, mi_sim_observable_count(sim, &count), "mi_sim_observable_count");
+    for (k = 0; k < count; ++k) {
+        mi_observable_info info;
+        double v;
+        check(sim, mi_sim_observable_info(sim, k, &info), "mi_sim_observable_info");
+        check(sim, mi_sim_observable(sim, info.name, &v), info.name);
+        printf("%s = %.17g\n", info.name, v);
+    }
+    check(sim, mi_sim_steps(sim, &steps), "mi_sim_steps");
+    check(sim, mi_sim_time(sim, &t), "mi_sim_time");
+    printf("steps = %llu\n", (unsigned long long)steps);
+    printf("time = %.17g\n", t);
+}
+
 #endif

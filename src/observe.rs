@@ -176,15 +176,17 @@ pub struct Field {
 pub struct Snapshot {
     /// Simulated time.
     pub time: f64,
-    /// (R, Z) positions.
-    pub positions: Vec<[f64; 2]>,
+    /// Particle positions as points in space, as the VTK files hold them:
+    /// (x, y, z) in 3-D (z along the rod axis, the anvil at z = 0), (R, Z, 0)
+    /// in the axisymmetric scenes (x = R, y = Z), (R, 0, 0) in Noh.
+    pub positions: Vec<[f64; 3]>,
     /// Fields; which ones depends on the scene.
     pub fields: Vec<Field>,
 }
 
 impl Snapshot {
-    /// Every field of a run now: `position` as the positions (R, Z; a
-    /// position of one component gets Z = 0), the others as fields.
+    /// Every field of a run now: `position` as the positions (its
+    /// components padded with zeros to three), the others as fields.
     pub fn of(model: &dyn crate::model::Model) -> Snapshot {
         let specs = model.field_specs();
         let value = |name| model.field(name).expect("a field the model lists");
@@ -194,7 +196,7 @@ impl Snapshot {
             time: model.time(),
             positions: value(position.name)
                 .chunks(k)
-                .map(|c| [c[0], c.get(1).copied().unwrap_or(0.0)])
+                .map(|c| std::array::from_fn(|k| c.get(k).copied().unwrap_or(0.0)))
                 .collect(),
             fields: rest
                 .iter()
@@ -214,17 +216,15 @@ impl Snapshot {
     }
 
     /// Writes the snapshot as a VTK XML unstructured grid (`.vtu`) of vertex
-    /// cells in the R-Z plane (x = R, y = Z), readable by ParaView. Two-component
-    /// vectors are padded to three. The file holds no time: list it in a
+    /// cells at [`Snapshot::positions`] (in the axisymmetric scenes the R-Z
+    /// plane, x = R, y = Z), readable by ParaView. Two-component vectors
+    /// are padded to three; every other field keeps its components (the
+    /// 3-D stress its six). The file holds no time: list it in a
     /// [`write_pvd`] collection for that.
     pub fn write_vtu(&self, path: &Path) -> Result<()> {
         use vtkio::model::*;
         let n = self.positions.len();
-        let points: Vec<f64> = self
-            .positions
-            .iter()
-            .flat_map(|p| [p[0], p[1], 0.0])
-            .collect();
+        let points: Vec<f64> = self.positions.iter().flatten().copied().collect();
         let mut point_data = Vec::new();
         for f in &self.fields {
             let nc = f.components.len();

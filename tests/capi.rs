@@ -247,7 +247,12 @@ fn c_abi_equals_rust_api_bit_for_bit() {
         bits(&rust.history().times)
     );
     let snap = rust.snapshot();
-    let pos: Vec<f64> = snap.positions.iter().flatten().copied().collect();
+    let pos: Vec<f64> = snap
+        .positions
+        .iter()
+        .flat_map(|p| &p[..2])
+        .copied()
+        .collect();
     assert_eq!(bits(&s.named(mi_sim_field, "position")), bits(&pos));
     for f in &snap.fields {
         assert_eq!(
@@ -856,8 +861,9 @@ fn only_the_documented_scene_names_are_accepted() {
         assert_eq!(d.to_str().unwrap(), "unknown scene name");
     }
     let names = meshless_impact::builtin_names();
-    assert_eq!(names.len(), 15);
+    assert_eq!(names.len(), 16);
     assert_eq!(names[14], "table1-12");
+    assert_eq!(names[15], "taylor3d-aisi310");
     for name in &names {
         let s = new_sim(name);
         let scene = Scene::builtin(name).unwrap();

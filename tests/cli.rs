@@ -1,5 +1,7 @@
 //! The command-line program: errors, outputs and the documented JSON keys.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -85,31 +87,17 @@ fn out_of_range_value_names_parameter_value_and_range() {
 fn json_has_every_observable_and_run_facts() {
     let dir = std::env::temp_dir().join(format!("mi-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let json = dir.join("out.json");
-    let csv = dir.join("hist.csv");
-    let vtk = dir.join("vtk");
-    let out = bin()
-        .args([
+    let common::CliOutputs { json, csv, vtk } = common::run_cli_with_outputs(
+        &[
             "run",
             "-q",
             "--set",
             "particles_radial=4",
             "--set",
             "end_time=3e-6",
-        ])
-        .arg("--json")
-        .arg(&json)
-        .arg("--csv")
-        .arg(&csv)
-        .arg("--vtk-dir")
-        .arg(&vtk)
-        .args(["--vtk-times", "1e-6"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        ],
+        &dir,
+        "1e-6",
     );
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
@@ -145,25 +133,7 @@ fn json_has_every_observable_and_run_facts() {
     // The collection lists both snapshots with their times: the first step
     // at or after 1 us, and the end of the run.
     let pvd = std::fs::read_to_string(vtk.join("particles.pvd")).unwrap();
-    let mut reader = quick_xml::Reader::from_str(&pvd);
-    let mut sets = Vec::new();
-    loop {
-        match reader.read_event().unwrap() {
-            quick_xml::events::Event::Empty(e) if e.name().as_ref() == b"DataSet" => {
-                let attr = |k: &str| {
-                    e.try_get_attribute(k)
-                        .unwrap()
-                        .unwrap()
-                        .unescape_value()
-                        .unwrap()
-                        .into_owned()
-                };
-                sets.push((attr("timestep").parse::<f64>().unwrap(), attr("file")));
-            }
-            quick_xml::events::Event::Eof => break,
-            _ => {}
-        }
-    }
+    let sets = common::pvd_datasets(&vtk.join("particles.pvd"));
     assert_eq!(sets.len(), 2, "{pvd}");
     assert_eq!(sets[0].1, "particles_0000.vtu");
     assert_eq!(sets[1].1, "particles_0001.vtu");

@@ -30,3 +30,67 @@ pub fn tail_slowdown_time(sim: &Simulation) -> f64 {
 pub fn pct(value: f64, reference: f64) -> f64 {
     100.0 * (value - reference) / reference
 }
+
+/// The data sets of a ParaView collection (`.pvd`): (time, file) each, in
+/// order.
+pub fn pvd_datasets(path: &std::path::Path) -> Vec<(f64, String)> {
+    let pvd = std::fs::read_to_string(path).unwrap();
+    let mut reader = quick_xml::Reader::from_str(&pvd);
+    let mut sets = Vec::new();
+    loop {
+        match reader.read_event().unwrap() {
+            quick_xml::events::Event::Empty(e) if e.name().as_ref() == b"DataSet" => {
+                let attr = |k: &str| {
+                    e.try_get_attribute(k)
+                        .unwrap()
+                        .unwrap()
+                        .unescape_value()
+                        .unwrap()
+                        .into_owned()
+                };
+                sets.push((attr("timestep").parse::<f64>().unwrap(), attr("file")));
+            }
+            quick_xml::events::Event::Eof => break,
+            _ => {}
+        }
+    }
+    sets
+}
+
+/// The outputs of one command-line run: `--json`, `--csv` and `--vtk-dir`.
+pub struct CliOutputs {
+    /// The final observables (JSON).
+    pub json: std::path::PathBuf,
+    /// The histories (CSV).
+    pub csv: std::path::PathBuf,
+    /// The snapshots and their collection `particles.pvd`.
+    pub vtk: std::path::PathBuf,
+}
+
+/// Runs `meshless-impact ARGS` with `--json`, `--csv` and `--vtk-dir`
+/// into `dir` (snapshots at `vtk_times` and at the end) and asserts that it
+/// succeeded.
+pub fn run_cli_with_outputs(args: &[&str], dir: &std::path::Path, vtk_times: &str) -> CliOutputs {
+    let o = CliOutputs {
+        json: dir.join("out.json"),
+        csv: dir.join("hist.csv"),
+        vtk: dir.join("vtk"),
+    };
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
+        .args(args)
+        .arg("--json")
+        .arg(&o.json)
+        .arg("--csv")
+        .arg(&o.csv)
+        .arg("--vtk-dir")
+        .arg(&o.vtk)
+        .args(["--vtk-times", vtk_times])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    o
+}

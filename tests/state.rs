@@ -2,6 +2,8 @@
 //! way a new scene with the same values would be refused; an unedited state
 //! is accepted and resumes (issue: forged saved states are accepted).
 
+mod common;
+
 use meshless_impact::{Scene, Simulation};
 use serde_json::{Value, json};
 
@@ -201,4 +203,147 @@ fn a_preset_run_round_trips_and_a_forged_material_is_refused() {
     s["scene"]["material"]["strength"] = json!("plastic");
     let msg = refused(&s);
     assert!(msg.contains("plastic"), "{msg}");
+}
+
+/// The bits of everything a run shows: its clock, every observable, every
+/// particle field and the recorded histories.
+fn bits(s: &Simulation) -> Vec<u64> {
+    let mut v = vec![s.time(), s.steps() as f64];
+    v.extend(s.observables());
+    for f in s.field_specs() {
+        v.extend(s.field(f.name).unwrap());
+    }
+    v.extend(&s.history().times);
+    v.extend(&s.history().values);
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// A `taylor3d` run (3 nodes across the radius) saved mid-way, as JSON
+/// (`Simulation::serialize_state`, the solver's `ModelState::save`) and as
+/// a copy (`ModelState::boxed_clone`), restored and run to rest, gives the
+/// bits of the run that was not interrupted: clock, observables, every 3-D
+/// field and the histories. (The FMU state, postcard: src/fmi/mod.rs and
+/// tests/fmu/test_taylor3d.py.)
+#[test]
+fn a_taylor3d_run_saved_mid_way_resumes_to_the_bits_of_the_whole_run() {
+    let sets = [("particles_radial", 3.0)];
+    let whole = common::run(Scene::builtin("taylor3d").unwrap(), &sets);
+    assert_eq!(whole.observable("at_rest"), Some(1.0));
+    let (mid, state) = saved("taylor3d", &sets, 10e-6);
+    assert!(
+        mid.steps() > 10 && mid.steps() < whole.steps() / 2,
+        "mid-way"
+    );
+    let mut back = Simulation::deserialize_state(&serde_json::to_vec(&state).unwrap()).unwrap();
+    let mut copy = mid.clone();
+    assert_eq!(bits(&back), bits(&mid), "restored as saved");
+    back.run().unwrap();
+    copy.run().unwrap();
+    assert_eq!(bits(&back), bits(&whole), "restored from JSON");
+    assert_eq!(bits(&copy), bits(&whole), "copied");
+}
+
+/// Each edit a forger might make to a `taylor3d` state (as for `taylor`,
+/// forged_taylor_states_are_refused), each refused with `InvalidState` and a
+/// message that says what is wrong.
+#[test]
+fn forged_taylor3d_states_are_refused() {
+    let (_, base) = saved("taylor3d", &[("particles_radial", 3.0)], 3e-6);
+    type Edit = fn(&mut Value);
+    let edits: [(&str, Edit, &str); 14] = [
+        (
+            "scene parameter out of range",
+            |s| s["scene"]["params"]["Taylor3d"]["density"] = json!(-5.0),
+            "density",
+        ),
+        (
+            "the solver's setup differs from the scene's",
+            |s| solver(s, "Taylor3d")["setup"]["impact_speed"] = json!(200.0),
+            "parameters",
+        ),
+        (
+            "the material edited",
+            |s| solver(s, "Taylor3d")["material"]["shear_modulus"] = json!(80e9),
+            "material",
+        ),
+        (
+            "a node removed",
+            |s| {
+                solver(s, "Taylor3d")["pos"].as_array_mut().unwrap().pop();
+            },
+            "positions",
+        ),
+        (
+            "a mass changed",
+            |s| solver(s, "Taylor3d")["mass"][3] = json!(1.0),
+            "masses",
+        ),
+        (
+            "a contact flag removed",
+            |s| {
+                solver(s, "Taylor3d")["contact"]
+                    .as_array_mut()
+                    .unwrap()
+                    .pop();
+            },
+            "contact",
+        ),
+        (
+            "a negative density",
+            |s| solver(s, "Taylor3d")["rho"][7] = json!(-1.0),
+            "densities",
+        ),
+        (
+            "a negative plastic strain",
+            |s| solver(s, "Taylor3d")["eps_p"][7] = json!(-0.5),
+            "plastic strains",
+        ),
+        (
+            "a negative temperature",
+            |s| solver(s, "Taylor3d")["temp"][2] = json!(-300.0),
+            "temperatures",
+        ),
+        (
+            "a zero time step",
+            |s| solver(s, "Taylor3d")["dt"] = json!(0.0),
+            "clock",
+        ),
+        (
+            "a time step of seconds",
+            |s| solver(s, "Taylor3d")["dt"] = json!(1.0),
+            "clock",
+        ),
+        (
+            "steps reset at a later time",
+            |s| solver(s, "Taylor3d")["steps"] = json!(0),
+            "step count",
+        ),
+        (
+            "a record interval of zero (the hang)",
+            |s| s["record_interval"] = json!(0.0),
+            "record",
+        ),
+        (
+            "a history row cut short",
+            |s| {
+                s["history"]["values"].as_array_mut().unwrap().pop();
+            },
+            "history",
+        ),
+    ];
+    let mut wrong = Vec::new();
+    for (what, edit, says) in edits {
+        let mut state = base.clone();
+        edit(&mut state);
+        match Simulation::deserialize_state(&serde_json::to_vec(&state).unwrap()) {
+            Ok(_) => wrong.push(format!("{what}: accepted")),
+            Err(e) if e.name() != "InvalidState" || !e.to_string().contains(says) => {
+                wrong.push(format!("{what}: {e}"))
+            }
+            Err(_) => {}
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
+    // The unedited state loads.
+    Simulation::deserialize_state(&serde_json::to_vec(&base).unwrap()).unwrap();
 }

@@ -114,3 +114,28 @@ fn aisi310_in_3d_against_the_axisymmetric_solver() {
 fn aisi310_in_3d_at_11_across() {
     aisi310(11.0, 41.0);
 }
+
+/// The material's cross-checks hold in 3-D as in `taylor`: a melt
+/// temperature not above the room temperature, or a rod hotter than its
+/// melt, is refused before anything runs (before, the 3-D row checked only
+/// the geometry, and such a rod ran until its energy error passed the
+/// bound).
+#[test]
+fn temperatures_are_checked_as_in_taylor() {
+    for (name, value, says) in [
+        ("melt_temperature", 293.0, "must exceed room_temperature"),
+        (
+            "initial_temperature",
+            1500.0,
+            "must be below melt_temperature",
+        ),
+    ] {
+        for kind in ["taylor", "taylor3d"] {
+            let mut scene = Scene::builtin(kind).unwrap();
+            scene.set(name, value).unwrap();
+            let e = meshless_impact::Simulation::new(scene).unwrap_err();
+            assert_eq!(e.name(), "Inconsistent", "{kind}: {e}");
+            assert!(e.to_string().contains(says), "{kind}: {e}");
+        }
+    }
+}

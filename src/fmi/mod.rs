@@ -1207,14 +1207,14 @@ mod tests {
         assert!(t.starts_with('{') && t.ends_with('}'));
     }
 
-    /// The value reference of a variable.
+    /// The value reference of a variable of the Taylor FMU.
     fn vr_of(name: &str) -> u32 {
-        taylor_fmu()
-            .variables()
-            .iter()
-            .find(|v| v.name == name)
-            .unwrap()
-            .vr
+        vr_in(taylor_fmu(), name)
+    }
+
+    /// The value reference of a variable of `fmu`.
+    fn vr_in(fmu: Fmu, name: &str) -> u32 {
+        fmu.variables().iter().find(|v| v.name == name).unwrap().vr
     }
 
     /// A new instance at 4 particles across the radius (cheap steps).
@@ -1591,6 +1591,125 @@ mod tests {
             }
         }
         assert_eq!(forged, values.len());
+    }
+
+    /// An initialized FMI 3 instance of the 3-D FMU at 3 nodes across the
+    /// radius.
+    fn taylor3d_instance() -> Instance {
+        let fmu = Fmu::named("Taylor3dImpact").expect("the registry declares the 3-D FMU");
+        let mut inst = Instance::new(Standard::Fmi3, fmu, "t3d", LogSink::None, false);
+        let pr = vr_in(fmu, "particles_radial");
+        assert_eq!(inst.set("set", &[pr], &[3.0], VarType::Int32), Status::Ok);
+        assert_eq!(inst.enter_initialization_mode(), Status::Ok);
+        assert_eq!(inst.exit_initialization_mode(), Status::Ok);
+        inst
+    }
+
+    /// Steps `inst` from `t` by 1 us until the run ends; the bits of its
+    /// outputs, its clock and every particle field then.
+    fn bits_at_the_end(inst: &mut Instance, mut t: f64) -> Vec<u64> {
+        while !inst.do_step("doStep", t, 1e-6).unwrap().terminate {
+            t += 1e-6;
+        }
+        run_bits(inst.sim.as_ref().unwrap())
+    }
+
+    /// The bits of a run's clock, outputs and particle fields.
+    fn run_bits(sim: &Simulation) -> Vec<u64> {
+        let mut v = vec![sim.time(), sim.steps() as f64];
+        v.extend(sim.observables());
+        for f in sim.field_specs() {
+            v.extend(sim.field(f.name).unwrap());
+        }
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// The 3-D FMU's state: a run saved mid-way (its postcard bytes),
+    /// restored into another instance and stepped to the end, gives the
+    /// bits of the run that was not interrupted, and of `Simulation` on
+    /// the same scene; forged states are refused with what is wrong.
+    #[test]
+    fn taylor3d_fmu_state_resumes_to_the_bits_of_the_whole_run() {
+        let mut whole = taylor3d_instance();
+        let fmu = whole.fmu;
+        let whole_bits = bits_at_the_end(&mut whole, 0.0);
+        let mut scene = Scene::builtin("taylor3d").unwrap();
+        scene.set("particles_radial", 3.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        sim.run().unwrap();
+        assert_eq!(sim.observable("at_rest"), Some(1.0));
+        assert_eq!(whole_bits, run_bits(&sim), "the FMU runs the scene's run");
+        let mut inst = taylor3d_instance();
+        let mut t = 0.0;
+        for _ in 0..10 {
+            inst.do_step("doStep", t, 1e-6).unwrap();
+            t += 1e-6;
+        }
+        let bytes = inst.save().serialize(fmu);
+        assert!(bytes.starts_with(b"Taylor3dImpact FMU state v2 postcard\n{"));
+        let mut other = Instance::new(Standard::Fmi2, fmu, "u", LogSink::None, false);
+        other.restore(&Saved::deserialize(fmu, &bytes).unwrap());
+        assert_eq!(bits_at_the_end(&mut other, t), whole_bits, "restored");
+        assert_eq!(bits_at_the_end(&mut inst, t), whole_bits, "not saved");
+
+        // Forged: each refused, naming what is wrong; a Taylor state too.
+        let forge = |edit: fn(&mut serde_json::Value)| {
+            let mut json = fmu.state_to_json(&bytes).unwrap();
+            edit(&mut json);
+            fmu.state_from_json(json).unwrap()
+        };
+        type Edit = fn(&mut serde_json::Value);
+        let edits: [(Edit, &str); 4] = [
+            (
+                |j| j["sim"]["solver"]["Taylor3d"]["mass"][0] = serde_json::json!(1.0),
+                "masses",
+            ),
+            (
+                |j| {
+                    j["sim"]["solver"]["Taylor3d"]["pos"]
+                        .as_array_mut()
+                        .unwrap()
+                        .pop();
+                },
+                "positions",
+            ),
+            (
+                |j| j["sim"]["solver"]["Taylor3d"]["temp"][4] = serde_json::json!(-1.0),
+                "temperatures",
+            ),
+            (
+                |j| j["scene"]["params"]["Taylor3d"]["damping"] = serde_json::json!(0.9),
+                "damping",
+            ),
+        ];
+        for (edit, why) in edits {
+            match Saved::deserialize(fmu, &forge(edit)) {
+                Ok(_) => panic!("{why}: the forged state was accepted"),
+                Err(e) => assert!(e.contains(why), "{e} should name {why}"),
+            }
+        }
+        assert!(Saved::deserialize(fmu, &forge(|_| {})).is_ok());
+        let e = Saved::deserialize(fmu, &stepped_bytes()).unwrap_err();
+        assert_eq!(e, "the bytes are not a serialized Taylor3dImpact FMU state");
+        let e = Saved::deserialize(taylor_fmu(), &bytes).unwrap_err();
+        assert_eq!(e, "the bytes are not a serialized TaylorImpact FMU state");
+        // A NaN or an infinity in place of the internal energy (postcard
+        // holds them; JSON cannot).
+        let energy =
+            fmu.state_to_json(&bytes).unwrap()["sim"]["solver"]["Taylor3d"]["internal_energy"]
+                .as_f64()
+                .unwrap();
+        assert!(energy > 0.0);
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut data = bytes.clone();
+            let at = data
+                .windows(8)
+                .position(|w| w == energy.to_le_bytes())
+                .expect("the energy is in the bytes");
+            data[at..at + 8].copy_from_slice(&bad.to_le_bytes());
+            let e = Saved::deserialize(fmu, &data).unwrap_err();
+            assert!(e.contains("clock and energies"), "{bad}: {e}");
+        }
     }
 
     #[test]

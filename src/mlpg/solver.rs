@@ -1176,25 +1176,37 @@ impl Mlpg3d {
                 return Err(format!("its {what} are not {n} finite tensors"));
             }
         }
+        // Each with the least physical value.
         let scalars = [
-            ("densities", &self.rho),
-            ("pressures", &self.pressure),
-            ("plastic strains", &self.eps_p),
-            ("temperatures", &self.temp),
+            ("densities", &self.rho, f64::MIN_POSITIVE),
+            ("pressures", &self.pressure, f64::NEG_INFINITY),
+            ("plastic strains", &self.eps_p, 0.0),
+            ("temperatures", &self.temp, f64::MIN_POSITIVE),
         ];
-        for (what, f) in scalars {
-            if f.len() != n || !f.iter().all(|x| x.is_finite()) {
-                return Err(format!("its {what} are not {n} finite values"));
+        for (what, f, least) in scalars {
+            if f.len() != n || !f.iter().all(|&x| x.is_finite() && x >= least) {
+                return Err(format!("its {what} are not {n} finite, physical values"));
             }
         }
         if self.contact.len() != n {
             return Err(format!("its contact flags are not {n}"));
         }
-        let clock = [self.time, self.dt];
-        if !clock.iter().all(|x| x.is_finite() && *x >= 0.0) || self.dt <= 0.0 {
-            return Err("its clock is not a finite time and a positive step".into());
-        }
-        Ok(())
+        crate::solver::check_restored_clock(
+            self.time,
+            self.dt,
+            self.dt0,
+            self.steps,
+            &[
+                self.min_spacing,
+                self.internal_energy,
+                self.plastic_work,
+                self.damping_dissipation,
+                self.contact_dissipation,
+                self.smoothing_dissipation,
+                self.quiet_since.unwrap_or(0.0),
+                self.last_release,
+            ],
+        )
     }
 }
 

@@ -1,5 +1,6 @@
 //! Error against run time: the cylindrical Noh problem against its exact
-//! solution, and Taylor test 7 against experiment and against the finest run.
+//! solution, Taylor test 7 against experiment and against the finest run,
+//! and test 7 in 3-D (MLPG) beside it.
 
 use super::plot::{Axes, Series};
 use super::runner::{CaseRun, Probe, run_case, scene};
@@ -52,8 +53,30 @@ pub struct TaylorPoint {
     pub energy_error: f64,
     /// Smallest neighbour spacing over the initial one, over the run.
     pub min_spacing: f64,
+    /// Spread of the impact face's radius around the axis, (max - min) /
+    /// mean (3-D only; NaN in the axisymmetric runs).
+    pub spread: f64,
     /// Outcome label.
     pub outcome: String,
+}
+
+impl TaylorPoint {
+    /// The point of a run at `across` particles (nodes) across the radius.
+    fn of(across: usize, run: &CaseRun) -> Self {
+        TaylorPoint {
+            across,
+            particles: run.particles,
+            steps: run.steps,
+            wall_s: run.wall_s,
+            lf: run.get("rod_length"),
+            df: 2.0 * run.get("mushroom_radius"),
+            lu: run.get("undeformed_length"),
+            energy_error: run.get("energy_error"),
+            min_spacing: run.min_spacing,
+            spread: run.get("mushroom_radius_spread"),
+            outcome: run.outcome.label().to_string(),
+        }
+    }
 }
 
 /// Observed order of convergence: minus the least-squares slope of
@@ -208,9 +231,9 @@ pub(super) const MAP_TIMES: [f64; 2] = [15e-6, 30e-6];
 /// End of the per-step face-lift record (3 microseconds).
 pub(super) const FACE_LIFT_WINDOW: f64 = 3e-6;
 
-/// The Taylor test 7 convergence study. Returns the run at the figures'
-/// resolution (with its snapshots and face-lift record).
-pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<CaseRun> {
+/// The Taylor test 7 convergence study. Returns its points and the run at
+/// the figures' resolution (with its snapshots and face-lift record).
+pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<(Vec<TaylorPoint>, CaseRun)> {
     let probe = Probe {
         snapshot_times: MAP_TIMES.to_vec(),
         per_step: vec!["face_lift"],
@@ -223,18 +246,7 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<CaseRun> {
     for &n in &plan.taylor {
         super::progress!("report: Taylor test 7, {n} particles across the radius");
         let run = run_case(scene("taylor", &[("particles_radial", n as f64)]), &probe);
-        points.push(TaylorPoint {
-            across: n,
-            particles: run.particles,
-            steps: run.steps,
-            wall_s: run.wall_s,
-            lf: run.get("rod_length"),
-            df: 2.0 * run.get("mushroom_radius"),
-            lu: run.get("undeformed_length"),
-            energy_error: run.get("energy_error"),
-            min_spacing: run.min_spacing,
-            outcome: run.outcome.label().to_string(),
-        });
+        points.push(TaylorPoint::of(n, &run));
         if n as f64 == plan.figures {
             figure_run = Some(run);
         }
@@ -360,7 +372,93 @@ pub(super) fn taylor(plan: &Plan, doc: &mut Doc) -> Result<CaseRun> {
         ),
     }
     doc.para(&text);
-    Ok(figure_run)
+    Ok((points, figure_run))
+}
+
+/// Test 7 in 3-D by the MLPG solver (`taylor3d`) at the plan's nodes across
+/// the radius, against experiment, beside the axisymmetric runs `msph` of
+/// [`taylor`]: the errors of both solvers against wall time.
+pub(super) fn taylor3d(plan: &Plan, doc: &mut Doc, msph: &[TaylorPoint]) -> Result<()> {
+    let probe = Probe::default();
+    let mut points = Vec::new();
+    for &n in &plan.taylor3d {
+        super::progress!("report: Taylor test 7 in 3-D, {n} nodes across the radius");
+        let run = run_case(scene("taylor3d", &[("particles_radial", n as f64)]), &probe);
+        points.push(TaylorPoint::of(n, &run));
+    }
+    let reference = meshless_impact::Scene::builtin("taylor3d")?.reference;
+    let exp = [reference["rod_length"], 2.0 * reference["mushroom_radius"]];
+    let mut t = Table::new(
+        "taylor3d_convergence",
+        &[
+            "across",
+            "nodes",
+            "steps",
+            "wall_s",
+            "Lf_mm",
+            "Lf_vs_exp",
+            "Df_mm",
+            "Df_vs_exp",
+            "Lu_mm",
+            "face_radius_spread",
+            "energy_error",
+            "min_spacing_ratio",
+            "outcome",
+        ],
+    );
+    for p in &points {
+        t.push(vec![
+            p.across.to_string(),
+            p.particles.to_string(),
+            p.steps.to_string(),
+            sig(p.wall_s, 3),
+            format!("{:.3}", p.lf * 1e3),
+            pct(p.lf, exp[0]),
+            format!("{:.3}", p.df * 1e3),
+            pct(p.df, exp[1]),
+            format!("{:.3}", p.lu * 1e3),
+            sig(p.spread, 3),
+            sig(p.energy_error, 3),
+            sig(p.min_spacing, 3),
+            p.outcome.clone(),
+        ]);
+    }
+    doc.para(
+        "### 1.3 Taylor test 7 in 3-D (MLPG mixed method)\n\n\
+         `meshless-impact run taylor3d --set particles_radial=N`: the same rod on the \
+         ring lattice in three dimensions, N nodes across the radius (axis and mantle \
+         included; the spacing of an axisymmetric run with the same N). Errors are \
+         signed, against experiment; `face_radius_spread` is the spread of the impact \
+         face's radius around the axis, (max - min) / mean, zero for an exactly \
+         axisymmetric solution.",
+    );
+    doc.table(&t)?;
+    let names = ["final length Lf", "impact-face diameter Df"];
+    let vals = |p: &TaylorPoint| [p.lf, p.df];
+    let series: Vec<Series> = [("axisymmetric MSPH", msph), ("3-D MLPG", &points[..])]
+        .into_iter()
+        .flat_map(|(solver, pts)| {
+            (0..2).map(move |k| {
+                Series::line(
+                    format!("{solver}: {}", names[k]),
+                    pts.iter()
+                        .filter(|p| p.outcome == "finished")
+                        .map(|p| (p.wall_s, (vals(p)[k] - exp[k]).abs() / exp[k]))
+                        .collect(),
+                )
+            })
+        })
+        .collect();
+    doc.lines(
+        "taylor_error_vs_time_solvers.svg",
+        Axes::log_log(
+            "Taylor test 7: |error| against experiment vs wall time, both solvers",
+            "wall time (s)",
+            "relative error",
+        ),
+        &series,
+    )?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -46,6 +46,8 @@ pub(crate) struct Plan {
     pub noh: Vec<usize>,
     /// Taylor particles across the radius for the convergence study.
     pub taylor: Vec<usize>,
+    /// Nodes across the radius of the 3-D (`taylor3d`) runs of the study.
+    pub taylor3d: Vec<usize>,
     /// Particles across the radius of the sensitivity, Table 1 and stability runs.
     pub resolution: f64,
     /// Resolution of the test 7 time histories and maps.
@@ -61,6 +63,7 @@ impl Plan {
                 quick,
                 noh: vec![100, 200, 400],
                 taylor: vec![4, 6, 8],
+                taylor3d: vec![3],
                 resolution: 6.0,
                 figures: 8.0,
                 wall_budget: 120.0,
@@ -70,6 +73,7 @@ impl Plan {
                 quick,
                 noh: vec![100, 200, 400, 800, 1600, 3200],
                 taylor: vec![8, 10, 15, 20, 31, 41, 61],
+                taylor3d: vec![3, 4, 6],
                 resolution: 20.0,
                 figures: 20.0,
                 wall_budget: 7200.0,
@@ -271,7 +275,8 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
         }
     );
     convergence::noh(&plan, &mut doc)?;
-    let figure_run = convergence::taylor(&plan, &mut doc)?;
+    let (taylor, figure_run) = convergence::taylor(&plan, &mut doc)?;
+    convergence::taylor3d(&plan, &mut doc, &taylor)?;
     figures::test7(&plan, &mut doc, figure_run)?;
     profiles::aisi310(&plan, &mut doc)?;
     sensitivity::smoothing(&plan, &mut doc)?;

@@ -212,9 +212,10 @@ where
     root.present().map_err(|e| plot_err(path, e))
 }
 
-/// Particles in the R-Z plane coloured by `values` (viridis), with a colour
-/// bar. Lengths are plotted in millimetres.
-pub fn map(path: &Path, title: &str, positions: &[[f64; 2]], values: &[f64]) -> Result<()> {
+/// Particles in the R-Z plane (the first two coordinates of axisymmetric
+/// [`crate::Snapshot::positions`]) coloured by `values` (viridis), with a
+/// colour bar. Lengths are plotted in millimetres.
+pub fn map(path: &Path, title: &str, positions: &[[f64; 3]], values: &[f64]) -> Result<()> {
     let (v0, v1) = values
         .iter()
         .filter(|v| v.is_finite())

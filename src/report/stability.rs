@@ -35,23 +35,49 @@ pub struct StabilityCase {
 }
 
 struct Def {
-    name: &'static str,
+    name: String,
     scene: &'static str,
     sets: Vec<(&'static str, f64)>,
 }
 
-fn def(name: &'static str, scene: &'static str, sets: Vec<(&'static str, f64)>) -> Def {
-    Def { name, scene, sets }
+fn def(name: impl Into<String>, scene: &'static str, sets: Vec<(&'static str, f64)>) -> Def {
+    Def {
+        name: name.into(),
+        scene,
+        sets,
+    }
+}
+
+/// `first`, then `sets`.
+fn with(first: (&'static str, f64), sets: &[(&'static str, f64)]) -> Vec<(&'static str, f64)> {
+    let mut v = vec![first];
+    v.extend_from_slice(sets);
+    v
+}
+
+/// One row for each kind of invalid input to a rod scene (`taylor`,
+/// `taylor3d`), named `<prefix>invalid_<kind>`: a value out of range, zero,
+/// NaN, infinite, parameters inconsistent together, a particle count out of
+/// range, an unknown name.
+fn invalid_inputs(prefix: &str, scene: &'static str) -> Vec<Def> {
+    let p = TaylorParams::default();
+    [
+        ("density", "density", -7830.0),
+        ("diameter", "initial_diameter", 0.0),
+        ("speed_nan", "impact_speed", f64::NAN),
+        ("speed_inf", "impact_speed", f64::INFINITY),
+        ("melt", "melt_temperature", p.room_temperature),
+        ("particles", "particles_radial", 0.0),
+        ("name", "impact_sped", 200.0),
+    ]
+    .into_iter()
+    .map(|(kind, k, v)| def(format!("{prefix}invalid_{kind}"), scene, vec![(k, v)]))
+    .collect()
 }
 
 fn cases(plan: &Plan) -> Vec<Def> {
     let p = TaylorParams::default();
-    let n = ("particles_radial", plan.resolution);
-    let t = |sets: &[(&'static str, f64)]| {
-        let mut v = vec![n];
-        v.extend_from_slice(sets);
-        v
-    };
+    let t = |sets: &[(&'static str, f64)]| with(("particles_radial", plan.resolution), sets);
     // The large-strain scheme (README): h = 2.0 spacings, velocity smoothing
     // of order 2, particle shifting.
     let large = |speed: f64, extra: &[(&'static str, f64)]| {
@@ -142,34 +168,55 @@ fn cases(plan: &Plan) -> Vec<Def> {
             "noh",
             vec![("particles_radial", 100.0), ("outer_radius", 0.05)],
         ),
-        def("invalid_density", "taylor", vec![("density", -7830.0)]),
-        def(
-            "invalid_diameter",
-            "taylor",
-            vec![("initial_diameter", 0.0)],
-        ),
-        def(
-            "invalid_speed_nan",
-            "taylor",
-            vec![("impact_speed", f64::NAN)],
-        ),
-        def(
-            "invalid_speed_inf",
-            "taylor",
-            vec![("impact_speed", f64::INFINITY)],
-        ),
-        def(
-            "invalid_melt",
-            "taylor",
-            vec![("melt_temperature", p.room_temperature)],
-        ),
-        def(
-            "invalid_particles",
-            "taylor",
-            vec![("particles_radial", 0.0)],
-        ),
-        def("invalid_name", "taylor", vec![("impact_sped", 200.0)]),
     ]
+    .into_iter()
+    .chain(invalid_inputs("", "taylor"))
+    .chain(cases_3d(plan))
+    .collect()
+}
+
+/// Nodes across the radius of the 3-D rows: 3 in the quick plan (each row
+/// a few seconds at most), the scene's default 6 in the full one.
+fn nodes_3d(plan: &Plan) -> f64 {
+    if plan.quick { 3.0 } else { 6.0 }
+}
+
+/// The rows of the 3-D solver (`taylor3d`): a stiff material, a fast
+/// shot, the coarsest lattice (3 nodes across in both plans), each kind of
+/// invalid input, and a damping ratio out of range.
+fn cases_3d(plan: &Plan) -> Vec<Def> {
+    let p = TaylorParams::default();
+    let t = |sets: &[(&'static str, f64)]| with(("particles_radial", nodes_3d(plan)), sets);
+    vec![
+        def(
+            "taylor3d_bulk_x10",
+            "taylor3d",
+            t(&[("bulk_modulus", 10.0 * p.bulk_modulus)]),
+        ),
+        def(
+            "taylor3d_bulk_x100",
+            "taylor3d",
+            t(&[("bulk_modulus", 100.0 * p.bulk_modulus)]),
+        ),
+        def(
+            "taylor3d_speed_600",
+            "taylor3d",
+            t(&[("impact_speed", 600.0)]),
+        ),
+        def(
+            "taylor3d_coarse_3",
+            "taylor3d",
+            vec![("particles_radial", 3.0)],
+        ),
+    ]
+    .into_iter()
+    .chain(invalid_inputs("taylor3d_", "taylor3d"))
+    .chain([def(
+        "taylor3d_invalid_damping",
+        "taylor3d",
+        vec![("damping", 0.9)],
+    )])
+    .collect()
 }
 
 fn setup_text(d: &Def) -> String {
@@ -202,7 +249,7 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<()> {
     );
     for (d, r) in defs.iter().zip(&runs) {
         let c = StabilityCase {
-            name: d.name.to_string(),
+            name: d.name.clone(),
             setup: setup_text(d),
             outcome: r.outcome.label().to_string(),
             message: r.outcome.message(),
@@ -237,7 +284,9 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<()> {
     doc.para(&format!(
         "## 5. Stability on stiff and extreme cases\n\n\
          Taylor cases run at {} particles across the radius unless the case sets it \
-         (test 7 otherwise; SI units), Noh cases as given. The `large_strain_` cases \
+         (test 7 otherwise; SI units), Noh cases as given. The `taylor3d_` cases run \
+         the 3-D MLPG solver (test 7 otherwise) at {} nodes across the radius unless \
+         the case sets it. The `large_strain_` cases \
          use the large-strain scheme (`smoothing_ratio=2 smoothing_order=2 \
          shifting=0.1`, README). `outcome` is `finished` \
          (end condition reached: the rod at rest, or t = 0.6 for Noh) or the name of \
@@ -248,7 +297,9 @@ pub(super) fn matrix(plan: &Plan, doc: &mut Doc) -> Result<()> {
          lists every final observable, history column or particle field holding a \
          NaN or an infinity. A case still running after {} s would be stopped and \
          reported as `over wall budget` (a hang).",
-        plan.resolution, plan.wall_budget
+        plan.resolution,
+        nodes_3d(plan),
+        plan.wall_budget
     ));
     doc.table(&t)?;
     let elastic = &runs[0];

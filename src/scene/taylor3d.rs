@@ -40,7 +40,12 @@ pub static ROW: SceneRow = SceneRow {
         Ok(Box::new(Taylor3dParams::of(s).build_with(material)?))
     },
     restore: restore::<Mlpg3d>,
-    fmu: None,
+    fmu: Some(super::registry::FmuIdentity {
+        model_identifier: "Taylor3dImpact",
+        model_name: "Taylor3dImpact",
+        description: "Taylor rod impact on a rigid anvil in 3-D: the MLPG mixed method (Han, Liu, Rajendran & Atluri) \
+                      with Johnson-Cook thermo-viscoplasticity; defaults are House et al. (1995) test 7 on 4340 steel",
+    }),
 };
 
 /// The material models of a `taylor3d` scene.

@@ -579,30 +579,19 @@ impl TaylorSolver {
             "temperatures",
             self.temp.iter().all(|&x| x.is_finite() && x > 0.0),
         )?;
-        let scalars = [
+        super::check_restored_clock(
             self.time,
             self.dt,
-            self.internal_energy,
-            self.smoothing_dissipation,
-            self.contact_dissipation,
-            self.min_spacing,
-            self.quiet_since.unwrap_or(0.0),
-        ];
-        finite("clock and energies", scalars.iter().all(|x| x.is_finite()))?;
-        // The step follows the wave speed, which a run cannot raise fourfold
-        // (that would take the density to a sixteenth); a forged step of
-        // seconds would fling the particles across the grid.
-        finite(
-            "clock",
-            self.time >= 0.0 && self.dt > 0.0 && self.dt <= 4.0 * self.dt0,
-        )?;
-        if (self.steps == 0) != (self.time == 0.0) {
-            return Err(format!(
-                "its step count {} does not match its time {}",
-                self.steps, self.time
-            ));
-        }
-        Ok(())
+            self.dt0,
+            self.steps,
+            &[
+                self.internal_energy,
+                self.smoothing_dissipation,
+                self.contact_dissipation,
+                self.min_spacing,
+                self.quiet_since.unwrap_or(0.0),
+            ],
+        )
     }
 
     /// Particles across the radius and along the axis.

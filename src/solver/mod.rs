@@ -76,6 +76,38 @@ pub(crate) fn check_time_step(dt: f64, dt0: f64, time: f64) -> crate::Result<()>
     }
 }
 
+/// Checks the clock of a restored run (the message says what is wrong): a
+/// finite time from zero; a positive step no longer than four times the
+/// first (the step follows the wave speed, which a run cannot raise
+/// fourfold, as that would take the density to a sixteenth; a forged step
+/// of seconds would fling the particles across the lattice); steps taken
+/// exactly when time has passed; and finite `bookkeeping` (energies, the
+/// smallest spacing, ...).
+pub(crate) fn check_restored_clock(
+    time: f64,
+    dt: f64,
+    dt0: f64,
+    steps: u64,
+    bookkeeping: &[f64],
+) -> std::result::Result<(), String> {
+    if !bookkeeping
+        .iter()
+        .chain([&time, &dt])
+        .all(|x| x.is_finite())
+    {
+        return Err("its clock and energies are not all finite and in range".into());
+    }
+    if !(time >= 0.0 && dt > 0.0 && dt <= 4.0 * dt0) {
+        return Err("its clock are not all finite and in range".into());
+    }
+    if (steps == 0) != (time == 0.0) {
+        return Err(format!(
+            "its step count {steps} does not match its time {time}"
+        ));
+    }
+    Ok(())
+}
+
 /// Index and field of the first non-finite value, if any.
 pub(crate) fn first_non_finite(fields: &[(&'static str, &[f64])]) -> Option<(&'static str, usize)> {
     fields

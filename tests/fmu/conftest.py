@@ -3,7 +3,6 @@ see run.sh), extracted once, and helpers that drive them through fmpy's
 low-level classes."""
 
 import json
-import os
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -52,22 +51,58 @@ def fmu2():
     return Model(FMU2, read_model_description(str(FMU2)), extract(str(FMU2)))
 
 
-_cli_cache = {}
-
-
 def cli_run(tmp_path_factory, *sets):
-    """Final observables of the command-line program for `--set` pairs."""
-    key = tuple(sets)
-    if key not in _cli_cache:
+    """Final observables of the command-line program (`taylor`) for `--set`
+    pairs."""
+    return cli_json(tmp_path_factory, *(a for s in sets for a in ("--set", s)))
+
+
+_models = {}
+
+
+def model(identifier, suffix=""):
+    """The FMU `target/fmu/<identifier><suffix>.fmu` (suffix "" for FMI 3,
+    "_fmi2" for FMI 2), read and extracted once."""
+    key = identifier + suffix
+    if key not in _models:
+        path = ROOT / "target" / "fmu" / f"{key}.fmu"
+        assert path.exists(), "run `cargo xtask fmu` first (tests/fmu/run.sh does)"
+        _models[key] = Model(path, read_model_description(str(path)), extract(str(path)))
+    return _models[key]
+
+
+def cli(*args):
+    """Standard output of the command-line program."""
+    return subprocess.run([str(CLI), *args], check=True, capture_output=True, text=True).stdout
+
+
+_runs = {}
+
+
+def cli_json(tmp_path_factory, *args):
+    """Final observables of `meshless-impact run ARGS --json`."""
+    if args not in _runs:
         out = tmp_path_factory.mktemp("cli") / "out.json"
-        args = [str(CLI), "run"]
-        for s in sets:
-            args += ["--set", s]
-        args += ["--json", str(out)]
-        subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                       env=dict(os.environ))
-        _cli_cache[key] = json.loads(out.read_text())
-    return _cli_cache[key]
+        cli("run", "-q", *args, "--json", str(out))
+        _runs[args] = json.loads(out.read_text())
+    return _runs[args]
+
+
+def params_of(*args):
+    """Names and values of `meshless-impact params ARGS`, in order."""
+    rows = cli("params", *args).splitlines()[1:]
+    return [(r.split()[0], float(r.split()[2])) for r in rows]
+
+
+def assert_simulated_equal_to_cli(r, ref, names):
+    """The last row of `simulate_fmu`'s result `r` equals the CLI's final
+    values `ref` for the outputs `names`, bit for bit."""
+    for name in names:
+        value = r[name][-1]
+        if name == "at_rest":
+            assert bool(value) == ref[name]
+        else:
+            assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
 
 
 def check_fmu_file(path):

@@ -85,6 +85,18 @@ def set_params(s, m, params):
             (s.setFloat64 if hasattr(s, "setFloat64") else s.setReal)([v.valueReference], [float(value)])
 
 
+def assert_set_refused(m, make, params, needle):
+    """Setting `params` on a new instance (`make(m)`: slave3 or slave2) is
+    refused with Error, and the host's log has an error containing
+    `needle`."""
+    s = make(m)
+    MESSAGES.clear()
+    with pytest.raises(FMICallException):
+        set_params(s, m, params)
+    assert any(needle in x for x in messages("logStatusError")), MESSAGES
+    s.freeInstance()
+
+
 def outputs(s, m):
     out = {}
     for v in m.outputs:

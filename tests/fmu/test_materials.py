@@ -7,62 +7,18 @@ A preset reaches an FMU as start values: the Wilkins bar of
 scenes/wilkins_copper_bilinear.toml through TaylorImpactBilinear equals the
 CLI run of that scene file."""
 
-import json
-import subprocess
 from pathlib import Path
 
 import pytest
-from fmpy import extract, read_model_description, simulate_fmu
+from fmpy import read_model_description, simulate_fmu
 
-from conftest import CLI, COARSE, ROOT, Model, check_fmu_file
+from conftest import COARSE, ROOT, assert_simulated_equal_to_cli, check_fmu_file, cli_json, model, params_of
 
 CHOICES = [
     ("TaylorImpactBilinear", "bilinear", "linear"),
     ("TaylorImpactMieGruneisen", "johnson_cook", "mie_gruneisen"),
     ("TaylorImpactBilinearMieGruneisen", "bilinear", "mie_gruneisen"),
 ]
-
-_models = {}
-
-
-def model(identifier, suffix):
-    key = identifier + suffix
-    if key not in _models:
-        path = ROOT / "target" / "fmu" / f"{key}.fmu"
-        assert path.exists(), "run `cargo xtask fmu` first (tests/fmu/run.sh does)"
-        _models[key] = Model(path, read_model_description(str(path)), extract(str(path)))
-    return _models[key]
-
-
-def cli(*args):
-    return subprocess.run([str(CLI), *args], check=True, capture_output=True, text=True).stdout
-
-
-_runs = {}
-
-
-def cli_json(tmp_path_factory, *args):
-    """Final observables of `meshless-impact run ARGS --json`."""
-    if args not in _runs:
-        out = tmp_path_factory.mktemp("cli") / "out.json"
-        cli("run", "-q", *args, "--json", str(out))
-        _runs[args] = json.loads(out.read_text())
-    return _runs[args]
-
-
-def params_of(*args):
-    """Names and values of `meshless-impact params ARGS`, in order."""
-    rows = cli("params", *args).splitlines()[1:]
-    return [(r.split()[0], float(r.split()[2])) for r in rows]
-
-
-def assert_equal_to_cli(r, ref, names):
-    for name in names:
-        value = r[name][-1]
-        if name == "at_rest":
-            assert bool(value) and ref[name] is True
-        else:
-            assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
 
 
 @pytest.mark.parametrize("suffix", ["", "_fmi2"])
@@ -96,7 +52,7 @@ def test_coarse_run_equals_the_cli(identifier, strength, eos, suffix, tmp_path_f
     ref = cli_json(tmp_path_factory, "--strength", strength, "--eos", eos, "--set", f"particles_radial={COARSE}")
     names = [v.name for v in m.outputs]
     r = simulate_fmu(str(m.path), start_values={"particles_radial": COARSE}, output=names)
-    assert_equal_to_cli(r, ref, names)
+    assert_simulated_equal_to_cli(r, ref, names)
     assert ref["at_rest"] is True
 
 
@@ -115,5 +71,6 @@ def test_preset_as_start_values_equals_the_scene_file(tmp_path_factory):
     start["particles_radial"] = COARSE
     names = [v.name for v in m.outputs]
     r = simulate_fmu(str(m.path), start_values=start, output=names, stop_time=400e-6)
-    assert_equal_to_cli(r, ref, names)
+    assert_simulated_equal_to_cli(r, ref, names)
+    assert ref["at_rest"] is True
     assert start["yield_stress"] == 400e6 and start["hardening_modulus"] == 100e6

@@ -9,7 +9,7 @@ from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from conftest import COARSE, cli_run
-from test_fmu import MESSAGES, init2, init3, messages, outputs, run3, set_params, slave2, slave3
+from test_fmu import MESSAGES, assert_set_refused, init2, init3, messages, outputs, run3, set_params, slave2, slave3
 
 BULK = 169.1e9
 
@@ -62,12 +62,7 @@ def test_a_solver_stop_is_an_error_with_its_name(fmu3, fmu2, params, needle):
 ])
 def test_invalid_value_is_refused_with_its_name(fmu3, fmu2, name, value, needle):
     for m, make in ((fmu3, slave3), (fmu2, slave2)):
-        s = make(m)
-        MESSAGES.clear()
-        with pytest.raises(FMICallException):
-            set_params(s, m, {name: value})
-        assert any(needle in x for x in messages("logStatusError")), MESSAGES
-        s.freeInstance()
+        assert_set_refused(m, make, {name: value}, needle)
 
 
 def test_melt_at_room_temperature_is_refused_at_initialization(fmu3, fmu2):
