@@ -29,6 +29,7 @@
 
 pub mod lattice;
 pub mod mls;
+pub mod profile;
 pub mod solver;
 pub mod sphere;
 pub mod step;
@@ -39,6 +40,7 @@ mod measure;
 
 pub use lattice::{Cylinder, NodeLattice, Surfaces};
 pub use mls::{NodalShapes, Recompute, ShapeRow, SupportParams, Supports};
+pub use profile::{Phase, PhaseTimes};
 pub use solver::{Energies, Mlpg3d, RodSetup};
 pub use sphere::{SphereRule, TestSphere};
 pub use weak::TractionOperator;

@@ -51,10 +51,12 @@
 
 use super::lattice::{Cylinder, NodeLattice, Surfaces};
 use super::mls::{NodalShapes, SupportParams, Supports, distance};
+use super::profile::{Phase, PhaseTimes};
 use super::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii};
 use super::step::{OMEGA_FACTOR, stable_step};
 use super::weak::TractionOperator;
 use crate::error::{Error, Result};
+use crate::isa::Isa;
 use crate::material::tensor::{Full, SymTensor};
 use crate::material::{Loading, Material, MaterialState, Point};
 use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
@@ -199,6 +201,12 @@ pub struct Mlpg3d {
     quiet_since: Option<f64>,
     /// Time of the last release of a node from the anvil.
     last_release: f64,
+    /// Wall time per phase of this process's steps (not saved).
+    #[serde(skip)]
+    profile: PhaseTimes,
+    /// The compiled copy of the hot loops (not saved: the best one).
+    #[serde(skip)]
+    isa: Isa,
 }
 
 /// The sums of one step over the nodes.
@@ -266,6 +274,8 @@ impl Mlpg3d {
             at_rest: false,
             quiet_since: None,
             last_release: 0.0,
+            profile: PhaseTimes::default(),
+            isa: Isa::best(),
             setup,
         };
         s.build_geometry(true)?;
@@ -339,18 +349,24 @@ impl Mlpg3d {
             },
             e => e,
         };
+        let mut clock = std::time::Instant::now();
         let mut g = self.geometry.take().unwrap_or_default();
         if supports || g.supports.is_none() {
             g.supports = Some(Supports::compute(
                 &self.supports_at,
                 SupportParams::default(),
             )?);
+            self.profile.supports += 1;
         }
+        self.profile.lap(Phase::Supports, &mut clock);
         let sup = g.supports.as_ref().expect("computed above");
         let pts = &self.built_at;
         g.shapes = NodalShapes::build(pts, sup).map_err(at_time)?;
+        self.profile.lap(Phase::Shapes, &mut clock);
         g.spheres = self.spheres(pts, sup, &g.shapes);
+        self.profile.lap(Phase::Spheres, &mut clock);
         g.op = TractionOperator::build(
+            self.isa,
             pts,
             sup,
             &g.spheres,
@@ -358,6 +374,8 @@ impl Mlpg3d {
             &SphereRule::of(BOUNDARY_RULE),
         )
         .map_err(at_time)?;
+        self.profile.lap(Phase::Operator, &mut clock);
+        self.profile.operators += 1;
         self.geometry = Some(g);
         self.rebuilds += 1;
         Ok(())
@@ -584,6 +602,7 @@ impl Mlpg3d {
         }
         let n = self.particles();
         let dt = self.dt;
+        let mut clock = std::time::Instant::now();
         self.material_state.fit(n);
         // 1. Forces from σ^n and the viscous stress.
         let total: Vec<[f64; 6]> = (0..n)
@@ -603,6 +622,7 @@ impl Mlpg3d {
         let g = self.geometry.as_ref().expect("built above");
         let mut force = vec![[0.0; 3]; n];
         g.op.apply(&total, &mut force);
+        self.profile.lap(Phase::Force, &mut clock);
         // 2-3. Velocities, contact, positions.
         let d0 = self.d_min0;
         let (volume, rho, mass) = (&g.op.volume, &self.rho, &self.mass);
@@ -637,6 +657,7 @@ impl Mlpg3d {
                 (held, released)
             })
             .collect();
+        self.profile.lap(Phase::Kick, &mut clock);
         // Velocity smoothing toward the MLS approximation at the node.
         let alpha = self.setup.smoothing;
         if alpha > 0.0 {
@@ -664,6 +685,7 @@ impl Mlpg3d {
             self.vel = smooth;
             self.smoothing_dissipation += before - kinetic(&self.vel, mass);
         }
+        self.profile.lap(Phase::Smoothing, &mut clock);
         let moved: Vec<(f64, f64, bool, Option<f64>)> = self
             .vel
             .par_iter_mut()
@@ -705,8 +727,10 @@ impl Mlpg3d {
                 });
             }
         }
+        self.profile.lap(Phase::Move, &mut clock);
         // 4. The geometry follows the body.
         let d_min = self.nearest_distance();
+        self.profile.lap(Phase::Spacing, &mut clock);
         let ratio = d_min / self.d_min0;
         self.min_spacing = self.min_spacing.min(ratio);
         if ratio < SPACING_COLLAPSE_BOUND {
@@ -718,17 +742,24 @@ impl Mlpg3d {
             });
         }
         if self.supports().recompute_reason(&self.pos).is_some() {
+            self.profile.lap(Phase::RebuildCheck, &mut clock);
             self.supports_at.clone_from(&self.pos);
             self.built_at.clone_from(&self.pos);
             self.build_geometry(true)?;
+            clock = std::time::Instant::now();
         } else if self.strain_since_build() > self.setup.rebuild_strain {
+            self.profile.lap(Phase::RebuildCheck, &mut clock);
             self.built_at.clone_from(&self.pos);
             self.build_geometry(false)?;
+            clock = std::time::Instant::now();
+        } else {
+            self.profile.lap(Phase::RebuildCheck, &mut clock);
         }
         // 5. Velocity gradients and the material.
         let g = self.geometry.as_ref().expect("built above");
         let mut grad = vec![[[0.0; 3]; 3]; n];
         g.shapes.velocity_gradients(&self.vel, &mut grad);
+        self.profile.lap(Phase::Gradients, &mut clock);
         let material = self.material;
         let c = self.damping_time;
         let (mass, vel) = (&self.mass, &self.vel);
@@ -839,6 +870,7 @@ impl Mlpg3d {
             t.mass += s.mass;
             t.worst_speed = t.worst_speed.max(s.worst_speed);
         }
+        self.profile.lap(Phase::Material, &mut clock);
         self.internal_energy += t.internal;
         self.plastic_work += t.plastic;
         self.damping_dissipation += t.damping;
@@ -877,7 +909,21 @@ impl Mlpg3d {
         } else {
             self.quiet_since = None;
         }
+        self.profile.lap(Phase::Checks, &mut clock);
         Ok(())
+    }
+
+    /// Runs the hot loops in the compiled copy `isa` from now on (by
+    /// default the best this processor runs); every copy gives the same
+    /// bits.
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = isa;
+    }
+
+    /// Wall time per phase of the steps taken in this process (a restored
+    /// run starts from zero), and the counts of the builds.
+    pub fn profile(&self) -> &PhaseTimes {
+        &self.profile
     }
 
     /// The largest relative motion of a named pair since the last build.
@@ -1212,5 +1258,60 @@ impl crate::model::Model for Mlpg3d {
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)
+    }
+    fn set_isa(&mut self, isa: Isa) {
+        self.set_isa(isa);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::bilinear::Bilinear;
+    use crate::material::eos::LinearEos;
+    use crate::material::{Damage, Eos, Strength};
+
+    /// A small plastic rod after some steps: its geometry rebuilt by the
+    /// fast operator build is the plain build's, bit for bit.
+    #[test]
+    fn the_operator_of_a_deformed_rod_is_the_plain_one() {
+        let material = Material {
+            eos: Eos::Linear(LinearEos {
+                bulk_modulus: 169.1e9,
+                density: 7830.0,
+            }),
+            strength: Strength::Bilinear(Bilinear {
+                yield_stress: 500e6,
+                hardening_modulus: 1e9,
+            }),
+            damage: Damage::None,
+            shear_modulus: 82.9e9,
+            specific_heat: 460.0,
+            taylor_quinney: 0.9,
+            reference_temperature: 293.0,
+        };
+        let cyl = Cylinder {
+            radius: 2e-3,
+            length: 10e-3,
+        };
+        let mut setup = RodSetup::new(cyl, 3, 300.0, 1e-3);
+        setup.rebuild_strain = 1e-3;
+        let mut s = Mlpg3d::new(setup, material).unwrap();
+        for _ in 0..40 {
+            s.step().unwrap();
+        }
+        assert!(s.rebuilds() > 2);
+        let g = s.geometry.as_ref().unwrap();
+        let sup = g.supports.as_ref().unwrap();
+        let plain = TractionOperator::build_plain(
+            &s.built_at,
+            sup,
+            &g.spheres,
+            &SphereRule::of(DEFAULT_RULE),
+            &SphereRule::of(BOUNDARY_RULE),
+        )
+        .unwrap();
+        assert!(g.spheres.iter().any(|t| !t.is_whole()));
+        assert!(plain == g.op, "the fast build changed the operator");
     }
 }
