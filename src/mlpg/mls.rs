@@ -150,11 +150,22 @@ impl Supports {
                 range: "(1, inf)".into(),
             });
         }
-        // A search radius that holds k others for an evenly filled box, then
-        // doubled until every node has them.
+        // A search radius whose cube holds k + 1 nodes of an evenly filled
+        // bounding box (its sphere about 4 k in the bulk, k on an edge), then
+        // doubled until every node has k others. Any radius that does gives
+        // the same k nearest: only the cost changes (a flat or thin set
+        // starts from its longest extent).
         let (lo, hi) = bounds(points);
-        let extent: f64 = (0..3).map(|d| (hi[d] - lo[d]).max(0.0)).fold(0.0, f64::max);
-        let mut search = (extent * ((k + 1) as f64 / points.len() as f64).cbrt()).max(1e-300);
+        let extents: [f64; 3] = std::array::from_fn(|d| (hi[d] - lo[d]).max(0.0));
+        let extent: f64 = extents.iter().copied().fold(0.0, f64::max);
+        let fill = (k + 1) as f64 / points.len() as f64;
+        let bulk = (extents[0] * extents[1] * extents[2] * fill).cbrt();
+        let mut search = if bulk > 1e-3 * extent {
+            bulk
+        } else {
+            extent * fill.cbrt()
+        }
+        .max(1e-300);
         let list = loop {
             let list = cell_list(points, search);
             if (0..points.len()).all(|i| list.of(i).len() > k) {

@@ -16,10 +16,9 @@ pub enum Phase {
     Smoothing,
     /// Positions and the anvil (step 3).
     Move,
-    /// Nearest named distance, the spacing check (step 4).
-    Spacing,
-    /// The rules for recomputing supports and rebuilding (step 4).
-    RebuildCheck,
+    /// The named pairs: the spacing check and the rules for recomputing
+    /// the supports and rebuilding the operator (step 4).
+    Pairs,
     /// Supports: the neighbour search and the named neighbours.
     Supports,
     /// MLS shape functions and gradients at the nodes.
@@ -38,13 +37,12 @@ pub enum Phase {
 
 impl Phase {
     /// Every phase, in the order of the step.
-    pub const ALL: [Phase; 13] = [
+    pub const ALL: [Phase; 12] = [
         Phase::Force,
         Phase::Kick,
         Phase::Smoothing,
         Phase::Move,
-        Phase::Spacing,
-        Phase::RebuildCheck,
+        Phase::Pairs,
         Phase::Supports,
         Phase::Shapes,
         Phase::Spheres,
@@ -61,8 +59,7 @@ impl Phase {
             Phase::Kick => "velocity update",
             Phase::Smoothing => "velocity smoothing",
             Phase::Move => "positions",
-            Phase::Spacing => "spacing check",
-            Phase::RebuildCheck => "rebuild checks",
+            Phase::Pairs => "spacing and rebuild checks",
             Phase::Supports => "supports (neighbour search)",
             Phase::Shapes => "MLS shapes at the nodes",
             Phase::Spheres => "test spheres",
@@ -78,7 +75,7 @@ impl Phase {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PhaseTimes {
     /// Wall time of each phase, indexed as [`Phase::ALL`].
-    pub wall: [Duration; 13],
+    pub wall: [Duration; 12],
     /// Builds of the supports (the first included).
     pub supports: u64,
     /// Builds of the shapes, spheres and operator (the first included).
