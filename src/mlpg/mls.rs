@@ -492,6 +492,17 @@ impl PointShapes {
         }
     }
 
+    /// Number of candidates gathered.
+    pub fn candidates(&self) -> usize {
+        self.node.len()
+    }
+
+    /// Number of candidates covering the point of the last
+    /// [`PointShapes::evaluate`].
+    pub fn covering(&self) -> usize {
+        self.covering
+    }
+
     /// The operator row accumulated since [`PointShapes::gather`]: the
     /// candidates that covered a point, in order, and their `B_J`.
     pub fn row(&self) -> (Vec<usize>, Vec<[f64; 3]>) {

@@ -404,6 +404,10 @@ impl Mlpg3d {
         };
         let mut clock = std::time::Instant::now();
         let mut g = self.geometry.take().unwrap_or_default();
+        // The old shapes and operator go before the new are built: they are
+        // most of the heap (BENCHMARKS.md, "3-D MLPG speed").
+        g.shapes = NodalShapes::default();
+        g.op = TractionOperator::default();
         if supports || g.supports.is_none() {
             g.supports = Some(Supports::compute(
                 &self.supports_at,
@@ -986,6 +990,63 @@ impl Mlpg3d {
         self.isa = isa;
     }
 
+    /// The heap bytes the run holds, by part (capacities, not lengths):
+    /// node fields (with the reference lattice and the material state),
+    /// the step's buffers, the supports, the shapes at the nodes, the test
+    /// spheres and the traction operator. BENCHMARKS.md, "3-D MLPG speed".
+    pub fn memory(&self) -> [(&'static str, usize); 6] {
+        fn b<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let l = &self.lattice;
+        let fields = b(&self.pos)
+            + b(&self.vel)
+            + b(&self.mass)
+            + b(&self.rho)
+            + b(&self.dev)
+            + b(&self.pressure)
+            + b(&self.eps_p)
+            + b(&self.temp)
+            + b(&self.visc)
+            + b(&self.contact)
+            + b(&self.supports_at)
+            + b(&self.built_at)
+            + b(&l.position)
+            + b(&l.volume)
+            + b(&l.surfaces)
+            + b(&l.sets.face)
+            + b(&l.sets.mantle)
+            + self.particles() * std::mem::size_of::<crate::material::PointState>();
+        let k = &self.scratch;
+        let scratch = b(&k.total)
+            + b(&k.force)
+            + b(&k.kicked)
+            + b(&k.smooth)
+            + b(&k.moved)
+            + b(&k.grad)
+            + b(&k.results);
+        let (mut supports, mut shapes, mut spheres, mut op) = (0, 0, 0, 0);
+        if let Some(g) = &self.geometry {
+            if let Some(s) = &g.supports {
+                supports =
+                    b(&s.radius) + b(&s.named.offsets) + b(&s.named.indices) + b(&s.named_distance);
+            }
+            let h = &g.shapes;
+            shapes = b(&h.offsets) + b(&h.nodes) + b(&h.phi) + b(&h.grad);
+            spheres = b(&g.spheres);
+            let o = &g.op;
+            op = b(&o.offsets) + b(&o.nodes) + b(&o.b) + b(&o.volume);
+        }
+        [
+            ("node fields", fields),
+            ("step buffers", scratch),
+            ("supports", supports),
+            ("shapes at the nodes", shapes),
+            ("test spheres", spheres),
+            ("traction operator", op),
+        ]
+    }
+
     /// Wall time per phase of the steps taken in this process (a restored
     /// run starts from zero), and the counts of the builds.
     pub fn profile(&self) -> &PhaseTimes {
@@ -1387,5 +1448,65 @@ mod tests {
         .unwrap();
         assert!(g.spheres.iter().any(|t| !t.is_whole()));
         assert!(plain == g.op, "the fast build changed the operator");
+    }
+
+    /// Measurement: the sizes behind the flop count of BENCHMARKS.md ("3-D
+    /// MLPG speed"): per node of `taylor3d` at impact (`PARTICLES_RADIAL`,
+    /// default 10), the operator and shape rows, the quadrature points, and
+    /// per point the candidates, those within `r_J` by the squared test and
+    /// those covering it.
+    #[test]
+    #[ignore = "measurement: the sizes behind the 3-D flop count"]
+    fn operator_sizes() {
+        use crate::mlpg::mls::{PointShapes, candidates};
+        let across: f64 = std::env::var("PARTICLES_RADIAL")
+            .map(|s| s.parse().unwrap())
+            .unwrap_or(10.0);
+        let p = crate::scene::taylor3d::Taylor3dParams {
+            particles_radial: across,
+            ..Default::default()
+        };
+        let s = p.build().unwrap();
+        let g = s.geometry.as_ref().unwrap();
+        let sup = g.supports.as_ref().unwrap();
+        let pts = &s.built_at;
+        let n = pts.len() as f64;
+        let reach = g.spheres.iter().map(|t| t.radius).fold(0.0, f64::max);
+        let list = candidates(pts, sup, reach);
+        let (whole, cut) = (SphereRule::of(DEFAULT_RULE), SphereRule::of(BOUNDARY_RULE));
+        let mut ps = PointShapes::default();
+        let (mut points, mut gathered, mut covering) = (0usize, 0usize, 0usize);
+        for i in 0..pts.len() {
+            let r0 = g.spheres[i].radius;
+            ps.gather(
+                list.of(i)
+                    .iter()
+                    .copied()
+                    .filter(|&j| distance(&pts[i], &pts[j]) <= (r0 + sup.radius[j]) * (1.0 + 1e-9)),
+                pts,
+                &sup.radius,
+            );
+            let k = ps.candidates();
+            g.spheres[i].for_each_point(pts[i], &whole, &cut, |x, _, _| {
+                ps.evaluate(Isa::best(), x, i).unwrap();
+                points += 1;
+                gathered += k;
+                covering += ps.covering();
+            });
+        }
+        let whole_spheres = g.spheres.iter().filter(|t| t.is_whole()).count();
+        println!(
+            "{} nodes ({whole_spheres} whole spheres): cell-list candidates {:.1}, gathered {:.1}, \
+             operator row {:.1}, shape row {:.1}, named {}; quadrature points {:.1} a node, \
+             covering {:.1} a point",
+            pts.len(),
+            list.indices.len() as f64 / n,
+            gathered as f64 / points as f64,
+            g.op.nodes.len() as f64 / n,
+            g.shapes.nodes.len() as f64 / n,
+            sup.params.neighbours,
+            points as f64 / n,
+            covering as f64 / points as f64,
+        );
     }
 }
