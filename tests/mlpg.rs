@@ -81,6 +81,7 @@ impl Bar {
             })
             .collect();
         let op = TractionOperator::build(
+            meshless_impact::Isa::best(),
             pts,
             &sup,
             &spheres,

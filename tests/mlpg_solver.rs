@@ -290,3 +290,33 @@ fn explore_taylor3d_stop() {
         );
     }
 }
+
+/// Exploration: the phase profile of `taylor3d` run to its end
+/// (`PARTICLES_RADIAL`, default 6), printed with the CPU time per
+/// node-step (BENCHMARKS.md, "3-D MLPG speed").
+#[test]
+#[ignore = "exploration"]
+fn explore_taylor3d_profile() {
+    use meshless_impact::Taylor3dParams;
+    let across: f64 = std::env::var("PARTICLES_RADIAL")
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(6.0);
+    let p = Taylor3dParams {
+        particles_radial: across,
+        ..Taylor3dParams::default()
+    };
+    let mut s = p.build().unwrap();
+    let t0 = std::time::Instant::now();
+    while !s.finished() {
+        s.step().unwrap();
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let node_steps = s.particles() as f64 * s.steps() as f64;
+    println!(
+        "{} nodes, {} steps, {wall:.2} s wall in the loop ({:.3} us per node-step)\n{}",
+        s.particles(),
+        s.steps(),
+        wall / node_steps * 1e6,
+        s.profile().table()
+    );
+}

@@ -138,7 +138,8 @@ fn sphere_rule_table() {
         .collect();
     let cut = SphereRule::new(Polyhedron::Octahedron, 1, TriangleRule::One);
     let run = |rule: &SphereRule| {
-        let op = TractionOperator::build(&pts, &sup, &spheres, rule, &cut).unwrap();
+        let op = TractionOperator::build(crate::isa::Isa::best(), &pts, &sup, &spheres, rule, &cut)
+            .unwrap();
         let mut out = vec![[0.0; 3]; pts.len()];
         op.apply(&stress, &mut out);
         let f = inner

@@ -52,6 +52,7 @@
 //! (too few, coplanar or collinear covering nodes) is the named error
 //! [`crate::Error::SingularMomentMatrix`], never a NaN.
 
+use crate::isa::{Isa, hot};
 use crate::msph::{MAX_CONDITION, invert};
 use crate::neighbors::{NeighborList, cell_list};
 use crate::{Error, Result};
@@ -149,11 +150,22 @@ impl Supports {
                 range: "(1, inf)".into(),
             });
         }
-        // A search radius that holds k others for an evenly filled box, then
-        // doubled until every node has them.
+        // A search radius whose cube holds k + 1 nodes of an evenly filled
+        // bounding box (its sphere about 4 k in the bulk, k on an edge), then
+        // doubled until every node has k others. Any radius that does gives
+        // the same k nearest: only the cost changes (a flat or thin set
+        // starts from its longest extent).
         let (lo, hi) = bounds(points);
-        let extent: f64 = (0..3).map(|d| (hi[d] - lo[d]).max(0.0)).fold(0.0, f64::max);
-        let mut search = (extent * ((k + 1) as f64 / points.len() as f64).cbrt()).max(1e-300);
+        let extents: [f64; 3] = std::array::from_fn(|d| (hi[d] - lo[d]).max(0.0));
+        let extent: f64 = extents.iter().copied().fold(0.0, f64::max);
+        let fill = (k + 1) as f64 / points.len() as f64;
+        let bulk = (extents[0] * extents[1] * extents[2] * fill).cbrt();
+        let mut search = if bulk > 1e-3 * extent {
+            bulk
+        } else {
+            extent * fill.cbrt()
+        }
+        .max(1e-300);
         let list = loop {
             let list = cell_list(points, search);
             if (0..points.len()).all(|i| list.of(i).len() > k) {
@@ -366,6 +378,242 @@ impl ShapeRow {
                     .push(std::array::from_fn(|k| w * dot(&gk[k], p) + dw[k] * gp));
             }
         }
+        Ok(())
+    }
+}
+
+/// The MLS shape functions, without gradients, at the many points of one
+/// node's test sphere, over candidates gathered once per node: the fast
+/// twin of [`ShapeRow::evaluate`] (with `gradient` false) for the traction
+/// operator ([`crate::mlpg::weak::TractionOperator::build`]).
+///
+/// The same operations in the same order as [`ShapeRow::evaluate`] on the
+/// candidates that cover the point, hence the same bits; what is saved is
+/// the work on the others: a squared distance against `r_J²` (with a
+/// margin) rules them out before any root or division. The buffers are
+/// reused from point to point and node to node.
+#[derive(Debug, Clone, Default)]
+pub struct PointShapes {
+    // The candidates, structure of arrays.
+    node: Vec<usize>,
+    cx: Vec<f64>,
+    cy: Vec<f64>,
+    cz: Vec<f64>,
+    r: Vec<f64>,
+    /// `r_J²` with a margin: a candidate farther than this covers nothing.
+    r2: Vec<f64>,
+    /// Per candidate, the sum over the points so far of `w φ_J n`.
+    acc: Vec<[f64; 3]>,
+    /// Per candidate, whether it covered any point so far.
+    touched: Vec<bool>,
+    // At the current point: squared distances, the candidates that may
+    // cover it, those that do, and their weights, basis and shapes.
+    dist2: Vec<f64>,
+    maybe: Vec<u32>,
+    cover: Vec<u32>,
+    s: Vec<f64>,
+    w: Vec<f64>,
+    p1: Vec<f64>,
+    p2: Vec<f64>,
+    p3: Vec<f64>,
+    phi: Vec<f64>,
+    /// How many candidates cover the current point.
+    covering: usize,
+}
+
+impl PointShapes {
+    /// Takes the candidate nodes `nodes` (in the order the plain
+    /// evaluation would see them) and clears the accumulated operator row.
+    pub fn gather(
+        &mut self,
+        nodes: impl Iterator<Item = usize>,
+        points: &[[f64; 3]],
+        radius: &[f64],
+    ) {
+        self.node.clear();
+        self.node.extend(nodes);
+        let gather = |v: &mut Vec<f64>, f: &dyn Fn(usize) -> f64, node: &[usize]| {
+            v.clear();
+            v.extend(node.iter().map(|&j| f(j)));
+        };
+        gather(&mut self.cx, &|j| points[j][0], &self.node);
+        gather(&mut self.cy, &|j| points[j][1], &self.node);
+        gather(&mut self.cz, &|j| points[j][2], &self.node);
+        gather(&mut self.r, &|j| radius[j], &self.node);
+        gather(
+            &mut self.r2,
+            &|j| radius[j] * radius[j] * (1.0 + 1e-9),
+            &self.node,
+        );
+        let k = self.node.len();
+        self.acc.clear();
+        self.acc.resize(k, [0.0; 3]);
+        self.touched.clear();
+        self.touched.resize(k, false);
+        self.dist2.resize(k, 0.0);
+        self.maybe.resize(k, 0);
+        self.cover.resize(k, 0);
+        for v in [
+            &mut self.s,
+            &mut self.w,
+            &mut self.p1,
+            &mut self.p2,
+            &mut self.p3,
+            &mut self.phi,
+        ] {
+            v.resize(k, 0.0);
+        }
+    }
+
+    /// The shape functions at `x` of the gathered candidates that cover it
+    /// (see [`ShapeRow::evaluate`]: the same errors, `node` labels them).
+    pub fn evaluate(&mut self, isa: Isa, x: [f64; 3], node: usize) -> Result<()> {
+        match point_shapes(isa, self, x) {
+            Ok(()) => Ok(()),
+            Err(condition) => Err(Error::SingularMomentMatrix {
+                method: crate::error::MomentMethod::Mls,
+                particle: node,
+                time: 0.0,
+                condition,
+            }),
+        }
+    }
+
+    /// Adds the quadrature point with outward normal `n` and weight `w`
+    /// (m²) of the last [`PointShapes::evaluate`] to the operator row:
+    /// `B_J += w φ_J n`.
+    pub fn accumulate(&mut self, n: [f64; 3], w: f64) {
+        for q in 0..self.covering {
+            let c = self.cover[q] as usize;
+            self.touched[c] = true;
+            for d in 0..3 {
+                self.acc[c][d] += w * self.phi[q] * n[d];
+            }
+        }
+    }
+
+    /// Number of candidates gathered.
+    #[cfg(test)]
+    pub fn candidates(&self) -> usize {
+        self.node.len()
+    }
+
+    /// Number of candidates covering the point of the last
+    /// [`PointShapes::evaluate`].
+    #[cfg(test)]
+    pub fn covering(&self) -> usize {
+        self.covering
+    }
+
+    /// The operator row accumulated since [`PointShapes::gather`]: the
+    /// candidates that covered a point, in order, and their `B_J`.
+    pub fn row(&self) -> (Vec<usize>, Vec<[f64; 3]>) {
+        let keep = || (0..self.node.len()).filter(|&c| self.touched[c]);
+        (
+            keep().map(|c| self.node[c]).collect(),
+            keep().map(|c| self.acc[c]).collect(),
+        )
+    }
+}
+
+hot! {
+    /// The body of [`PointShapes::evaluate`]; the error is the condition
+    /// number (infinite when too few nodes cover `x` or `A` is singular).
+    fn point_shapes(ps: &mut PointShapes, x: [f64; 3]) -> std::result::Result<(), f64> {
+        let k = ps.node.len();
+        // Squared distances, summed as ShapeRow::evaluate sums them.
+        let (cx, cy, cz, r, r2) = (&ps.cx[..k], &ps.cy[..k], &ps.cz[..k], &ps.r[..k], &ps.r2[..k]);
+        let dist2 = &mut ps.dist2[..k];
+        for (d2, ((&cx, &cy), &cz)) in dist2.iter_mut().zip(cx.iter().zip(cy).zip(cz)) {
+            let d = [x[0] - cx, x[1] - cy, x[2] - cz];
+            *d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        }
+        // Those within r_J (with the margin), in candidate order: their
+        // index, squared distance and radius.
+        let (maybe, md2, mr) = (&mut ps.maybe[..k], &mut ps.s[..k], &mut ps.w[..k]);
+        let mut m = 0;
+        for c in 0..k {
+            maybe[m] = c as u32;
+            md2[m] = dist2[c];
+            mr[m] = r[c];
+            m += (dist2[c] <= r2[c]) as usize;
+        }
+        // The exact test of ShapeRow::evaluate: s = |x − x_J| / r_J < 1.
+        for (d2, &r) in md2[..m].iter_mut().zip(&mr[..m]) {
+            *d2 = d2.sqrt() / r;
+        }
+        let ms = &ps.s[..m];
+        let (cover, s, cr) = (&mut ps.cover[..m], &mut ps.phi[..m], &mut ps.dist2[..m]);
+        let (px, py, pz) = (&mut ps.p1[..m], &mut ps.p2[..m], &mut ps.p3[..m]);
+        let mut covering = 0;
+        for q in 0..m {
+            let c = ps.maybe[q] as usize;
+            cover[covering] = c as u32;
+            s[covering] = ms[q];
+            cr[covering] = r[c];
+            px[covering] = cx[c];
+            py[covering] = cy[c];
+            pz[covering] = cz[c];
+            covering += (ms[q] < 1.0) as usize;
+        }
+        if covering < BASIS {
+            return Err(f64::INFINITY);
+        }
+        let m = covering;
+        let h = cr[..m].iter().fold(0.0f64, |h, &r| h.max(r));
+        // Weights and the scaled basis.
+        let w = &mut ps.w[..m];
+        for ((((w, &s), p1), p2), p3) in w
+            .iter_mut()
+            .zip(&s[..m])
+            .zip(&mut px[..m])
+            .zip(&mut py[..m])
+            .zip(&mut pz[..m])
+        {
+            *w = 1.0 - s * s * (6.0 - 8.0 * s + 3.0 * s * s);
+            *p1 = (*p1 - x[0]) / h;
+            *p2 = (*p2 - x[1]) / h;
+            *p3 = (*p3 - x[2]) / h;
+        }
+        // The moment matrix, each entry summed in candidate order; its
+        // first row and column are the same sums.
+        let mut a0 = [0.0; BASIS];
+        let mut a = [[0.0; 3]; 3];
+        for q in 0..m {
+            let w = ps.w[q];
+            let p = [ps.p1[q], ps.p2[q], ps.p3[q]];
+            a0[0] += w;
+            for r in 0..3 {
+                let wp = w * p[r];
+                a0[r + 1] += wp;
+                for c in 0..3 {
+                    a[r][c] += wp * p[c];
+                }
+            }
+        }
+        let a: [[f64; BASIS]; BASIS] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| match (r, c) {
+                (0, c) => a0[c],
+                (r, 0) => a0[r],
+                (r, c) => a[r - 1][c - 1],
+            })
+        });
+        let inv = invert(a).ok_or(f64::INFINITY)?;
+        let condition = norm1(&a) * norm1(&inv);
+        if !condition.is_finite() || condition > MAX_CONDITION {
+            return Err(condition);
+        }
+        let g: [f64; BASIS] = std::array::from_fn(|r| inv[r][0]);
+        for ((((phi, &w), &p1), &p2), &p3) in ps.phi[..m]
+            .iter_mut()
+            .zip(&ps.w[..m])
+            .zip(&ps.p1[..m])
+            .zip(&ps.p2[..m])
+            .zip(&ps.p3[..m])
+        {
+            *phi = w * dot(&g, &[1.0, p1, p2, p3]);
+        }
+        ps.covering = m;
         Ok(())
     }
 }

@@ -29,6 +29,7 @@
 
 pub mod lattice;
 pub mod mls;
+pub mod profile;
 pub mod solver;
 pub mod sphere;
 pub mod step;

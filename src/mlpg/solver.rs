@@ -51,10 +51,12 @@
 
 use super::lattice::{Cylinder, NodeLattice, Surfaces};
 use super::mls::{NodalShapes, SupportParams, Supports, distance};
+use super::profile::{Phase, PhaseTimes};
 use super::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii};
 use super::step::{OMEGA_FACTOR, stable_step};
 use super::weak::TractionOperator;
 use crate::error::{Error, Result};
+use crate::isa::Isa;
 use crate::material::tensor::{Full, SymTensor};
 use crate::material::{Loading, Material, MaterialState, Point};
 use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
@@ -199,6 +201,64 @@ pub struct Mlpg3d {
     quiet_since: Option<f64>,
     /// Time of the last release of a node from the anvil.
     last_release: f64,
+    /// Wall time per phase of this process's steps (not saved).
+    #[serde(skip)]
+    profile: PhaseTimes,
+    /// The buffers of the step.
+    #[serde(skip)]
+    scratch: Scratch,
+    /// The compiled copy of the hot loops (not saved: the best one).
+    #[serde(skip)]
+    isa: Isa,
+}
+
+/// What [`Mlpg3d::named_pairs`] finds.
+#[derive(Debug, Clone, Copy)]
+struct NamedPairs {
+    nearest: f64,
+    recompute: bool,
+    strain: f64,
+}
+
+impl NamedPairs {
+    const NONE: NamedPairs = NamedPairs {
+        nearest: f64::INFINITY,
+        recompute: false,
+        strain: 0.0,
+    };
+
+    fn join(a: Self, b: Self) -> Self {
+        NamedPairs {
+            nearest: a.nearest.min(b.nearest),
+            recompute: a.recompute || b.recompute,
+            strain: a.strain.max(b.strain),
+        }
+    }
+}
+
+/// The buffers of a step, reused from step to step (not saved).
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    total: Vec<[f64; 6]>,
+    force: Vec<[f64; 3]>,
+    kicked: Vec<(f64, bool)>,
+    smooth: Vec<[f64; 3]>,
+    moved: Vec<(f64, f64, bool, Option<f64>)>,
+    grad: Vec<[[f64; 3]; 3]>,
+    results: Vec<std::result::Result<Tally, (usize, Error)>>,
+}
+
+impl Scratch {
+    /// Every buffer at `n` entries (allocates only when `n` grows).
+    fn fit(&mut self, n: usize) {
+        self.total.resize(n, [0.0; 6]);
+        self.force.resize(n, [0.0; 3]);
+        self.kicked.resize(n, (0.0, false));
+        self.smooth.resize(n, [0.0; 3]);
+        self.moved.resize(n, (0.0, 0.0, false, None));
+        self.grad.resize(n, [[0.0; 3]; 3]);
+        self.results.resize(n, Ok(Tally::default()));
+    }
 }
 
 /// The sums of one step over the nodes.
@@ -266,6 +326,9 @@ impl Mlpg3d {
             at_rest: false,
             quiet_since: None,
             last_release: 0.0,
+            profile: PhaseTimes::default(),
+            scratch: Scratch::default(),
+            isa: Isa::best(),
             setup,
         };
         s.build_geometry(true)?;
@@ -339,18 +402,28 @@ impl Mlpg3d {
             },
             e => e,
         };
+        let mut clock = std::time::Instant::now();
         let mut g = self.geometry.take().unwrap_or_default();
+        // The old shapes and operator go before the new are built: they are
+        // most of the heap (BENCHMARKS.md, "3-D MLPG speed").
+        g.shapes = NodalShapes::default();
+        g.op = TractionOperator::default();
         if supports || g.supports.is_none() {
             g.supports = Some(Supports::compute(
                 &self.supports_at,
                 SupportParams::default(),
             )?);
+            self.profile.supports += 1;
         }
+        self.profile.lap(Phase::Supports, &mut clock);
         let sup = g.supports.as_ref().expect("computed above");
         let pts = &self.built_at;
         g.shapes = NodalShapes::build(pts, sup).map_err(at_time)?;
+        self.profile.lap(Phase::Shapes, &mut clock);
         g.spheres = self.spheres(pts, sup, &g.shapes);
+        self.profile.lap(Phase::Spheres, &mut clock);
         g.op = TractionOperator::build(
+            self.isa,
             pts,
             sup,
             &g.spheres,
@@ -358,6 +431,8 @@ impl Mlpg3d {
             &SphereRule::of(BOUNDARY_RULE),
         )
         .map_err(at_time)?;
+        self.profile.lap(Phase::Operator, &mut clock);
+        self.profile.operators += 1;
         self.geometry = Some(g);
         self.rebuilds += 1;
         Ok(())
@@ -583,35 +658,46 @@ impl Mlpg3d {
             self.rebuilds -= 1;
         }
         let n = self.particles();
-        let dt = self.dt;
+        let clock = std::time::Instant::now();
         self.material_state.fit(n);
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.fit(n);
+        let result = self.step_with(&mut scratch, clock);
+        self.scratch = scratch;
+        result
+    }
+
+    /// The step with its buffers (reused from step to step: the step
+    /// allocates nothing once they have their size).
+    fn step_with(&mut self, scratch: &mut Scratch, mut clock: std::time::Instant) -> Result<()> {
+        let dt = self.dt;
         // 1. Forces from σ^n and the viscous stress.
-        let total: Vec<[f64; 6]> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let (d, p, v) = (self.dev[i], self.pressure[i], self.visc[i]);
-                [
-                    d[0] - p + v[0],
-                    d[1] - p + v[1],
-                    d[2] - p + v[2],
-                    d[3] + v[3],
-                    d[4] + v[4],
-                    d[5] + v[5],
-                ]
-            })
-            .collect();
+        let total = &mut scratch.total;
+        total.par_iter_mut().enumerate().for_each(|(i, t)| {
+            let (d, p, v) = (self.dev[i], self.pressure[i], self.visc[i]);
+            *t = [
+                d[0] - p + v[0],
+                d[1] - p + v[1],
+                d[2] - p + v[2],
+                d[3] + v[3],
+                d[4] + v[4],
+                d[5] + v[5],
+            ];
+        });
         let g = self.geometry.as_ref().expect("built above");
-        let mut force = vec![[0.0; 3]; n];
-        g.op.apply(&total, &mut force);
+        let force = &mut scratch.force;
+        g.op.apply(total, force);
+        self.profile.lap(Phase::Force, &mut clock);
         // 2-3. Velocities, contact, positions.
         let d0 = self.d_min0;
         let (volume, rho, mass) = (&g.op.volume, &self.rho, &self.mass);
-        let kicked: Vec<(f64, bool)> = self
-            .vel
+        let kicked = &mut scratch.kicked;
+        self.vel
             .par_iter_mut()
             .zip(self.contact.par_iter_mut())
+            .zip(kicked.par_iter_mut())
             .enumerate()
-            .map(|(i, (v, touch))| {
+            .for_each(|(i, ((v, touch), out))| {
                 let f = force[i];
                 let inertia = rho[i] * volume[i];
                 // A node held on the anvil loses the speed it had toward it
@@ -634,44 +720,44 @@ impl Mlpg3d {
                         v[2] = 0.0;
                     }
                 }
-                (held, released)
-            })
-            .collect();
+                *out = (held, released);
+            });
+        self.profile.lap(Phase::Kick, &mut clock);
         // Velocity smoothing toward the MLS approximation at the node.
         let alpha = self.setup.smoothing;
         if alpha > 0.0 {
             let shapes = &g.shapes;
             let vel = &self.vel;
-            let smooth: Vec<[f64; 3]> = (0..n)
-                .into_par_iter()
-                .map(|i| {
-                    let mut m = [0.0; 3];
-                    for q in shapes.row(i) {
-                        let vj = vel[shapes.nodes[q]];
-                        for d in 0..3 {
-                            m[d] += shapes.phi[q] * vj[d];
-                        }
+            let smooth = &mut scratch.smooth;
+            smooth.par_iter_mut().enumerate().for_each(|(i, out)| {
+                let mut m = [0.0; 3];
+                for q in shapes.row(i) {
+                    let vj = vel[shapes.nodes[q]];
+                    for d in 0..3 {
+                        m[d] += shapes.phi[q] * vj[d];
                     }
-                    let mut v: [f64; 3] =
-                        std::array::from_fn(|d| vel[i][d] + alpha * (m[d] - vel[i][d]));
-                    if self.contact[i] {
-                        v[2] = 0.0;
-                    }
-                    v
-                })
-                .collect();
+                }
+                let mut v: [f64; 3] =
+                    std::array::from_fn(|d| vel[i][d] + alpha * (m[d] - vel[i][d]));
+                if self.contact[i] {
+                    v[2] = 0.0;
+                }
+                *out = v;
+            });
             let before = kinetic(&self.vel, mass);
-            self.vel = smooth;
+            std::mem::swap(&mut self.vel, smooth);
             self.smoothing_dissipation += before - kinetic(&self.vel, mass);
         }
-        let moved: Vec<(f64, f64, bool, Option<f64>)> = self
-            .vel
+        self.profile.lap(Phase::Smoothing, &mut clock);
+        let moved = &mut scratch.moved;
+        self.vel
             .par_iter_mut()
             .zip(self.pos.par_iter_mut())
             .zip(self.contact.par_iter_mut())
             .zip(kicked.par_iter())
+            .zip(moved.par_iter_mut())
             .enumerate()
-            .map(|(i, (((v, x), touch), &(held, released)))| {
+            .for_each(|(i, ((((v, x), touch), &(held, released)), out))| {
                 let mut through = None;
                 for d in 0..3 {
                     x[d] += dt * v[d];
@@ -686,9 +772,8 @@ impl Mlpg3d {
                     v[2] = 0.0;
                     *touch = true;
                 }
-                (held, lost, released, through)
-            })
-            .collect();
+                *out = (held, lost, released, through);
+            });
         self.time += dt;
         self.steps += 1;
         for (i, &(held, lost, released, through)) in moved.iter().enumerate() {
@@ -705,8 +790,11 @@ impl Mlpg3d {
                 });
             }
         }
+        self.profile.lap(Phase::Move, &mut clock);
         // 4. The geometry follows the body.
-        let d_min = self.nearest_distance();
+        let pairs = self.named_pairs();
+        self.profile.lap(Phase::Pairs, &mut clock);
+        let d_min = pairs.nearest;
         let ratio = d_min / self.d_min0;
         self.min_spacing = self.min_spacing.min(ratio);
         if ratio < SPACING_COLLAPSE_BOUND {
@@ -717,23 +805,26 @@ impl Mlpg3d {
                 hint: "",
             });
         }
-        if self.supports().recompute_reason(&self.pos).is_some() {
+        if pairs.recompute {
             self.supports_at.clone_from(&self.pos);
             self.built_at.clone_from(&self.pos);
             self.build_geometry(true)?;
-        } else if self.strain_since_build() > self.setup.rebuild_strain {
+            clock = std::time::Instant::now();
+        } else if pairs.strain > self.setup.rebuild_strain {
             self.built_at.clone_from(&self.pos);
             self.build_geometry(false)?;
+            clock = std::time::Instant::now();
         }
         // 5. Velocity gradients and the material.
         let g = self.geometry.as_ref().expect("built above");
-        let mut grad = vec![[[0.0; 3]; 3]; n];
-        g.shapes.velocity_gradients(&self.vel, &mut grad);
+        let grad = &mut scratch.grad;
+        g.shapes.velocity_gradients(&self.vel, grad);
+        self.profile.lap(Phase::Gradients, &mut clock);
         let material = self.material;
         let c = self.damping_time;
         let (mass, vel) = (&self.mass, &self.vel);
-        let results: Vec<std::result::Result<Tally, (usize, Error)>> = self
-            .dev
+        let results = &mut scratch.results;
+        self.dev
             .par_iter_mut()
             .zip(self.pressure.par_iter_mut())
             .zip(self.eps_p.par_iter_mut())
@@ -741,96 +832,106 @@ impl Mlpg3d {
             .zip(self.rho.par_iter_mut())
             .zip(self.visc.par_iter_mut())
             .zip(self.material_state.points_mut().par_iter_mut())
+            .zip(results.par_iter_mut())
             .enumerate()
-            .map(|(i, ((((((dev, p), eps), temp), rho), visc), state))| {
-                let l = &grad[i];
-                let d = |a: usize, b: usize| 0.5 * (l[a][b] + l[b][a]);
-                let w = |a: usize, b: usize| 0.5 * (l[a][b] - l[b][a]);
-                let rate: Full = [d(0, 0), d(1, 1), d(2, 2), d(0, 1), d(1, 2), d(2, 0)];
-                let tr = rate[0] + rate[1] + rate[2];
-                let rho_new = *rho * (1.0 - dt * tr);
-                let load = Loading {
-                    dt,
-                    rate,
-                    spin: [w(0, 1), w(1, 2), w(2, 0)],
-                    density: rho_new,
-                };
-                let before = Point {
-                    deviator: *dev,
-                    pressure: *p,
-                    plastic_strain: *eps,
-                    temperature: *temp,
-                };
-                let new = material.update(&load, &before, state).map_err(|l| {
-                    (
-                        i,
-                        Error::CompressionLimit {
-                            particle: i,
-                            time: 0.0,
-                            compression: l.compression,
-                            limit: l.limit,
-                        },
-                    )
-                })?;
-                let stress =
-                    |s: &Full, p: f64| -> Full { [s[0] - p, s[1] - p, s[2] - p, s[3], s[4], s[5]] };
-                let mid: Full = {
-                    let (a, b) = (stress(dev, *p), stress(&new.deviator, new.pressure));
-                    std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
-                };
-                let volume = mass[i] / rho_new;
-                let bulk = material.eos.bulk_modulus(rho_new, new.pressure);
-                let mu = material.shear_modulus;
-                let v: Full = std::array::from_fn(|k| {
-                    let dev_rate = if k < 3 { rate[k] - tr / 3.0 } else { rate[k] };
-                    let vol = if k < 3 { bulk * tr } else { 0.0 };
-                    c * (vol + 2.0 * mu * dev_rate)
-                });
-                let t = Tally {
-                    internal: dt * volume * mid.double_dot(&rate),
-                    plastic: volume * new.deviator.von_mises() * (new.plastic_strain - *eps),
-                    damping: dt * volume * v.double_dot(&rate),
-                    kinetic: kinetic1(vel[i], mass[i]),
-                    momentum: mass[i] * vel[i][2],
-                    mass: mass[i],
-                    worst_speed: (material.longitudinal_modulus(rho_new, new.pressure) / rho_new)
-                        .sqrt()
-                        + norm(vel[i]),
-                };
-                *dev = new.deviator;
-                *p = new.pressure;
-                *eps = new.plastic_strain;
-                *temp = new.temperature;
-                *rho = rho_new;
-                *visc = v;
-                let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
-                let bad = if !finite(&vel[i]) {
-                    Some("velocity")
-                } else if !rho_new.is_finite() {
-                    Some("density")
-                } else if !finite(dev) || !p.is_finite() {
-                    Some("stress")
-                } else if !temp.is_finite() {
-                    Some("temperature")
-                } else {
-                    None
-                };
-                if let Some(field) = bad {
-                    return Err((
-                        i,
-                        Error::NonFinite {
-                            field,
-                            particle: i,
-                            time: 0.0,
-                        },
-                    ));
-                }
-                Ok(t)
-            })
-            .collect();
+            .for_each(
+                |(i, (((((((dev, p), eps), temp), rho), visc), state), out))| {
+                    *out = (|| {
+                        let l = &grad[i];
+                        let d = |a: usize, b: usize| 0.5 * (l[a][b] + l[b][a]);
+                        let w = |a: usize, b: usize| 0.5 * (l[a][b] - l[b][a]);
+                        let rate: Full = [d(0, 0), d(1, 1), d(2, 2), d(0, 1), d(1, 2), d(2, 0)];
+                        let tr = rate[0] + rate[1] + rate[2];
+                        let rho_new = *rho * (1.0 - dt * tr);
+                        let load = Loading {
+                            dt,
+                            rate,
+                            spin: [w(0, 1), w(1, 2), w(2, 0)],
+                            density: rho_new,
+                        };
+                        let before = Point {
+                            deviator: *dev,
+                            pressure: *p,
+                            plastic_strain: *eps,
+                            temperature: *temp,
+                        };
+                        let new = material.update(&load, &before, state).map_err(|l| {
+                            (
+                                i,
+                                Error::CompressionLimit {
+                                    particle: i,
+                                    time: 0.0,
+                                    compression: l.compression,
+                                    limit: l.limit,
+                                },
+                            )
+                        })?;
+                        let stress = |s: &Full, p: f64| -> Full {
+                            [s[0] - p, s[1] - p, s[2] - p, s[3], s[4], s[5]]
+                        };
+                        let mid: Full = {
+                            let (a, b) = (stress(dev, *p), stress(&new.deviator, new.pressure));
+                            std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
+                        };
+                        let volume = mass[i] / rho_new;
+                        let bulk = material.eos.bulk_modulus(rho_new, new.pressure);
+                        let mu = material.shear_modulus;
+                        let v: Full = std::array::from_fn(|k| {
+                            let dev_rate = if k < 3 { rate[k] - tr / 3.0 } else { rate[k] };
+                            let vol = if k < 3 { bulk * tr } else { 0.0 };
+                            c * (vol + 2.0 * mu * dev_rate)
+                        });
+                        let t = Tally {
+                            internal: dt * volume * mid.double_dot(&rate),
+                            plastic: volume
+                                * new.deviator.von_mises()
+                                * (new.plastic_strain - *eps),
+                            damping: dt * volume * v.double_dot(&rate),
+                            kinetic: kinetic1(vel[i], mass[i]),
+                            momentum: mass[i] * vel[i][2],
+                            mass: mass[i],
+                            worst_speed: (material.longitudinal_modulus(rho_new, new.pressure)
+                                / rho_new)
+                                .sqrt()
+                                + norm(vel[i]),
+                        };
+                        *dev = new.deviator;
+                        *p = new.pressure;
+                        *eps = new.plastic_strain;
+                        *temp = new.temperature;
+                        *rho = rho_new;
+                        *visc = v;
+                        let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+                        let bad = if !finite(&vel[i]) {
+                            Some("velocity")
+                        } else if !rho_new.is_finite() {
+                            Some("density")
+                        } else if !finite(dev) || !p.is_finite() {
+                            Some("stress")
+                        } else if !temp.is_finite() {
+                            Some("temperature")
+                        } else {
+                            None
+                        };
+                        if let Some(field) = bad {
+                            return Err((
+                                i,
+                                Error::NonFinite {
+                                    field,
+                                    particle: i,
+                                    time: 0.0,
+                                },
+                            ));
+                        }
+                        Ok(t)
+                    })();
+                },
+            );
         let mut t = Tally::default();
-        for r in results {
-            let s = r.map_err(|(_, e)| with_time(e, self.time))?;
+        for r in results.iter() {
+            let s = r
+                .as_ref()
+                .map_err(|(_, e)| with_time(e.clone(), self.time))?;
             t.internal += s.internal;
             t.plastic += s.plastic;
             t.damping += s.damping;
@@ -839,6 +940,7 @@ impl Mlpg3d {
             t.mass += s.mass;
             t.worst_speed = t.worst_speed.max(s.worst_speed);
         }
+        self.profile.lap(Phase::Material, &mut clock);
         self.internal_energy += t.internal;
         self.plastic_work += t.plastic;
         self.damping_dissipation += t.damping;
@@ -877,29 +979,108 @@ impl Mlpg3d {
         } else {
             self.quiet_since = None;
         }
+        self.profile.lap(Phase::Checks, &mut clock);
         Ok(())
     }
 
-    /// The largest relative motion of a named pair since the last build.
-    fn strain_since_build(&self) -> f64 {
+    /// Runs the hot loops in the compiled copy `isa` from now on (by
+    /// default the best this processor runs); every copy gives the same
+    /// bits.
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = isa;
+    }
+
+    /// The heap bytes the run holds, by part (capacities, not lengths):
+    /// node fields (with the reference lattice and the material state),
+    /// the step's buffers, the supports, the shapes at the nodes, the test
+    /// spheres and the traction operator. BENCHMARKS.md, "3-D MLPG speed".
+    pub fn memory(&self) -> [(&'static str, usize); 6] {
+        fn b<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let l = &self.lattice;
+        let fields = b(&self.pos)
+            + b(&self.vel)
+            + b(&self.mass)
+            + b(&self.rho)
+            + b(&self.dev)
+            + b(&self.pressure)
+            + b(&self.eps_p)
+            + b(&self.temp)
+            + b(&self.visc)
+            + b(&self.contact)
+            + b(&self.supports_at)
+            + b(&self.built_at)
+            + b(&l.position)
+            + b(&l.volume)
+            + b(&l.surfaces)
+            + b(&l.sets.face)
+            + b(&l.sets.mantle)
+            + self.particles() * std::mem::size_of::<crate::material::PointState>();
+        let k = &self.scratch;
+        let scratch = b(&k.total)
+            + b(&k.force)
+            + b(&k.kicked)
+            + b(&k.smooth)
+            + b(&k.moved)
+            + b(&k.grad)
+            + b(&k.results);
+        let (mut supports, mut shapes, mut spheres, mut op) = (0, 0, 0, 0);
+        if let Some(g) = &self.geometry {
+            if let Some(s) = &g.supports {
+                supports =
+                    b(&s.radius) + b(&s.named.offsets) + b(&s.named.indices) + b(&s.named_distance);
+            }
+            let h = &g.shapes;
+            shapes = b(&h.offsets) + b(&h.nodes) + b(&h.phi) + b(&h.grad);
+            spheres = b(&g.spheres);
+            let o = &g.op;
+            op = b(&o.offsets) + b(&o.nodes) + b(&o.b) + b(&o.volume);
+        }
+        [
+            ("node fields", fields),
+            ("step buffers", scratch),
+            ("supports", supports),
+            ("shapes at the nodes", shapes),
+            ("test spheres", spheres),
+            ("traction operator", op),
+        ]
+    }
+
+    /// Wall time per phase of the steps taken in this process (a restored
+    /// run starts from zero), and the counts of the builds.
+    pub fn profile(&self) -> &PhaseTimes {
+        &self.profile
+    }
+
+    /// One pass over the named pairs at the current positions: the
+    /// smallest distance (the spacing check), whether a pair has left the
+    /// range of [`Supports::recompute_reason`] (the supports are
+    /// recomputed), and the largest relative motion of a pair since the
+    /// last build ([`REBUILD_STRAIN`]). Minima, maxima and an "any": the
+    /// same for any number of threads.
+    fn named_pairs(&self) -> NamedPairs {
         let sup = self.supports();
+        let limit = 0.5 * (1.0 + sup.params.factor);
         let (x, b) = (&self.pos, &self.built_at);
         (0..x.len())
             .into_par_iter()
             .map(|i| {
-                sup.named
-                    .of(i)
-                    .iter()
-                    .map(|&j| {
-                        let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
-                        let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
-                        norm(std::array::from_fn(|d| now[d] - then[d])) / norm(then)
-                    })
-                    .fold(0.0, f64::max)
+                let lo = sup.named.offsets[i];
+                let mut out = NamedPairs::NONE;
+                for (q, &j) in sup.named.of(i).iter().enumerate() {
+                    let d = distance(&x[i], &x[j]);
+                    out.nearest = out.nearest.min(d);
+                    let ratio = d / sup.named_distance[lo + q];
+                    out.recompute |= ratio > limit || ratio < 1.0 / limit;
+                    let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
+                    let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
+                    let strain = norm(std::array::from_fn(|d| now[d] - then[d])) / norm(then);
+                    out.strain = out.strain.max(strain);
+                }
+                out
             })
-            .collect::<Vec<f64>>()
-            .into_iter()
-            .fold(0.0, f64::max)
+            .reduce(|| NamedPairs::NONE, NamedPairs::join)
     }
 
     /// The rod observables of the current state.
@@ -1227,5 +1408,120 @@ impl crate::model::Model for Mlpg3d {
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)
+    }
+    fn set_isa(&mut self, isa: Isa) {
+        self.set_isa(isa);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::bilinear::Bilinear;
+    use crate::material::eos::LinearEos;
+    use crate::material::{Damage, Eos, Strength};
+
+    /// A small plastic rod after some steps: its geometry rebuilt by the
+    /// fast operator build is the plain build's, bit for bit.
+    #[test]
+    fn the_operator_of_a_deformed_rod_is_the_plain_one() {
+        let material = Material {
+            eos: Eos::Linear(LinearEos {
+                bulk_modulus: 169.1e9,
+                density: 7830.0,
+            }),
+            strength: Strength::Bilinear(Bilinear {
+                yield_stress: 500e6,
+                hardening_modulus: 1e9,
+            }),
+            damage: Damage::None,
+            shear_modulus: 82.9e9,
+            specific_heat: 460.0,
+            taylor_quinney: 0.9,
+            reference_temperature: 293.0,
+        };
+        let cyl = Cylinder {
+            radius: 2e-3,
+            length: 10e-3,
+        };
+        let mut setup = RodSetup::new(cyl, 3, 300.0, 1e-3);
+        setup.rebuild_strain = 1e-3;
+        let mut s = Mlpg3d::new(setup, material).unwrap();
+        for _ in 0..40 {
+            s.step().unwrap();
+        }
+        assert!(s.rebuilds() > 2);
+        let g = s.geometry.as_ref().unwrap();
+        let sup = g.supports.as_ref().unwrap();
+        let plain = TractionOperator::build_plain(
+            &s.built_at,
+            sup,
+            &g.spheres,
+            &SphereRule::of(DEFAULT_RULE),
+            &SphereRule::of(BOUNDARY_RULE),
+        )
+        .unwrap();
+        assert!(g.spheres.iter().any(|t| !t.is_whole()));
+        assert!(plain == g.op, "the fast build changed the operator");
+    }
+
+    /// Measurement: the sizes behind the flop count of BENCHMARKS.md ("3-D
+    /// MLPG speed"): per node of `taylor3d` at impact (`PARTICLES_RADIAL`,
+    /// default 10), the operator and shape rows, the quadrature points, and
+    /// per point the candidates, those within `r_J` by the squared test and
+    /// those covering it.
+    #[test]
+    #[ignore = "measurement: the sizes behind the 3-D flop count"]
+    fn operator_sizes() {
+        use crate::mlpg::mls::{PointShapes, candidates};
+        let across: f64 = std::env::var("PARTICLES_RADIAL")
+            .map(|s| s.parse().unwrap())
+            .unwrap_or(10.0);
+        let p = crate::scene::taylor3d::Taylor3dParams {
+            particles_radial: across,
+            ..Default::default()
+        };
+        let s = p.build().unwrap();
+        let g = s.geometry.as_ref().unwrap();
+        let sup = g.supports.as_ref().unwrap();
+        let pts = &s.built_at;
+        let n = pts.len() as f64;
+        let reach = g.spheres.iter().map(|t| t.radius).fold(0.0, f64::max);
+        let list = candidates(pts, sup, reach);
+        let (whole, cut) = (SphereRule::of(DEFAULT_RULE), SphereRule::of(BOUNDARY_RULE));
+        let mut ps = PointShapes::default();
+        let (mut points, mut gathered, mut covering) = (0usize, 0usize, 0usize);
+        for i in 0..pts.len() {
+            let r0 = g.spheres[i].radius;
+            ps.gather(
+                list.of(i)
+                    .iter()
+                    .copied()
+                    .filter(|&j| distance(&pts[i], &pts[j]) <= (r0 + sup.radius[j]) * (1.0 + 1e-9)),
+                pts,
+                &sup.radius,
+            );
+            let k = ps.candidates();
+            g.spheres[i].for_each_point(pts[i], &whole, &cut, |x, _, _| {
+                ps.evaluate(Isa::best(), x, i).unwrap();
+                points += 1;
+                gathered += k;
+                covering += ps.covering();
+            });
+        }
+        let whole_spheres = g.spheres.iter().filter(|t| t.is_whole()).count();
+        println!(
+            "{} nodes ({whole_spheres} whole spheres): cell-list candidates {:.1}, gathered {:.1}, \
+             operator row {:.1}, shape row {:.1}, named {}; quadrature points {:.1} a node, \
+             covering {:.1} a point",
+            pts.len(),
+            list.indices.len() as f64 / n,
+            gathered as f64 / points as f64,
+            g.op.nodes.len() as f64 / n,
+            g.shapes.nodes.len() as f64 / n,
+            sup.params.neighbours,
+            points as f64 / n,
+            covering as f64 / points as f64,
+        );
     }
 }

@@ -13,7 +13,8 @@
 //! Stresses are stored as 6 components `[xx, yy, zz, xy, yz, zx]`.
 
 use crate::Result;
-use crate::mlpg::mls::{ShapeRow, Supports, candidates};
+use crate::isa::Isa;
+use crate::mlpg::mls::{PointShapes, ShapeRow, Supports, candidates, distance};
 use crate::mlpg::sphere::{SphereRule, TestSphere};
 use rayon::prelude::*;
 
@@ -42,7 +43,67 @@ impl TractionOperator {
     /// octahedral rule `cut` on cut ones. In parallel over nodes, the same
     /// bits for any number of threads; the first failing node (in index
     /// order) names the error.
+    ///
+    /// The same arithmetic as [`TractionOperator::build_plain`] in the same
+    /// order, so the same bits, with less work around it: each node's
+    /// candidates are first narrowed to those whose support can reach its
+    /// sphere (`|x_i − x_J| ≤ r0_i + r_J`, with a margin), gathered into
+    /// arrays of coordinates; at each quadrature point a squared distance
+    /// (no root, no division) picks the few that may cover it, and only
+    /// those get the exact test `|x − x_J| / r_J < 1` and the MLS sums
+    /// ([`PointShapes`]), in the compiled copy `isa` (every copy gives the
+    /// same bits).
     pub fn build(
+        isa: Isa,
+        points: &[[f64; 3]],
+        supports: &Supports,
+        spheres: &[TestSphere],
+        whole: &SphereRule,
+        cut: &SphereRule,
+    ) -> Result<Self> {
+        let reach = spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
+        let list = candidates(points, supports, reach);
+        let radius = &supports.radius;
+        let rows: Vec<Result<Row>> = (0..points.len())
+            .into_par_iter()
+            .map_init(PointShapes::default, |ps, i| {
+                let cand = list.of(i);
+                let xi = points[i];
+                let r0 = spheres[i].radius;
+                ps.gather(
+                    cand.iter().copied().filter(|&j| {
+                        // A margin far above round-off: the narrowing only
+                        // has to keep every node that can cover a point.
+                        distance(&xi, &points[j]) <= (r0 + radius[j]) * (1.0 + 1e-9)
+                    }),
+                    points,
+                    radius,
+                );
+                let mut failed = None;
+                spheres[i].for_each_point(xi, whole, cut, |x, n, w| {
+                    if failed.is_some() {
+                        return;
+                    }
+                    if let Err(e) = ps.evaluate(isa, x, i) {
+                        failed = Some(e);
+                        return;
+                    }
+                    ps.accumulate(n, w);
+                });
+                if let Some(e) = failed {
+                    return Err(e);
+                }
+                Ok(ps.row())
+            })
+            .collect();
+        Self::assemble(rows, spheres)
+    }
+
+    /// The plain twin of [`TractionOperator::build`]: one full MLS
+    /// evaluation ([`ShapeRow::evaluate`]) over every candidate at every
+    /// quadrature point. Kept as the reference the fast build is pinned to
+    /// (the same bits, `tests::the_fast_build_gives_the_plain_bits`).
+    pub fn build_plain(
         points: &[[f64; 3]],
         supports: &Supports,
         spheres: &[TestSphere],
@@ -88,6 +149,12 @@ impl TractionOperator {
                 },
             )
             .collect();
+        Self::assemble(rows, spheres)
+    }
+
+    /// The operator of the rows of every node, in node order (the first
+    /// failed row's error).
+    fn assemble(rows: Vec<Result<Row>>, spheres: &[TestSphere]) -> Result<Self> {
         let mut op = TractionOperator {
             offsets: vec![0],
             volume: spheres.iter().map(TestSphere::volume).collect(),
@@ -156,7 +223,7 @@ mod tests {
     /// The operator with the solver's rules.
     fn operator(pts: &[[f64; 3]], sup: &Supports, spheres: &[TestSphere]) -> TractionOperator {
         let (whole, cut) = (SphereRule::of(DEFAULT_RULE), SphereRule::of(BOUNDARY_RULE));
-        TractionOperator::build(pts, sup, spheres, &whole, &cut).unwrap()
+        TractionOperator::build(Isa::best(), pts, sup, spheres, &whole, &cut).unwrap()
     }
 
     #[test]
@@ -219,6 +286,48 @@ mod tests {
         };
         let (a, b) = (build(1), build(2));
         assert!(a == b, "thread count changed the result");
+    }
+
+    #[test]
+    fn the_fast_build_gives_the_plain_bits() {
+        let (pts, sup, mut spheres, _) = setup(6, 1.0);
+        // Cut spheres on the box faces, in turned frames, as the solver's
+        // boundary nodes have them.
+        let hi = 5.0;
+        for (i, p) in pts.iter().enumerate() {
+            let mut cut = [0i8; 3];
+            for a in 0..3 {
+                if p[a] < 0.3 {
+                    cut[a] = -1;
+                } else if p[a] > hi - 0.3 {
+                    cut[a] = 1;
+                }
+            }
+            if cut != [0; 3] {
+                let (c, s) = (0.8f64, 0.6f64);
+                spheres[i] = TestSphere {
+                    radius: spheres[i].radius.max(0.3),
+                    frame: [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]],
+                    cut,
+                };
+            }
+        }
+        let (whole, cut) = (SphereRule::of(DEFAULT_RULE), SphereRule::of(BOUNDARY_RULE));
+        let plain = TractionOperator::build_plain(&pts, &sup, &spheres, &whole, &cut).unwrap();
+        for isa in Isa::available() {
+            let fast = TractionOperator::build(isa, &pts, &sup, &spheres, &whole, &cut).unwrap();
+            assert!(
+                fast == plain,
+                "the {} copy changed the operator",
+                isa.name()
+            );
+        }
+        // The same error at the same node: a sphere too far out.
+        spheres[3].radius = 50.0;
+        let e =
+            TractionOperator::build(Isa::best(), &pts, &sup, &spheres, &whole, &cut).unwrap_err();
+        let p = TractionOperator::build_plain(&pts, &sup, &spheres, &whole, &cut).unwrap_err();
+        assert_eq!(format!("{e:?}"), format!("{p:?}"));
     }
 
     /// ∂σ_c/∂x_a of a linear field, by a difference (exact for linear).
