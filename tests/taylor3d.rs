@@ -45,8 +45,8 @@ fn test7_in_3d_coarse() {
     check(6.0);
 }
 
-/// 11 nodes across (10 rings, 33431 nodes; 358 s wall on two shared cores,
-/// `scripts/validate.sh`): measured Lf 34.57 mm (−0.08 %), Df 10.34 mm
+/// 11 nodes across (10 rings, 33431 nodes; 358 s wall on two shared cores
+/// before the speed work, which kept the bits; `scripts/validate.sh`): measured Lf 34.57 mm (−0.08 %), Df 10.34 mm
 /// (+8.8 %: outside the 8 %, so this test fails on Df), spread 0.14 %,
 /// energy error 0.85 %; the axisymmetric solver at the matched spacing
 /// (`particles_radial` = 11) gives 34.84 mm, 0.76 % longer (within 1 %).

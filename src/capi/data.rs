@@ -344,7 +344,8 @@ pub unsafe extern "C" fn mi_sim_field_info(
 
 /// Copies the current values of the particle field `name` by the buffer
 /// convention: `particles * components` doubles, interleaved per particle
-/// (for `"stress"`: RR, ZZ, TT, RZ of particle 0, then of particle 1, ...).
+/// (for `"stress"` of `taylor`: RR, ZZ, TT, RZ of particle 0, then of particle
+/// 1, ...; of `taylor3d`: xx, yy, zz, xy, yz, zx; `mi_sim_field_info` names them).
 /// Only this field is made (not the whole snapshot), and a size query
 /// (`buf` NULL) or a buffer too small makes none.
 ///
