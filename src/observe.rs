@@ -158,6 +158,57 @@ pub struct FieldSpec {
     pub components: &'static [&'static str],
 }
 
+/// A rod solver's field table: position, density and velocity with the
+/// coordinates `axes`, pressure, stress with the components `stress`,
+/// plastic strain, temperature and the contact flag.
+pub(crate) const fn rod_fields(
+    axes: &'static [&'static str],
+    stress: &'static [&'static str],
+) -> [FieldSpec; 8] {
+    [
+        FieldSpec {
+            name: "position",
+            unit: "m",
+            components: axes,
+        },
+        FieldSpec {
+            name: "density",
+            unit: "kg/m3",
+            components: &["rho"],
+        },
+        FieldSpec {
+            name: "velocity",
+            unit: "m/s",
+            components: axes,
+        },
+        FieldSpec {
+            name: "pressure",
+            unit: "Pa",
+            components: &["P"],
+        },
+        FieldSpec {
+            name: "stress",
+            unit: "Pa",
+            components: stress,
+        },
+        FieldSpec {
+            name: "plastic_strain",
+            unit: "1",
+            components: &["eps_p"],
+        },
+        FieldSpec {
+            name: "temperature",
+            unit: "K",
+            components: &["T"],
+        },
+        FieldSpec {
+            name: "in_contact",
+            unit: "bool",
+            components: &["contact"],
+        },
+    ]
+}
+
 /// One named particle field of a snapshot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Field {

@@ -1232,48 +1232,8 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// The node fields of the 3-D solver.
-pub const MLPG_FIELDS: &[FieldSpec] = &[
-    FieldSpec {
-        name: "position",
-        unit: "m",
-        components: &["x", "y", "z"],
-    },
-    FieldSpec {
-        name: "density",
-        unit: "kg/m3",
-        components: &["rho"],
-    },
-    FieldSpec {
-        name: "velocity",
-        unit: "m/s",
-        components: &["x", "y", "z"],
-    },
-    FieldSpec {
-        name: "pressure",
-        unit: "Pa",
-        components: &["P"],
-    },
-    FieldSpec {
-        name: "stress",
-        unit: "Pa",
-        components: &["xx", "yy", "zz", "xy", "yz", "zx"],
-    },
-    FieldSpec {
-        name: "plastic_strain",
-        unit: "1",
-        components: &["eps_p"],
-    },
-    FieldSpec {
-        name: "temperature",
-        unit: "K",
-        components: &["T"],
-    },
-    FieldSpec {
-        name: "in_contact",
-        unit: "bool",
-        components: &["contact"],
-    },
-];
+pub const MLPG_FIELDS: &[FieldSpec] =
+    &crate::observe::rod_fields(&["x", "y", "z"], &["xx", "yy", "zz", "xy", "yz", "zx"]);
 
 impl Mlpg3d {
     /// Current values of [`TAYLOR3D_OBSERVABLES`], in that order.

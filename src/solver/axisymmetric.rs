@@ -1547,48 +1547,8 @@ impl TaylorSolver {
 }
 
 /// The particle fields of the Taylor solver.
-pub const TAYLOR_FIELDS: &[FieldSpec] = &[
-    FieldSpec {
-        name: "position",
-        unit: "m",
-        components: &["R", "Z"],
-    },
-    FieldSpec {
-        name: "density",
-        unit: "kg/m3",
-        components: &["rho"],
-    },
-    FieldSpec {
-        name: "velocity",
-        unit: "m/s",
-        components: &["R", "Z"],
-    },
-    FieldSpec {
-        name: "pressure",
-        unit: "Pa",
-        components: &["P"],
-    },
-    FieldSpec {
-        name: "stress",
-        unit: "Pa",
-        components: &["RR", "ZZ", "TT", "RZ"],
-    },
-    FieldSpec {
-        name: "plastic_strain",
-        unit: "1",
-        components: &["eps_p"],
-    },
-    FieldSpec {
-        name: "temperature",
-        unit: "K",
-        components: &["T"],
-    },
-    FieldSpec {
-        name: "in_contact",
-        unit: "bool",
-        components: &["contact"],
-    },
-];
+pub const TAYLOR_FIELDS: &[FieldSpec] =
+    &crate::observe::rod_fields(&["R", "Z"], &["RR", "ZZ", "TT", "RZ"]);
 
 /// A copy of a run (an FMU state got to roll back to) starts with empty
 /// buffers, as a restored run does, and rebuilds them at its next step with
