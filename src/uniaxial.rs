@@ -70,11 +70,7 @@ impl Layer {
     fn wave_speed(&self, rho: f64, s: &CellState) -> f64 {
         match (self, s) {
             (Layer::Ceramic(c), CellState::Ceramic(p)) => {
-                let eta = c.matrix_compression(rho, p.porosity).max(0.0);
-                let [b1, b2, b3] = c.beta;
-                let k = (b1 + eta * (2.0 * b2 + 3.0 * eta * b3)) * (1.0 + eta);
-                let g = c.porosity_factor(p.porosity) * c.shear_modulus;
-                ((k + 4.0 / 3.0 * g) / rho).sqrt()
+                (c.longitudinal_modulus(rho, p.porosity) / rho).sqrt()
             }
             (Layer::Solid(m), CellState::Solid(p, _)) => {
                 (m.longitudinal_modulus(rho, p.pressure) / rho).sqrt()

@@ -30,7 +30,8 @@ use eos::LinearEos;
 use ideal_gas::IdealGas;
 use johnson_cook::JohnsonCook;
 use mie_gruneisen::{CompressionLimit, MieGruneisen, check};
-use tensor::{SymTensor, radial_return};
+use rajendran_grove::{CeramicPoint, CeramicVars, RajendranGrove};
+use tensor::{Full, SymTensor, radial_return};
 
 /// Equation of state: the pressure from the density and the specific
 /// internal energy.
@@ -96,6 +97,14 @@ pub enum Strength {
 pub enum Damage {
     /// No damage: the state is left as it is.
     None,
+    /// The Rajendran-Grove ceramic (seed 004, section 4;
+    /// [`rajendran_grove`]): micro-cracks, pores and pulverization. Its
+    /// moduli fall with the crack density and its pressure depends on the
+    /// porosity, so it owns the whole update of its points: its porous
+    /// pressure (eqs. 16-18) stands in for the equation of state and its
+    /// Gurson and Mohr-Coulomb strengths (eqs. 21, 25) for the strength
+    /// model. Build it with [`Material::ceramic`].
+    RajendranGrove(RajendranGrove),
 }
 
 impl Damage {
@@ -112,7 +121,9 @@ impl Damage {
     ) {
         let _ = (load, plastic_increment, point, state);
         match self {
-            Damage::None => {}
+            // The ceramic's damage is part of its own update
+            // (`Material::update_ceramic`).
+            Damage::None | Damage::RajendranGrove(_) => {}
         }
     }
 }
@@ -172,6 +183,10 @@ pub struct PointState {
     /// same (a particle that does not yield), which spares two `powf` and
     /// gives the same bits.
     memo: Memo,
+    /// The damage model's variables: `None` for a material without damage,
+    /// and for a ceramic point before its first step (it then starts from
+    /// the intact state, [`RajendranGrove::initial_point`]).
+    damage: Option<CeramicVars>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -192,13 +207,24 @@ impl Default for PointState {
                 hardening: 0.0,
                 thermal: 0.0,
             },
+            damage: None,
         }
     }
 }
 
-/// Per-particle state of a material's models, owned next to the material.
-/// It holds caches only today (rebuilt after a restore); damage variables
-/// will join it.
+impl PointState {
+    /// The ceramic variables of the point, if its material has them and it
+    /// has taken a step.
+    pub fn ceramic(&self) -> Option<&CeramicVars> {
+        self.damage.as_ref()
+    }
+}
+
+/// Per-particle state of a material's models, owned next to the material:
+/// caches (rebuilt after a restore) and, for a material with damage, the
+/// damage variables, which are physical state. The solvers do not save this
+/// state yet, so no scene offers a material with damage until its solver
+/// saves and restores them.
 #[derive(Debug, Clone, Default)]
 pub struct MaterialState {
     points: Vec<PointState>,
@@ -245,7 +271,56 @@ impl Material {
             check("yield_stress", b.yield_stress, non_negative)?;
             check("hardening_modulus", b.hardening_modulus, non_negative)?;
         }
+        if let Damage::RajendranGrove(c) = &self.damage {
+            c.validate()?;
+            // The slots the ceramic stands in for hold its intact matrix
+            // ([`Material::ceramic`]); anything else is a contradiction.
+            let intact = Material::ceramic(
+                *c,
+                self.specific_heat,
+                self.taylor_quinney,
+                self.reference_temperature,
+            );
+            if (self.eos, self.strength, self.shear_modulus)
+                != (intact.eos, intact.strength, intact.shear_modulus)
+            {
+                return Err(crate::Error::Inconsistent(
+                    "a Rajendran-Grove material holds its own moduli, pressure and strength: \
+                     build it with Material::ceramic"
+                        .into(),
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// A material of Rajendran-Grove ceramic ([`Damage::RajendranGrove`])
+    /// with its thermal constants. The equation-of-state and strength slots
+    /// hold the intact dense matrix (linear pressure of bulk modulus
+    /// `beta1` at the initial density, perfectly plastic at `C1`), for what
+    /// reads them outside the update; [`Material::update`] and
+    /// [`Material::longitudinal_modulus`] use the ceramic itself.
+    pub fn ceramic(
+        c: RajendranGrove,
+        specific_heat: f64,
+        taylor_quinney: f64,
+        reference_temperature: f64,
+    ) -> Material {
+        Material {
+            eos: Eos::Linear(LinearEos {
+                bulk_modulus: c.bulk_modulus(),
+                density: c.density,
+            }),
+            strength: Strength::Bilinear(Bilinear {
+                yield_stress: c.c1,
+                hardening_modulus: 0.0,
+            }),
+            damage: Damage::RajendranGrove(c),
+            shear_modulus: c.shear_modulus,
+            specific_heat,
+            taylor_quinney,
+            reference_temperature,
+        }
     }
 
     /// The specific internal energy the equation of state sees at
@@ -265,9 +340,28 @@ impl Material {
 
     /// The longitudinal modulus `rho c^2 + 4/3 G` that sets the elastic wave
     /// speed at density `rho` and pressure `p`.
+    ///
+    /// A ceramic's modulus depends on its porosity: without a point's state
+    /// this is the one of the intact point at the initial porosity
+    /// ([`Material::wave_modulus`] takes the state).
     #[inline]
     pub fn longitudinal_modulus(&self, rho: f64, p: f64) -> f64 {
+        if let Damage::RajendranGrove(c) = &self.damage {
+            return c.longitudinal_modulus(rho, c.initial_porosity);
+        }
         self.eos.bulk_modulus(rho, p) + 4.0 / 3.0 * self.shear_modulus
+    }
+
+    /// The longitudinal modulus of a point in state `state` at density
+    /// `rho` and pressure `p`: [`Material::longitudinal_modulus`], but for
+    /// a ceramic at the point's own porosity, with the shear modulus of the
+    /// uncracked porous solid (cracks only soften it, so the wave speed is
+    /// bounded from above, as a stable time step needs).
+    pub fn wave_modulus(&self, rho: f64, p: f64, state: &PointState) -> f64 {
+        match (&self.damage, &state.damage) {
+            (Damage::RajendranGrove(c), Some(v)) => c.longitudinal_modulus(rho, v.porosity),
+            _ => self.longitudinal_modulus(rho, p),
+        }
     }
 
     /// One step of a particle: the Jaumann-rate trial deviator, the J2
@@ -282,6 +376,9 @@ impl Material {
         old: &Point<T>,
         state: &mut PointState,
     ) -> std::result::Result<Point<T>, CompressionLimit> {
+        if let Damage::RajendranGrove(c) = &self.damage {
+            return Ok(self.update_ceramic(c, load, old, state));
+        }
         let mu = self.shear_modulus;
         let trial = old
             .deviator
@@ -319,12 +416,49 @@ impl Material {
         self.damage.apply(load, ret.plastic_strain, &mut new, state);
         Ok(new)
     }
+
+    /// One step of a ceramic point ([`RajendranGrove`]'s update, in 3-D
+    /// components whatever the solver's form), heated by the Taylor-Quinney
+    /// fraction of its plastic work.
+    fn update_ceramic<T: SymTensor>(
+        &self,
+        c: &RajendranGrove,
+        load: &Loading<T>,
+        old: &Point<T>,
+        state: &mut PointState,
+    ) -> Point<T> {
+        let full = Loading::<Full> {
+            dt: load.dt,
+            rate: load.rate.to_full(),
+            spin: T::spin_to_full(&load.spin),
+            density: load.density,
+        };
+        let vars = state.damage.unwrap_or_else(|| c.initial_point().vars());
+        let mut point = CeramicPoint {
+            elastic_strain: vars.elastic_strain,
+            deviator: old.deviator.to_full(),
+            pressure: old.pressure,
+            plastic_strain: old.plastic_strain,
+            crack_size: vars.crack_size,
+            porosity: vars.porosity,
+            pulverized: vars.pulverized,
+        };
+        let work = c.update(&full, self.energy(old.temperature), &mut point);
+        state.damage = Some(point.vars());
+        Point {
+            deviator: T::from_full(&point.deviator),
+            pressure: point.pressure,
+            plastic_strain: point.plastic_strain,
+            temperature: old.temperature
+                + self.taylor_quinney * work / (load.density * self.specific_heat),
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tensor::{Axisymmetric, Full};
+    use tensor::Axisymmetric;
 
     fn steel(strength: Strength, eos: Eos) -> Material {
         Material {
@@ -464,6 +598,139 @@ mod tests {
         let old = unloaded([0.0; 4], 0.0);
         let err = m.update(&load, &old, &mut PointState::default());
         assert!(err.is_err(), "{err:?}");
+    }
+
+    /// A strain path through compression past the elastic limit, shear
+    /// with spin, and tension until the cracks pulverize the point: the
+    /// rates of each leg (3-D components) and its number of steps.
+    fn ceramic_path() -> Vec<(Full, [f64; 3], usize)> {
+        vec![
+            // Uniaxial strain along Y at 1e5/s: past the HEL (log strain
+            // about 0.025) by 0.035.
+            ([0.0, -1e5, 0.0, 0.0, 0.0, 0.0], [0.0; 3], 350),
+            // Shear in XY with spin, under the compression.
+            ([0.0, 0.0, 0.0, 5e4, 0.0, 0.0], [2e4, 0.0, 0.0], 200),
+            // Unloading into triaxial tension: the cracks open and grow
+            // until the point pulverizes, and it is pulled on after that.
+            ([1e5, 1e5, 1e5, 0.0, 0.0, 0.0], [0.0; 3], 2000),
+        ]
+    }
+
+    /// The ceramic material steps a point exactly as the ceramic's own
+    /// point update does (its analytic checks are in
+    /// [`rajendran_grove`]), to the bit, in the 3-D form and, over an
+    /// axisymmetric path, in the axisymmetric form; the point is heated by
+    /// the Taylor-Quinney fraction of the plastic work the point update
+    /// returns. The path pulverizes the point, so every branch is taken.
+    #[test]
+    fn ceramic_material_steps_as_the_point_update() {
+        let c = RajendranGrove::ad85();
+        let (heat, tq, t0) = (750.0, 0.9, 293.0);
+        let m = Material::ceramic(c, heat, tq, t0);
+        assert!(m.validate().is_ok());
+        let dt = 1e-9;
+        let mut twin = c.initial_point();
+        let mut twin_temp = t0;
+        let mut rho = c.density;
+        let mut full = unloaded([0.0; 6], 0.0);
+        let mut axi = unloaded([0.0; 4], 0.0);
+        let (mut s6, mut s4) = (PointState::default(), PointState::default());
+        let mut steps = 0;
+        let mut least_porosity = c.initial_porosity;
+        for (rate, spin, n) in ceramic_path() {
+            for _ in 0..n {
+                rho *= 1.0 - dt * (rate[0] + rate[1] + rate[2]);
+                let load = Loading::<Full> {
+                    dt,
+                    rate,
+                    spin,
+                    density: rho,
+                };
+                let work = c.update(&load, m.energy(twin_temp), &mut twin);
+                twin_temp += tq * work / (rho * heat);
+                full = m.update(&load, &full, &mut s6).unwrap();
+                assert_eq!(full.deviator, twin.deviator, "step {steps}");
+                assert_eq!(full.pressure, twin.pressure, "step {steps}");
+                assert_eq!(full.plastic_strain, twin.plastic_strain);
+                assert_eq!(full.temperature, twin_temp);
+                assert_eq!(s6.ceramic(), Some(&twin.vars()));
+                least_porosity = least_porosity.min(twin.porosity);
+                // The same path in (R, Z, theta) as (X, Y, Z): the legs
+                // have no YZ or ZX part.
+                let load4 = Loading::<Axisymmetric> {
+                    dt,
+                    rate: Axisymmetric::from_full(&rate),
+                    spin: spin[0],
+                    density: rho,
+                };
+                axi = m.update(&load4, &axi, &mut s4).unwrap();
+                assert_eq!(axi.deviator.to_full(), twin.deviator);
+                assert_eq!(axi.pressure, twin.pressure);
+                assert_eq!(axi.temperature, twin_temp);
+                steps += 1;
+            }
+        }
+        let v = s6.ceramic().unwrap();
+        assert!(least_porosity < 0.095, "pores closed: {least_porosity}");
+        assert!(v.pulverized.is_some(), "pulverized at the end: {v:?}");
+        assert!(twin_temp > t0 && full.plastic_strain > 0.0);
+    }
+
+    /// The ceramic's wave modulus at its initial density and porosity is
+    /// `beta1 + 4/3 R_g G` (the matrix is neither compressed nor
+    /// stretched), with Mackenzie's `R_g` typed out; a compressed point is
+    /// stiffer; the state's porosity is the one used.
+    #[test]
+    fn ceramic_wave_modulus() {
+        let c = RajendranGrove::ad85();
+        let m = Material::ceramic(c, 750.0, 0.9, 293.0);
+        let (k, g, f0) = (150e9, 88e9, 0.1);
+        let rg = 1.0 - (6.0 * k + 12.0 * g) / (9.0 * k + 8.0 * g) * f0;
+        let at_rest = m.longitudinal_modulus(c.density, 0.0);
+        assert!((at_rest - (k + 4.0 / 3.0 * rg * g)).abs() < 1e-12 * at_rest);
+        assert!(m.longitudinal_modulus(1.05 * c.density, 1e9) > at_rest);
+        // A point whose pores have closed to 5%: its matrix is less
+        // compressed at the same density, and its shear modulus higher.
+        let state = PointState {
+            damage: Some(CeramicVars {
+                porosity: 0.05,
+                ..c.initial_point().vars()
+            }),
+            ..PointState::default()
+        };
+        let rho = c.density * 0.95 / 0.9;
+        let eta: f64 = 0.9 * rho / (0.95 * c.density) - 1.0;
+        assert!(eta.abs() < 1e-15);
+        let rg5 = 1.0 - (6.0 * k + 12.0 * g) / (9.0 * k + 8.0 * g) * 0.05;
+        let want = k + 4.0 / 3.0 * rg5 * g;
+        let got = m.wave_modulus(rho, 0.0, &state);
+        assert!((got - want).abs() < 1e-9 * want, "{got} {want}");
+        // A material without damage ignores the state.
+        let steel = steel(jc(), linear());
+        assert_eq!(
+            steel.wave_modulus(7900.0, 1e8, &state),
+            steel.longitudinal_modulus(7900.0, 1e8)
+        );
+    }
+
+    /// A ceramic material refuses a constant out of range by name, and
+    /// slots that contradict the ceramic.
+    #[test]
+    fn ceramic_material_is_validated() {
+        let c = RajendranGrove {
+            initial_porosity: 0.7,
+            ..RajendranGrove::ad85()
+        };
+        match Material::ceramic(c, 750.0, 0.9, 293.0).validate() {
+            Err(crate::Error::OutOfRange { name, .. }) => assert_eq!(name, "initial_porosity"),
+            other => panic!("{other:?}"),
+        }
+        let odd = Material {
+            shear_modulus: 1e9,
+            ..Material::ceramic(RajendranGrove::ad85(), 750.0, 0.9, 293.0)
+        };
+        let err = odd.validate().unwrap_err();
+        assert_eq!(err.name(), "Inconsistent", "{err}");
     }
 
     /// Constants out of range are refused by name.

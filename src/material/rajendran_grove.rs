@@ -362,6 +362,20 @@ impl RajendranGrove {
         }
     }
 
+    /// The longitudinal modulus `rho c_L^2` of a point at density `rho` and
+    /// porosity `f`: the tangent of the pressure of eqs. (16)-(18) with
+    /// respect to the volumetric strain, `(b1 + 2 b2 eta + 3 b3 eta^2)
+    /// (1 + eta)`, at the matrix compression `eta` (none in tension), plus
+    /// `4/3 R_g G` of the uncracked solid. Cracks only soften a point, so
+    /// this bounds its wave speed from above.
+    pub fn longitudinal_modulus(&self, rho: f64, f: f64) -> f64 {
+        let eta = self.matrix_compression(rho, f).max(0.0);
+        let [b1, b2, b3] = self.beta;
+        let k = (b1 + eta * (2.0 * b2 + 3.0 * eta * b3)) * (1.0 + eta);
+        let g = self.porosity_factor(f) * self.shear_modulus;
+        k + 4.0 / 3.0 * g
+    }
+
     /// One step of a point under `load` (`load.density` is the density at
     /// the end of the step), with specific internal energy `energy` (J/kg,
     /// from the initial state). Returns the plastic work per unit volume.
@@ -507,6 +521,34 @@ pub struct CeramicPoint {
     pub porosity: f64,
     /// The frozen state once pulverized.
     pub pulverized: Option<Pulverized>,
+}
+
+/// The variables of a point of Rajendran-Grove material that a solver's
+/// particle fields (deviator, pressure, plastic strain, temperature) do not
+/// hold: what [`super::Material::update`] keeps per particle for
+/// [`super::Damage::RajendranGrove`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CeramicVars {
+    /// Elastic deviatoric strain `e_e` (XX, YY, ZZ, XY, YZ, ZX).
+    pub elastic_strain: Full,
+    /// Crack radius `a` (m).
+    pub crack_size: f64,
+    /// Porosity `f` (1).
+    pub porosity: f64,
+    /// The frozen state once pulverized.
+    pub pulverized: Option<Pulverized>,
+}
+
+impl CeramicPoint {
+    /// The point's variables that the solver's fields do not hold.
+    pub fn vars(&self) -> CeramicVars {
+        CeramicVars {
+            elastic_strain: self.elastic_strain,
+            crack_size: self.crack_size,
+            porosity: self.porosity,
+            pulverized: self.pulverized,
+        }
+    }
 }
 
 /// What a pulverized point keeps: its moduli at pulverization and its

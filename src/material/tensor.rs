@@ -57,6 +57,19 @@ pub trait SymTensor: Copy + PartialEq + std::fmt::Debug + AsRef<[f64]> + AsMut<[
     fn norm(&self) -> f64 {
         self.double_dot(self).sqrt()
     }
+
+    /// The tensor in 3-D components. The axisymmetric form is the 3-D one
+    /// with (R, Z, theta) as (X, Y, Z), whose shears YZ and ZX are zero by
+    /// symmetry.
+    fn to_full(&self) -> Full;
+
+    /// The tensor from 3-D components: the inverse of [`Self::to_full`] on
+    /// the tensors the form can hold (the axisymmetric form drops YZ and
+    /// ZX).
+    fn from_full(f: &Full) -> Self;
+
+    /// The spin in 3-D components `(W_XY, W_YZ, W_ZX)`.
+    fn spin_to_full(w: &Self::Spin) -> [f64; 3];
 }
 
 /// Axisymmetric components (RR, ZZ, theta-theta, RZ).
@@ -79,6 +92,22 @@ impl SymTensor for Axisymmetric {
             s[2] + dt * (2.0 * mu * (d[2] - dvol)),
             s[3] + dt * (omega * (s[1] - s[0]) + 2.0 * mu * d[3]),
         ]
+    }
+
+    #[inline]
+    fn to_full(&self) -> Full {
+        [self[0], self[1], self[2], self[3], 0.0, 0.0]
+    }
+
+    #[inline]
+    fn from_full(f: &Full) -> Self {
+        [f[0], f[1], f[2], f[3]]
+    }
+
+    /// `W_RZ` is `W_XY`.
+    #[inline]
+    fn spin_to_full(w: &f64) -> [f64; 3] {
+        [*w, 0.0, 0.0]
     }
 }
 
@@ -105,6 +134,21 @@ impl SymTensor for Full {
             let dev = if c < 3 { d[c] - dvol } else { d[c] };
             self[c] + dt * (rot(i, j) + 2.0 * mu * dev)
         })
+    }
+
+    #[inline]
+    fn to_full(&self) -> Full {
+        *self
+    }
+
+    #[inline]
+    fn from_full(f: &Full) -> Self {
+        *f
+    }
+
+    #[inline]
+    fn spin_to_full(w: &[f64; 3]) -> [f64; 3] {
+        *w
     }
 }
 
@@ -156,11 +200,6 @@ pub fn radial_return<T: SymTensor>(
 mod tests {
     use super::*;
 
-    /// The axisymmetric components as 3-D ones: (R, Z, theta) as (X, Y, Z).
-    fn lift(s: &Axisymmetric) -> Full {
-        [s[0], s[1], s[2], s[3], 0.0, 0.0]
-    }
-
     #[test]
     fn radial_return_lands_on_the_yield_surface() {
         let mu = 82.9e9;
@@ -211,9 +250,9 @@ mod tests {
         let axi: Axisymmetric = [1.2e9, -0.7e9, -0.5e9, 0.4e9];
         let (a, b) = (
             radial_return(&axi, sy, mu, hard),
-            radial_return(&lift(&axi), sy, mu, hard),
+            radial_return(&axi.to_full(), sy, mu, hard),
         );
-        assert_eq!(lift(&a.stress), b.stress);
+        assert_eq!(a.stress.to_full(), b.stress);
         assert_eq!(a.plastic_strain, b.plastic_strain);
         assert_eq!(a.plastic_work, b.plastic_work);
     }
@@ -226,7 +265,9 @@ mod tests {
         let d: Axisymmetric = [3e3, -5e3, 1e3, 2e3];
         let (omega, mu, dt) = (4e3, 40e9, 1e-8);
         let a = s.jaumann_trial(&d, &omega, mu, dt);
-        let b = lift(&s).jaumann_trial(&lift(&d), &[omega, 0.0, 0.0], mu, dt);
+        let b =
+            s.to_full()
+                .jaumann_trial(&d.to_full(), &Axisymmetric::spin_to_full(&omega), mu, dt);
         for c in 0..4 {
             assert!(
                 (a[c] - b[c]).abs() <= 1e-15 * s[c].abs().max(a[c].abs()),
