@@ -180,6 +180,11 @@ pub struct Mlpg3d {
     /// the Nanson normals).
     #[serde(default)]
     reference: Vec<[f64; 3]>,
+    /// `reference` at the last build of the operator (the test spheres'
+    /// Nanson normals are built from it, so a restored run rebuilds them
+    /// as they were).
+    #[serde(default)]
+    built_reference: Vec<[f64; 3]>,
     // Node fields (structure of arrays).
     pos: Vec<[f64; 3]>,
     vel: Vec<[f64; 3]>,
@@ -341,6 +346,7 @@ impl Mlpg3d {
             supports_at: pos.clone(),
             built_at: pos.clone(),
             reference: pos.clone(),
+            built_reference: pos.clone(),
             pos,
             lattice,
             geometry: None,
@@ -479,10 +485,10 @@ impl Mlpg3d {
         let n = pts.len();
         // F⁻¹ = ∂X/∂x at every node.
         let mut finv = vec![[[0.0; 3]; 3]; n];
-        shapes.velocity_gradients(&self.reference, &mut finv);
+        shapes.velocity_gradients(&self.built_reference, &mut finv);
         let surf = &self.lattice.surfaces;
         let contact = &self.contact;
-        let reference = &self.reference;
+        let reference = &self.built_reference;
         // Current outward normals of the boundary planes through each node:
         // (mantle, face or top), zero when absent.
         let normals: Vec<[[f64; 3]; 2]> = (0..n)
@@ -850,10 +856,12 @@ impl Mlpg3d {
         if pairs.recompute {
             self.supports_at.clone_from(&self.pos);
             self.built_at.clone_from(&self.pos);
+            self.built_reference.clone_from(&self.reference);
             self.build_geometry(true)?;
             clock = std::time::Instant::now();
         } else if pairs.strain > self.setup.rebuild_strain {
             self.built_at.clone_from(&self.pos);
+            self.built_reference.clone_from(&self.reference);
             self.build_geometry(false)?;
             clock = std::time::Instant::now();
         }
@@ -1148,6 +1156,7 @@ impl Mlpg3d {
             + b(&self.supports_at)
             + b(&self.built_at)
             + b(&self.reference)
+            + b(&self.built_reference)
             + b(&l.position)
             + b(&l.volume)
             + b(&l.surfaces)
@@ -1447,6 +1456,7 @@ impl Mlpg3d {
             ("support positions", &self.supports_at),
             ("build positions", &self.built_at),
             ("reference places", &self.reference),
+            ("reference places at the build", &self.built_reference),
         ];
         for (what, f) in vectors {
             if f.len() != n || !f.iter().flatten().all(|x| x.is_finite()) {
