@@ -322,7 +322,7 @@ fn explore_taylor3d_profile() {
 }
 
 /// The Wilkins copper bar in 3-D (`scenes/wilkins_copper_3d.toml`) at 3
-/// nodes across the radius (494 nodes) with node shifting `beta`, built
+/// nodes across the radius (399 nodes) with node shifting `beta`, built
 /// directly (its steps and fields are then at hand).
 fn coarse_wilkins(beta: f64) -> Mlpg3d {
     use meshless_impact::Taylor3dParams;
@@ -341,7 +341,7 @@ fn coarse_wilkins(beta: f64) -> Mlpg3d {
 
 /// Node shifting on the coarse Wilkins bar: without it the second layer is
 /// pressed onto the face and the run stops with `SpacingCollapse` (at
-/// 30 µs); with `shifting = 0.1` no pair closes below the guard, the bar
+/// 34.2 µs); with `shifting = 0.1` no pair closes below the guard, the bar
 /// comes to rest with no named stop, every node on the anvil stays on its
 /// plane (z = 0 exactly, after every step), none passes below it, and the
 /// energy balance holds within 5 %.
