@@ -30,6 +30,7 @@
 pub mod lattice;
 pub mod mls;
 pub mod profile;
+pub mod shift;
 pub mod solver;
 pub mod sphere;
 pub mod step;

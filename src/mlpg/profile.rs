@@ -16,6 +16,9 @@ pub enum Phase {
     Smoothing,
     /// Positions and the anvil (step 3).
     Move,
+    /// Node shifting and the carrying of the fields (step 3, with
+    /// `shifting > 0`).
+    Shift,
     /// The named pairs: the spacing check and the rules for recomputing
     /// the supports and rebuilding the operator (step 4).
     Pairs,
@@ -37,11 +40,12 @@ pub enum Phase {
 
 impl Phase {
     /// Every phase, in the order of the step.
-    pub const ALL: [Phase; 12] = [
+    pub const ALL: [Phase; 13] = [
         Phase::Force,
         Phase::Kick,
         Phase::Smoothing,
         Phase::Move,
+        Phase::Shift,
         Phase::Pairs,
         Phase::Supports,
         Phase::Shapes,
@@ -59,6 +63,7 @@ impl Phase {
             Phase::Kick => "velocity update",
             Phase::Smoothing => "velocity smoothing",
             Phase::Move => "positions",
+            Phase::Shift => "node shifting",
             Phase::Pairs => "spacing and rebuild checks",
             Phase::Supports => "supports (neighbour search)",
             Phase::Shapes => "MLS shapes at the nodes",
@@ -75,7 +80,7 @@ impl Phase {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PhaseTimes {
     /// Wall time of each phase, indexed as [`Phase::ALL`].
-    pub wall: [Duration; 12],
+    pub wall: [Duration; 13],
     /// Builds of the supports (the first included).
     pub supports: u64,
     /// Builds of the shapes, spheres and operator (the first included).

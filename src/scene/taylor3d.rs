@@ -86,6 +86,13 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(1.0e-4, 0.2),
         "relative motion of neighbours past which the MLPG shapes, test spheres and traction operator are rebuilt",
     ),
+    spec(
+        "shifting",
+        "1",
+        0.0,
+        Range::closed(0.0, 1.0),
+        "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the seed",
+    ),
     END_TIME,
 ];
 
@@ -94,7 +101,7 @@ choice_tables! {
     /// Parameters of the 3-D Taylor impact scene with Johnson-Cook and the
     /// linear EOS (the default; SI units): the `taylor` scene's names and
     /// defaults for the rod and its material, the resolution, and the MLPG
-    /// damping, smoothing and rebuild strain.
+    /// damping, smoothing, rebuild strain and node shifting.
     TAYLOR3D_PARAMS,
     /// The table with bilinear strength and the linear EOS.
     TAYLOR3D_BILINEAR_PARAMS,
@@ -140,7 +147,8 @@ param_struct! {
         impact_speed, initial_length, initial_diameter, density, shear_modulus,
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
         melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
-        particles_radial, damping, smoothing_coefficient, rebuild_strain, end_time,
+        particles_radial, damping, smoothing_coefficient, rebuild_strain, shifting,
+        end_time,
     }
 }
 
@@ -199,6 +207,7 @@ impl Taylor3dParams {
         s.damping = self.damping;
         s.rebuild_strain = self.rebuild_strain;
         s.smoothing = self.smoothing_coefficient;
+        s.shifting = self.shifting;
         s
     }
 
