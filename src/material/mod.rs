@@ -97,8 +97,8 @@ pub enum Strength {
 pub enum Damage {
     /// No damage: the state is left as it is.
     None,
-    /// The Rajendran-Grove ceramic (seed 004, section 4;
-    /// [`rajendran_grove`]): micro-cracks, pores and pulverization. Its
+    /// The Rajendran-Grove ceramic (seed 004, section 4; the module
+    /// `rajendran_grove`): micro-cracks, pores and pulverization. Its
     /// moduli fall with the crack density and its pressure depends on the
     /// porosity, so it owns the whole update of its points: its porous
     /// pressure (eqs. 16-18) stands in for the equation of state and its
@@ -298,7 +298,7 @@ impl Material {
     /// with its thermal constants. The equation-of-state and strength slots
     /// hold the intact dense matrix (linear pressure of bulk modulus
     /// `beta1` at the initial density, perfectly plastic at `C1`), for what
-    /// reads them outside the update; [`Material::update`] and
+    /// reads them outside the update; the update of a point and
     /// [`Material::longitudinal_modulus`] use the ceramic itself.
     pub fn ceramic(
         c: RajendranGrove,

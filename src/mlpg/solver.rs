@@ -130,10 +130,10 @@ pub struct RodSetup {
     /// α of the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
     /// after each velocity update ([`SMOOTHING`]).
     pub smoothing: f64,
-    /// β of the node shifting ([`super::shift`]; the `taylor` scene's
-    /// `shifting`): pairs closer than [`SHIFT_RANGE`] of the initial
+    /// β of the node shifting (`src/mlpg/shift.rs`; the `taylor` scene's
+    /// `shifting`): pairs closer than `SHIFT_RANGE` of the initial
     /// spacing push apart by up to β times the spacing per step
-    /// ([`SHIFT_CAP`] at most); 0 (the default): Lagrangian nodes.
+    /// (`SHIFT_CAP` at most); 0 (the default): Lagrangian nodes.
     #[serde(default)]
     pub shifting: f64,
 }
