@@ -424,3 +424,89 @@ fn a_shifting_run_restored_mid_way_resumes_to_the_bits() {
     assert_eq!(back.steps(), whole.steps());
     assert!(bits(&back) == bits(&whole), "the restored run differs");
 }
+
+/// Exploration: the face region of the Wilkins bar in 3-D
+/// (`scenes/wilkins_copper_3d.toml`, `MI_SET` overrides as in
+/// `explore_taylor3d_stop`): every 2.5 µs the nodes on the anvil (face and
+/// interior), the releases since the last line, the energy error and the
+/// spread, and the five fastest nodes of the face region with their
+/// height, surfaces, contact, pressure and plastic strain.
+#[test]
+#[ignore = "exploration"]
+fn explore_wilkins3d_face() {
+    use meshless_impact::Taylor3dParams;
+    let path = std::env::var("MI_SCENE_FILE").unwrap_or_else(|_| {
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml").into()
+    });
+    let mut scene = Scene::from_file(&path).unwrap();
+    for kv in std::env::var("MI_SET").unwrap_or_default().split(',') {
+        if let Some((k, v)) = kv.split_once('=') {
+            scene.set(k, v.parse().unwrap()).unwrap();
+        }
+    }
+    let material = scene
+        .kind()
+        .material()
+        .unwrap()
+        .material(meshless_impact::materials::Prefix::None, |n| scene.get(n))
+        .unwrap();
+    let mut s = Taylor3dParams::of(&scene).build_with(material).unwrap();
+    let mut next = 2.5e-6;
+    let mut releases = 0usize;
+    let mut recontacts = 0usize;
+    let mut before: Vec<bool> = s.in_contact().to_vec();
+    let err = loop {
+        if s.finished() {
+            break None;
+        }
+        if let Err(e) = s.step() {
+            break Some(e);
+        }
+        for (b, &c) in before.iter_mut().zip(s.in_contact()) {
+            if *b && !c {
+                releases += 1;
+            } else if !*b && c {
+                recontacts += 1;
+            }
+            *b = c;
+        }
+        if s.time() >= next {
+            next += 2.5e-6;
+            let surf = &s.lattice().surfaces;
+            let c = s.in_contact();
+            let face_on = (0..c.len())
+                .filter(|&i| c[i] && !surf[i].interior())
+                .count();
+            let inner_on = (0..c.len()).filter(|&i| c[i] && surf[i].interior()).count();
+            let e = s.energies();
+            println!(
+                "t {:.1} us: on anvil {face_on} surface + {inner_on} interior, releases {releases}, re-contacts {recontacts}, energy error {:.4}, spread {:.4}",
+                s.time() * 1e6,
+                e.error,
+                s.mushroom_radius_spread()
+            );
+            releases = 0;
+            recontacts = 0;
+            let (x, v) = (s.positions(), s.velocities());
+            let p = s.field("pressure").unwrap();
+            let eps = s.field("plastic_strain").unwrap();
+            let mut near: Vec<usize> = (0..x.len()).filter(|&i| x[i][2] < 2e-3).collect();
+            let speed = |i: usize| (v[i][0].powi(2) + v[i][1].powi(2) + v[i][2].powi(2)).sqrt();
+            near.sort_by(|&a, &b| speed(b).total_cmp(&speed(a)));
+            for &i in near.iter().take(5) {
+                println!(
+                    "   node {i}: z {:.3} mm r {:.3} mm (at impact z {:.3}), v {:?}, {:?}, contact {}, p {:.2} GPa, eps {:.2}",
+                    x[i][2] * 1e3,
+                    (x[i][0].powi(2) + x[i][1].powi(2)).sqrt() * 1e3,
+                    s.lattice().position[i][2] * 1e3,
+                    v[i].map(|a| (a * 10.0).round() / 10.0),
+                    surf[i],
+                    c[i],
+                    p[i] * 1e-9,
+                    eps[i]
+                );
+            }
+        }
+    };
+    println!("stop at {:.3} us: {err:?}", s.time() * 1e6);
+}
