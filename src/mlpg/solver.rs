@@ -1542,11 +1542,9 @@ mod tests {
     use crate::material::eos::LinearEos;
     use crate::material::{Damage, Eos, Strength};
 
-    /// A small plastic rod after some steps: its geometry rebuilt by the
-    /// fast operator build is the plain build's, bit for bit.
-    #[test]
-    fn the_operator_of_a_deformed_rod_is_the_plain_one() {
-        let material = Material {
+    /// 4340-like steel with bilinear hardening (yield 500 MPa, H = 1 GPa).
+    fn plastic_steel() -> Material {
+        Material {
             eos: Eos::Linear(LinearEos {
                 bulk_modulus: 169.1e9,
                 density: 7830.0,
@@ -1560,11 +1558,22 @@ mod tests {
             specific_heat: 460.0,
             taylor_quinney: 0.9,
             reference_temperature: 293.0,
-        };
-        let cyl = Cylinder {
+        }
+    }
+
+    /// A rod of radius 2 mm and length 10 mm.
+    fn small_rod() -> Cylinder {
+        Cylinder {
             radius: 2e-3,
             length: 10e-3,
-        };
+        }
+    }
+
+    /// A small plastic rod after some steps: its geometry rebuilt by the
+    /// fast operator build is the plain build's, bit for bit.
+    #[test]
+    fn the_operator_of_a_deformed_rod_is_the_plain_one() {
+        let (material, cyl) = (plastic_steel(), small_rod());
         let mut setup = RodSetup::new(cyl, 3, 300.0, 1e-3);
         setup.rebuild_strain = 1e-3;
         let mut s = Mlpg3d::new(setup, material).unwrap();
@@ -1594,25 +1603,7 @@ mod tests {
     /// the save.
     #[test]
     fn a_run_restored_after_a_release_rebuilds_the_spheres_of_the_last_build() {
-        let material = Material {
-            eos: Eos::Linear(LinearEos {
-                bulk_modulus: 169.1e9,
-                density: 7830.0,
-            }),
-            strength: Strength::Bilinear(Bilinear {
-                yield_stress: 500e6,
-                hardening_modulus: 1e9,
-            }),
-            damage: Damage::None,
-            shear_modulus: 82.9e9,
-            specific_heat: 460.0,
-            taylor_quinney: 0.9,
-            reference_temperature: 293.0,
-        };
-        let cyl = Cylinder {
-            radius: 2e-3,
-            length: 10e-3,
-        };
+        let (material, cyl) = (plastic_steel(), small_rod());
         let mut s = Mlpg3d::new(RodSetup::new(cyl, 3, 300.0, 1e-3), material).unwrap();
         while s.contact == s.built_contact {
             assert!(s.steps() < 2000, "no node left the anvil");
