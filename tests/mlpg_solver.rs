@@ -202,28 +202,38 @@ fn elastic_wave_speed_and_rebound() {
 /// The loop gives the same bits on one thread and on two.
 #[test]
 fn one_thread_and_two_give_the_same_bits() {
-    let run = |threads: usize| {
+    same_bits_on_one_thread_and_two(|| {
+        let mut setup = RodSetup::new(ROD, 3, 200.0, 1e-3);
+        setup.rebuild_strain = 1e-3;
+        let mut material = elastic();
+        material.strength = Strength::Bilinear(Bilinear {
+            yield_stress: 500e6,
+            hardening_modulus: 1e9,
+        });
+        let mut s = Mlpg3d::new(setup, material).unwrap();
+        for _ in 0..30 {
+            s.step().unwrap();
+        }
+        assert!(s.rebuilds() > 2, "the operator was rebuilt");
+        s
+    });
+}
+
+/// Runs `run` on a pool of one thread and on a pool of two, and asserts
+/// that the two runs end with the same positions, stresses and observables,
+/// bit for bit.
+fn same_bits_on_one_thread_and_two(run: impl Fn() -> Mlpg3d + Sync) {
+    let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
         pool.install(|| {
-            let mut setup = RodSetup::new(ROD, 3, 200.0, 1e-3);
-            setup.rebuild_strain = 1e-3;
-            let mut material = elastic();
-            material.strength = Strength::Bilinear(Bilinear {
-                yield_stress: 500e6,
-                hardening_modulus: 1e9,
-            });
-            let mut s = Mlpg3d::new(setup, material).unwrap();
-            for _ in 0..30 {
-                s.step().unwrap();
-            }
-            assert!(s.rebuilds() > 2, "the operator was rebuilt");
+            let s = run();
             (s.field("position"), s.field("stress"), s.observables())
         })
     };
-    let (a, b) = (run(1), run(2));
+    let (a, b) = (on(1), on(2));
     assert!(a == b, "the thread count changed the result");
 }
 
@@ -376,21 +386,13 @@ fn shifting_keeps_the_pairs_apart_that_collapse_without_it() {
 /// where nodes shift).
 #[test]
 fn shifting_gives_the_same_bits_on_one_thread_and_two() {
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut s = coarse_wilkins(0.1);
-            while s.time() < 35e-6 {
-                s.step().unwrap();
-            }
-            (s.field("position"), s.field("stress"), s.observables())
-        })
-    };
-    let (a, b) = (run(1), run(2));
-    assert!(a == b, "the thread count changed the result");
+    same_bits_on_one_thread_and_two(|| {
+        let mut s = coarse_wilkins(0.1);
+        while s.time() < 35e-6 {
+            s.step().unwrap();
+        }
+        s
+    });
 }
 
 /// A run with node shifting saved mid-way (the nodes shifting) and restored
