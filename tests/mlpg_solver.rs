@@ -2,9 +2,9 @@
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
-use meshless_impact::Scene;
 use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup};
 use meshless_impact::materials::{Bilinear, Damage, Eos, LinearEos, Material, Strength};
+use meshless_impact::{Scene, Taylor3dParams};
 
 /// House test 7's 4340 steel constants (Pa, kg/m³).
 const K: f64 = 169.1e9;
@@ -244,7 +244,6 @@ fn same_bits_on_one_thread_and_two(run: impl Fn() -> Mlpg3d + Sync) {
 #[test]
 #[ignore = "exploration"]
 fn explore_taylor3d_stop() {
-    use meshless_impact::Taylor3dParams;
     let mut s = match std::env::var("MI_SCENE_FILE") {
         Ok(path) => {
             let mut scene = Scene::from_file(&path).unwrap();
@@ -307,7 +306,6 @@ fn explore_taylor3d_stop() {
 #[test]
 #[ignore = "exploration"]
 fn explore_taylor3d_profile() {
-    use meshless_impact::Taylor3dParams;
     let across: f64 = std::env::var("PARTICLES_RADIAL")
         .map(|s| s.parse().unwrap())
         .unwrap_or(6.0);
@@ -335,18 +333,11 @@ fn explore_taylor3d_profile() {
 /// nodes across the radius (399 nodes) with node shifting `beta`, built
 /// directly (its steps and fields are then at hand).
 fn coarse_wilkins(beta: f64) -> Mlpg3d {
-    use meshless_impact::Taylor3dParams;
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml");
     let mut scene = Scene::from_file(path).unwrap();
     scene.set("particles_radial", 3.0).unwrap();
     scene.set("shifting", beta).unwrap();
-    let material = scene
-        .kind()
-        .material()
-        .unwrap()
-        .material(meshless_impact::materials::Prefix::None, |n| scene.get(n))
-        .unwrap();
-    Taylor3dParams::of(&scene).build_with(material).unwrap()
+    build3d(&scene)
 }
 
 /// Node shifting on the coarse Wilkins bar: without it the second layer is
@@ -436,7 +427,6 @@ fn a_shifting_run_restored_mid_way_resumes_to_the_bits() {
 #[test]
 #[ignore = "exploration"]
 fn explore_wilkins3d_face() {
-    use meshless_impact::Taylor3dParams;
     let path = std::env::var("MI_SCENE_FILE").unwrap_or_else(|_| {
         concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml").into()
     });
@@ -446,13 +436,7 @@ fn explore_wilkins3d_face() {
             scene.set(k, v.parse().unwrap()).unwrap();
         }
     }
-    let material = scene
-        .kind()
-        .material()
-        .unwrap()
-        .material(meshless_impact::materials::Prefix::None, |n| scene.get(n))
-        .unwrap();
-    let mut s = Taylor3dParams::of(&scene).build_with(material).unwrap();
+    let mut s = build3d(&scene);
     let mut next = 2.5e-6;
     let mut releases = 0usize;
     let mut recontacts = 0usize;
@@ -511,4 +495,15 @@ fn explore_wilkins3d_face() {
         }
     };
     println!("stop at {:.3} us: {err:?}", s.time() * 1e6);
+}
+
+/// The 3-D solver of a `taylor3d` scene, with the scene's material choice.
+fn build3d(scene: &Scene) -> Mlpg3d {
+    let material = scene
+        .kind()
+        .material()
+        .unwrap()
+        .material(meshless_impact::materials::Prefix::None, |n| scene.get(n))
+        .unwrap();
+    Taylor3dParams::of(scene).build_with(material).unwrap()
 }
