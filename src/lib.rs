@@ -103,9 +103,13 @@ pub use uniaxial::{Layer, PlateImpact};
 /// ([`Damage`](materials::Damage)); the models by name
 /// ([`MaterialChoice`](materials::MaterialChoice)) and the named materials
 /// ([`PRESETS`](materials::PRESETS)); the Rajendran-Grove ceramic at a
-/// material point, with its state ([`CeramicPoint`](materials::CeramicPoint)).
+/// material point, with its state ([`CeramicPoint`](materials::CeramicPoint)),
+/// and the parameter block of a ceramic plate
+/// ([`PLATE_CERAMIC`](materials::PLATE_CERAMIC),
+/// [`ceramic_material`](materials::ceramic_material)).
 pub mod materials {
     pub use crate::material::bilinear::Bilinear;
+    pub use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
     pub use crate::material::choice::{EosKind, MaterialChoice, Prefix, StrengthKind};
     pub use crate::material::eos::LinearEos;
     pub use crate::material::ideal_gas::IdealGas;

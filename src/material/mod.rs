@@ -14,6 +14,7 @@
 //! what the chosen models use, alone or under a body's prefix.
 
 pub mod bilinear;
+pub mod ceramic_block;
 pub mod choice;
 pub mod eos;
 pub mod ideal_gas;

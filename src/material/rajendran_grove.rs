@@ -118,8 +118,11 @@ pub struct RajendranGrove {
 }
 
 impl RajendranGrove {
-    /// AD85 alumina, seed 004 Table 1.
-    pub fn ad85() -> Self {
+    /// AD85 alumina, seed 004 Table 1 (with the reference strain rate of
+    /// eq. 22, 1/s, and pulverization at the crack density 0.75 of section
+    /// 4.3). A `const fn`, so that parameter tables take their defaults
+    /// from it ([`super::ceramic_block::PLATE_CERAMIC`]).
+    pub const fn ad85() -> Self {
         RajendranGrove {
             density: 3420.0,
             shear_modulus: 88e9,
