@@ -1,11 +1,12 @@
 //! Materials composed from parts, run in the Taylor solver: the bilinear
 //! strength model against its Johnson-Cook emulation on the Wilkins copper
-//! bar, and the Mie-Grüneisen equation of state.
+//! bar, the Mie-Grüneisen equation of state, and the Rajendran-Grove
+//! ceramic's damage variables in a saved state.
 
-use meshless_impact::TaylorParams;
 use meshless_impact::internals::TaylorSolver;
-use meshless_impact::materials::{Eos, Material, MieGruneisen};
-use meshless_impact::{Error, Scene, Simulation};
+use meshless_impact::materials::{Eos, Material, MieGruneisen, RajendranGrove};
+use meshless_impact::{Error, Model, Scene, Simulation, TaylorParams};
+use serde_json::Value;
 
 /// A scene file of `scenes/` at `particles_radial` across, as a user reads
 /// it (`--scene-file` with `--set particles_radial=N`).
@@ -140,4 +141,71 @@ fn inconsistent_materials_are_refused() {
         matches!(&err, Error::OutOfRange { name, .. } if name == "eos_c0"),
         "{err}"
     );
+}
+
+/// A rod of AD85 ceramic (the Wilkins bar's shape and speed, 227 m/s: past
+/// the ceramic's elastic limit at the face) saved mid-way, in JSON and in
+/// postcard, and restored resumes to the bits of the run that was not
+/// interrupted: its damage variables (elastic strain, crack radius,
+/// porosity) are part of the saved state, one per particle. A restored
+/// state whose damage variables are not one per particle, or that carries
+/// them for a material without damage, is refused.
+#[test]
+fn a_ceramic_rod_saves_and_restores_its_damage() {
+    let mut p = wilkins(5.0);
+    let ad85 = RajendranGrove::ad85();
+    p.density = ad85.density;
+    let m = Material::ceramic(ad85, 880.0, 1.0, p.initial_temperature);
+    let mut run = TaylorSolver::with_material(p, m).unwrap();
+    let fresh = TaylorSolver::with_material(p, m).unwrap();
+    for _ in 0..40 {
+        run.step().unwrap();
+    }
+    let saved = serde_json::to_value(&run).unwrap();
+    let damage = saved["material_state"].as_array().unwrap();
+    assert_eq!(damage.len(), run.particles());
+    // The face has compacted: its pores are no longer the initial 10%.
+    let least = damage
+        .iter()
+        .map(|d| d["porosity"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    assert!(least < 0.099, "{least}");
+    let from_json: TaylorSolver = serde_json::from_value(saved.clone()).unwrap();
+    let bytes = postcard::to_allocvec(&run).unwrap();
+    let from_postcard: TaylorSolver = postcard::from_bytes(&bytes).unwrap();
+    let mut ends = Vec::new();
+    for mut s in [run, from_json, from_postcard] {
+        Model::check_restored(&s, &fresh).unwrap();
+        for _ in 0..40 {
+            s.step().unwrap();
+        }
+        ends.push(serde_json::to_string(&s).unwrap());
+    }
+    assert_eq!(ends[0], ends[1], "restored from JSON");
+    assert_eq!(ends[0], ends[2], "restored from postcard");
+
+    // Forged: a particle's damage variables removed.
+    let refused = |state: &Value, fresh: &TaylorSolver| {
+        let s: TaylorSolver = serde_json::from_value(state.clone()).unwrap();
+        Model::check_restored(&s, fresh).unwrap_err()
+    };
+    let mut cut = saved.clone();
+    cut["material_state"].as_array_mut().unwrap().pop();
+    let n = fresh.particles();
+    assert_eq!(
+        refused(&cut, &fresh),
+        format!("it holds {} damage states for {n} particles", n - 1)
+    );
+    let mut nan = saved.clone();
+    nan["material_state"][3]["crack_size"] = (-1.0).into();
+    assert!(refused(&nan, &fresh).contains("damage variables"));
+    // Damage variables grafted onto a copper rod of the same shape.
+    let copper = wilkins(5.0);
+    let mut steel = TaylorSolver::new(copper).unwrap();
+    steel.step().unwrap();
+    let mut graft = serde_json::to_value(&steel).unwrap();
+    assert_eq!(graft["material_state"], Value::Null);
+    graft["material_state"] = saved["material_state"].clone();
+    let e = refused(&graft, &TaylorSolver::new(copper).unwrap());
+    assert!(e.contains("no damage model"), "{e}");
 }

@@ -5,13 +5,15 @@
 //! (4-component) and the 3-D (6-component) form alike.
 //!
 //! A solver keeps a [`MaterialState`] next to its material (per-particle
-//! state of the models: today the Johnson-Cook memo, later damage
-//! variables) and calls [`Material::update`] once per particle and step.
+//! state of the models: the Johnson-Cook memo, and the ceramic's damage
+//! variables, which it saves) and calls [`Material::update`] once per
+//! particle and step.
 //!
 //! A scene chooses the models by name ([`choice`]: `strength =
 //! "johnson_cook" | "bilinear"`, `eos = "linear" | "mie_gruneisen"`) or
 //! takes a named material ([`presets`]); its parameter table then lists only
-//! what the chosen models use, alone or under a body's prefix.
+//! what the chosen models use, alone or under a body's prefix. A plate of
+//! Rajendran-Grove ceramic takes its constants from [`ceramic_block`].
 
 pub mod bilinear;
 pub mod ceramic_block;
@@ -222,10 +224,17 @@ impl PointState {
 }
 
 /// Per-particle state of a material's models, owned next to the material:
-/// caches (rebuilt after a restore) and, for a material with damage, the
-/// damage variables, which are physical state. The solvers do not save this
-/// state yet, so no scene offers a material with damage until its solver
-/// saves and restores them.
+/// caches (the Johnson-Cook memo) and, for a material with damage, the
+/// damage variables, which are physical state.
+///
+/// **Saved form.** A solver saves this state with its run: serde writes
+/// only the damage variables, as `Option<Vec<Option<CeramicVars>>>`, one
+/// entry per particle (`None` for a point that has none yet), and writes
+/// `None` when no point has any (a run without damage: one byte in
+/// postcard, `null` in JSON). The caches are not saved; they come back
+/// empty and are rebuilt at the next step with the same bits. A restored
+/// state must be checked against the run's particle count
+/// ([`MaterialState::check_len`]).
 #[derive(Debug, Clone, Default)]
 pub struct MaterialState {
     points: Vec<PointState>,
@@ -240,6 +249,93 @@ impl MaterialState {
     /// The particles' states, to be cut into chunks.
     pub fn points_mut(&mut self) -> &mut [PointState] {
         &mut self.points
+    }
+
+    /// Whether some point holds damage variables.
+    pub fn has_damage(&self) -> bool {
+        self.points.iter().any(|p| p.damage.is_some())
+    }
+
+    /// Checks a restored state for a run of `n` particles (the message
+    /// says what is wrong): it holds no damage variables, or one entry per
+    /// particle, each finite and physical (porosity in [0, 1), a positive
+    /// crack radius, positive frozen moduli once pulverized). A state that
+    /// passes cannot leave a particle without its damage variables, give it
+    /// another's, or feed NaN into a step.
+    pub fn check_len(&self, n: usize) -> std::result::Result<(), String> {
+        if !self.has_damage() {
+            return Ok(());
+        }
+        let len = self.points.len();
+        if len != n {
+            return Err(format!("it holds {len} damage states for {n} particles"));
+        }
+        match self
+            .points
+            .iter()
+            .position(|p| p.damage.is_some_and(|v| !physical(&v)))
+        {
+            Some(i) => Err(format!(
+                "its damage variables are not all finite and in range (particle {i})"
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Whether the variables of a ceramic point are finite and physical.
+fn physical(v: &CeramicVars) -> bool {
+    v.elastic_strain.iter().all(|x| x.is_finite())
+        && v.crack_size.is_finite()
+        && v.crack_size > 0.0
+        && (0.0..1.0).contains(&v.porosity)
+        && v.pulverized.is_none_or(|p| {
+            p.bulk_modulus.is_finite()
+                && p.bulk_modulus > 0.0
+                && p.shear_modulus.is_finite()
+                && p.shear_modulus > 0.0
+                && p.volumetric_strain.is_finite()
+        })
+}
+
+/// The saved form: the damage variables only, `None` when no point has any.
+impl serde::Serialize for MaterialState {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        struct Damage<'a>(&'a [PointState]);
+        impl serde::Serialize for Damage<'_> {
+            fn serialize<S: serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> std::result::Result<S::Ok, S::Error> {
+                serializer.collect_seq(self.0.iter().map(|p| p.damage.as_ref()))
+            }
+        }
+        self.has_damage()
+            .then_some(Damage(&self.points))
+            .serialize(serializer)
+    }
+}
+
+/// Reads the saved form back: the damage variables, with empty caches (not
+/// yet checked: [`MaterialState::check_len`]).
+impl<'de> serde::Deserialize<'de> for MaterialState {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        let damage = Option::<Vec<Option<CeramicVars>>>::deserialize(deserializer)?;
+        Ok(MaterialState {
+            points: damage
+                .unwrap_or_default()
+                .into_iter()
+                .map(|damage| PointState {
+                    damage,
+                    ..PointState::default()
+                })
+                .collect(),
+        })
     }
 }
 
@@ -712,6 +808,146 @@ mod tests {
             steel.wave_modulus(7900.0, 1e8, &state),
             steel.longitudinal_modulus(7900.0, 1e8)
         );
+    }
+
+    /// Every bit of a point's damage variables.
+    fn damage_bits(p: &PointState) -> Option<Vec<u64>> {
+        p.ceramic().map(|v| {
+            let mut x = v.elastic_strain.to_vec();
+            x.extend([v.crack_size, v.porosity]);
+            if let Some(q) = v.pulverized {
+                x.extend([q.bulk_modulus, q.shear_modulus, q.volumetric_strain]);
+            }
+            x.iter().map(|f| f.to_bits()).collect()
+        })
+    }
+
+    /// The state of four ceramic points stepped along [`ceramic_path`] by
+    /// 100, 400 and 2550 steps (intact and elastic, compacted and sheared,
+    /// pulverized), the last never stepped.
+    fn ceramic_state() -> MaterialState {
+        let c = RajendranGrove::ad85();
+        let m = Material::ceramic(c, 750.0, 0.9, 293.0);
+        let mut state = MaterialState::default();
+        state.fit(4);
+        let dt = 1e-9;
+        let mut rho = c.density;
+        let mut point = unloaded([0.0; 6], 0.0);
+        let mut k = 0;
+        for (rate, spin, n) in ceramic_path() {
+            for _ in 0..n {
+                rho *= 1.0 - dt * (rate[0] + rate[1] + rate[2]);
+                let load = Loading::<Full> {
+                    dt,
+                    rate,
+                    spin,
+                    density: rho,
+                };
+                let mut step = state.points_mut()[0];
+                point = m.update(&load, &point, &mut step).unwrap();
+                state.points_mut()[0] = step;
+                k += 1;
+                match k {
+                    100 => state.points_mut()[1] = step,
+                    400 => state.points_mut()[2] = step,
+                    _ => {}
+                }
+            }
+        }
+        // Point 0 is the pulverized one; 3 has not stepped.
+        state
+    }
+
+    /// A state with ceramic points round-trips through postcard and JSON
+    /// with the same bits in every damage variable, a point without
+    /// variables stays without, and the caches come back empty; a state
+    /// without damage saves as the empty payload (one byte in postcard,
+    /// `null` in JSON).
+    #[test]
+    fn material_state_saves_only_the_damage() {
+        let state = ceramic_state();
+        let p = &state.points;
+        assert!(p[0].ceramic().unwrap().pulverized.is_some(), "{:?}", p[0]);
+        assert!(p[1].ceramic().unwrap().pulverized.is_none());
+        let c = RajendranGrove::ad85();
+        assert!(p[2].ceramic().unwrap().porosity < c.initial_porosity);
+        assert!(p[3].ceramic().is_none());
+        let bytes = postcard::to_allocvec(&state).unwrap();
+        let text = serde_json::to_string(&state).unwrap();
+        let from_postcard: MaterialState = postcard::from_bytes(&bytes).unwrap();
+        let from_json: MaterialState = serde_json::from_str(&text).unwrap();
+        for back in [&from_postcard, &from_json] {
+            assert_eq!(back.points.len(), 4);
+            for (a, b) in state.points.iter().zip(&back.points) {
+                assert_eq!(damage_bits(a), damage_bits(b));
+                assert!(b.memo.eps_p.is_nan() && b.memo.temp.is_nan());
+            }
+            back.check_len(4).unwrap();
+        }
+        // The payload: Some, four entries, the last None.
+        assert_eq!(bytes[..2], [1, 4]);
+        assert_eq!(*bytes.last().unwrap(), 0);
+        assert!(text.starts_with("[{\"elastic_strain\":") && text.ends_with(",null]"));
+
+        // Steel: the Johnson-Cook memo is filled, and not saved.
+        let m = steel(jc(), linear());
+        let mut steel_state = MaterialState::default();
+        steel_state.fit(3);
+        let load = Loading::<Full> {
+            dt: 1e-7,
+            rate: [0.0, 0.0, 0.0, 5e4, 0.0, 0.0],
+            spin: [0.0; 3],
+            density: 7850.0,
+        };
+        for s in steel_state.points_mut() {
+            m.update(&load, &unloaded([0.0; 6], 0.0), s).unwrap();
+            assert_eq!(s.memo.eps_p, 0.0);
+        }
+        assert!(!steel_state.has_damage());
+        assert_eq!(postcard::to_allocvec(&steel_state).unwrap(), [0]);
+        assert_eq!(serde_json::to_string(&steel_state).unwrap(), "null");
+        let back: MaterialState = postcard::from_bytes(&[0]).unwrap();
+        assert!(back.points.is_empty());
+        back.check_len(3).unwrap();
+    }
+
+    /// A restored state with damage variables for another number of
+    /// particles, or with variables out of range, is refused, saying what
+    /// is wrong.
+    #[test]
+    fn restored_material_state_is_checked() {
+        let state = ceramic_state();
+        state.check_len(4).unwrap();
+        let e = state.check_len(5).unwrap_err();
+        assert_eq!(e, "it holds 4 damage states for 5 particles");
+        assert!(state.check_len(3).is_err());
+        let forged = |edit: fn(&mut CeramicVars)| {
+            let mut s = state.clone();
+            edit(s.points[1].damage.as_mut().unwrap());
+            s.check_len(4)
+        };
+        type Edit = fn(&mut CeramicVars);
+        let edits: [Edit; 5] = [
+            |v| v.porosity = 1.0,
+            |v| v.porosity = -0.01,
+            |v| v.crack_size = 0.0,
+            |v| v.elastic_strain[4] = f64::NAN,
+            |v| {
+                v.pulverized = Some(rajendran_grove::Pulverized {
+                    bulk_modulus: 1e11,
+                    shear_modulus: 0.0,
+                    volumetric_strain: 0.0,
+                })
+            },
+        ];
+        for edit in edits {
+            let e = forged(edit).unwrap_err();
+            assert_eq!(
+                e,
+                "its damage variables are not all finite and in range (particle 1)"
+            );
+        }
+        assert!(forged(|v| v.porosity = 0.2).is_ok());
     }
 
     /// A ceramic material refuses a constant out of range by name, and

@@ -171,7 +171,7 @@ struct Geometry {
 pub struct Mlpg3d {
     setup: RodSetup,
     material: Material,
-    #[serde(skip)]
+    #[serde(default)]
     material_state: MaterialState,
     /// The reference lattice (positions at impact, volumes, surfaces, sets).
     lattice: NodeLattice,

@@ -43,7 +43,7 @@ use crate::isa::Isa;
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
 use crate::material::choice::{MaterialChoice, Prefix};
-use crate::material::{Loading, Material, MaterialState, Point};
+use crate::material::{Damage, Loading, Material, MaterialState, Point};
 use crate::neighbors::padded_rows;
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{self, RodSets};
@@ -80,9 +80,10 @@ pub const ENERGY_ERROR_BOUND: f64 = 0.5;
 pub struct TaylorSolver {
     p: TaylorParams,
     material: Material,
-    /// Per-particle state of the material's models (caches only today: not
-    /// saved, rebuilt after a restore).
-    #[serde(skip)]
+    /// Per-particle state of the material's models: its damage variables
+    /// are saved (none for a material without damage), its caches rebuilt
+    /// after a restore ([`MaterialState`]'s saved form).
+    #[serde(default)]
     material_state: MaterialState,
     nr: usize,
     nz: usize,
@@ -548,6 +549,10 @@ impl TaylorSolver {
                 return Err(format!("it holds {len} {what} for {n} particles"));
             }
         }
+        if self.material_state.has_damage() && matches!(self.material.damage, Damage::None) {
+            return Err("it holds damage variables, and its material has no damage model".into());
+        }
+        self.material_state.check_len(n)?;
         let finite = |what: &str, ok: bool| {
             if ok {
                 Ok(())
