@@ -363,3 +363,18 @@ pub fn write_pvd(path: &Path, snapshots: &[(f64, String)]) -> Result<()> {
     writeln!(f).map_err(|e| Error::io(path, e))?;
     f.flush().map_err(|e| Error::io(path, e))
 }
+
+observables! {
+    PENETRATION_OBSERVABLES, "Observables of the penetration scene (a projectile through a plate, 3-D MLPG), in output order.",
+    projectile_velocity: "m/s", "axial velocity of the projectile's centre of mass, positive in its direction of flight; its final value is the residual velocity";
+    projectile_length: "m", "extent of the projectile along the axis (highest minus lowest node)";
+    hole_radius: "m", "radius of the channel about the axis free of intact (not pulverized) plate material within the plate's original thickness; 0 before the plate is perforated";
+    damaged_fraction: "1", "mass fraction of the plate whose crack density has grown past 1% of its value at pulverization";
+    pulverized_fraction: "1", "mass fraction of the plate that is pulverized";
+    max_damage: "1", "largest crack density gamma = N0* a^3 in the plate";
+    kinetic_energy: "J", "kinetic energy of both bodies";
+    internal_energy: "J", "stress work stored and dissipated in both bodies' materials";
+    contact_dissipation: "J", "kinetic energy removed by the contact between the bodies (perfectly inelastic along the line of centres)";
+    smoothing_dissipation: "J", "kinetic energy removed by the velocity smoothing toward the MLS approximation";
+    energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
+}

@@ -94,3 +94,15 @@ pub fn run_cli_with_outputs(args: &[&str], dir: &std::path::Path, vtk_times: &st
     );
     o
 }
+
+/// Asserts that `run` gives the same result on one thread and on two.
+pub fn same_on_one_thread_and_two<T: PartialEq + Send>(run: impl Fn() -> T + Sync) {
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(&run)
+    };
+    assert!(on(1) == on(2), "the thread count changed the result");
+}

@@ -2,6 +2,8 @@
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
+mod common;
+
 use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup};
 use meshless_impact::materials::{Bilinear, Damage, Eos, LinearEos, Material, Strength};
 use meshless_impact::{Scene, Taylor3dParams};
@@ -223,18 +225,10 @@ fn one_thread_and_two_give_the_same_bits() {
 /// that the two runs end with the same positions, stresses and observables,
 /// bit for bit.
 fn same_bits_on_one_thread_and_two(run: impl Fn() -> Mlpg3d + Sync) {
-    let on = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let s = run();
-            (s.field("position"), s.field("stress"), s.observables())
-        })
-    };
-    let (a, b) = (on(1), on(2));
-    assert!(a == b, "the thread count changed the result");
+    common::same_on_one_thread_and_two(|| {
+        let s = run();
+        (s.field("position"), s.field("stress"), s.observables())
+    });
 }
 
 /// Exploration: `taylor3d` at its defaults but without the velocity

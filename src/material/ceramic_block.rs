@@ -50,7 +50,7 @@
 use super::Material;
 use super::rajendran_grove::RajendranGrove;
 use crate::error::{Error, Result};
-use crate::scene::params::{ParamSpec, Range};
+use crate::scene::params::{ParamSpec, Range, spec as row};
 
 /// AD85, the source of the defaults.
 const AD85: RajendranGrove = RajendranGrove::ad85();
@@ -58,23 +58,6 @@ const AD85: RajendranGrove = RajendranGrove::ad85();
 /// Specific heat of the default plate (J/(kg K)): engineering alumina (see
 /// the module documentation for the source).
 const ALUMINA_SPECIFIC_HEAT: f64 = 880.0;
-
-/// One row of the table.
-const fn row(
-    name: &'static str,
-    unit: &'static str,
-    default: f64,
-    range: Range,
-    description: &'static str,
-) -> ParamSpec {
-    ParamSpec {
-        name,
-        unit,
-        default,
-        range,
-        description,
-    }
-}
 
 /// Every parameter of a plate of Rajendran-Grove ceramic, under `plate_`:
 /// the model's constants in the order of seed 004's Table 1, then the

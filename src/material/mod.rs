@@ -552,6 +552,13 @@ impl Material {
     }
 }
 
+impl MaterialState {
+    /// The particles' states (empty before the first step).
+    pub fn points(&self) -> &[PointState] {
+        &self.points
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -460,8 +460,16 @@ impl RajendranGrove {
         let open = self.matrix_compression(load.density, f) < 0.0;
         let gs = self.release_rate(point.crack_size, f, p, &s, open);
         point.crack_size += self.growth_speed(gs, open) * load.dt;
-        let gamma = self.crack_density(point.crack_size);
+        let mut gamma = self.crack_density(point.crack_size);
         if gamma >= self.critical_damage {
+            // The step that crosses the critical density pulverizes the
+            // point at it (one step of crack growth near the Rayleigh
+            // speed can overshoot it many times over): the crack radius
+            // and the frozen moduli are those at γ = critical_damage.
+            point.crack_size = point
+                .crack_size
+                .min((self.critical_damage / self.flaw_density).cbrt());
+            gamma = gamma.min(self.critical_damage);
             let eta = self.matrix_compression(load.density, f);
             let (k, g) = self.effective_moduli(gamma, f, eta, p, &s);
             point.pulverized = Some(Pulverized {
@@ -987,6 +995,13 @@ mod tests {
             let p = path.point;
             let gs = m.release_rate(before.crack_size, 0.0, p.pressure, &p.deviator, true);
             let da = p.crack_size - before.crack_size;
+            if p.pulverized.is_some() {
+                // The step that reaches the critical density stops there.
+                let critical = (m.critical_damage / m.flaw_density).cbrt();
+                assert!(before.pulverized.is_none() && p.crack_size == critical);
+                assert!(da <= m.growth_speed(gs, true) * dt);
+                break;
+            }
             if gs <= m.critical_release_rate() {
                 assert_eq!(da, 0.0);
             } else {

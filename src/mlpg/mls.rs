@@ -128,6 +128,10 @@ pub struct Supports {
     pub named_distance: Vec<f64>,
     /// The parameters used.
     pub params: SupportParams,
+    /// The body of each node, for a run of several bodies (empty: one
+    /// body): a node names, and is covered by, nodes of its own body only,
+    /// so that the MLS fields of bodies in contact stay apart.
+    pub group: Vec<u8>,
 }
 
 impl Supports {
@@ -135,13 +139,38 @@ impl Supports {
     /// [`Error::OutOfRange`] for `neighbours < 3`, a factor ≤ 1 or fewer
     /// than `neighbours + 1` nodes.
     pub fn compute(points: &[[f64; 3]], params: SupportParams) -> Result<Self> {
+        Self::compute_grouped(points, &[], params)
+    }
+
+    /// The supports of nodes of several bodies: `group[i]` is the body of
+    /// node `i` (empty: one body), and every node names its `k` nearest of
+    /// its own body. Every body needs more than `k` nodes.
+    pub fn compute_grouped(
+        points: &[[f64; 3]],
+        group: &[u8],
+        params: SupportParams,
+    ) -> Result<Self> {
         let k = params.neighbours;
+        let same = |i: usize, j: usize| group.is_empty() || group[i] == group[j];
         if k < BASIS - 1 || k >= points.len() {
             return Err(Error::OutOfRange {
                 name: "support neighbours".into(),
                 value: k as f64,
                 range: format!("[{}, {}]", BASIS - 1, points.len().saturating_sub(1)),
             });
+        }
+        if !group.is_empty() {
+            let mut count = [0usize; 256];
+            for &g in group {
+                count[g as usize] += 1;
+            }
+            if group.len() != points.len() || group.iter().any(|&g| count[g as usize] <= k) {
+                return Err(Error::OutOfRange {
+                    name: "nodes of a body".into(),
+                    value: group.iter().map(|&g| count[g as usize]).min().unwrap_or(0) as f64,
+                    range: format!("[{}, inf)", k + 1),
+                });
+            }
         }
         if params.factor.is_nan() || params.factor <= 1.0 || !params.factor.is_finite() {
             return Err(Error::OutOfRange {
@@ -168,7 +197,7 @@ impl Supports {
         .max(1e-300);
         let list = loop {
             let list = cell_list(points, search);
-            if (0..points.len()).all(|i| list.of(i).len() > k) {
+            if (0..points.len()).all(|i| list.of(i).iter().filter(|&&j| same(i, j)).count() > k) {
                 break list;
             }
             search *= 2.0;
@@ -179,7 +208,7 @@ impl Supports {
                 let mut row: Vec<(f64, usize)> = list
                     .of(i)
                     .iter()
-                    .filter(|&&j| j != i)
+                    .filter(|&&j| j != i && same(i, j))
                     .map(|&j| (distance(&points[i], &points[j]), j))
                     .collect();
                 row.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -210,6 +239,7 @@ impl Supports {
             named,
             named_distance,
             params,
+            group: group.to_vec(),
         })
     }
 
@@ -642,8 +672,24 @@ fn norm1(m: &[[f64; BASIS]; BASIS]) -> f64 {
 /// Candidate nodes for points within `reach` of each node: the cell-list
 /// neighbours within `reach + max r_J`, a superset of the nodes whose
 /// supports cover any point within `reach` of the node.
+/// With several bodies ([`Supports::group`]) only the node's own body's.
 pub fn candidates(points: &[[f64; 3]], supports: &Supports, reach: f64) -> NeighborList {
-    cell_list(points, reach + supports.max_radius())
+    let list = cell_list(points, reach + supports.max_radius());
+    let g = &supports.group;
+    if g.is_empty() {
+        return list;
+    }
+    let mut out = NeighborList {
+        offsets: Vec::with_capacity(list.offsets.len()),
+        indices: Vec::with_capacity(list.indices.len()),
+    };
+    out.offsets.push(0);
+    for i in 0..list.len() {
+        out.indices
+            .extend(list.of(i).iter().copied().filter(|&j| g[j] == g[i]));
+        out.offsets.push(out.indices.len());
+    }
+    out
 }
 
 /// The shape functions and their gradients at the nodes themselves, in
@@ -924,5 +970,48 @@ pub(crate) mod tests {
         let stretched = scaled(1.24);
         let shapes = NodalShapes::build(&stretched, &sup).unwrap();
         assert!((0..pts.len()).all(|i| shapes.row(i).len() > p.neighbours));
+    }
+
+    /// Two bodies touching (a cube on a cube, one spacing apart): grouped
+    /// supports name and cover only nodes of the node's own body, each
+    /// body's supports are those it has alone, and a body with no more than
+    /// `k` nodes is refused by name.
+    #[test]
+    fn grouped_supports_keep_the_bodies_apart() {
+        let a = jittered_cube(5, 1.0, 0.2, 7);
+        let b: Vec<[f64; 3]> = jittered_cube(5, 1.0, 0.2, 8)
+            .iter()
+            .map(|x| [x[0], x[1], x[2] + 5.0])
+            .collect();
+        let pts: Vec<[f64; 3]> = a.iter().chain(&b).copied().collect();
+        let group: Vec<u8> = (0..pts.len()).map(|i| (i >= a.len()) as u8).collect();
+        let p = SupportParams::default();
+        let sup = Supports::compute_grouped(&pts, &group, p).unwrap();
+        let alone = Supports::compute(&a, p).unwrap();
+        for i in 0..a.len() {
+            assert_eq!(sup.named.of(i), alone.named.of(i));
+            assert_eq!(sup.radius[i], alone.radius[i]);
+        }
+        for i in 0..pts.len() {
+            assert!(sup.named.of(i).iter().all(|&j| group[j] == group[i]));
+        }
+        // Ungrouped, some node of one body names a node of the other.
+        let mixed = Supports::compute(&pts, p).unwrap();
+        assert!((0..pts.len()).any(|i| mixed.named.of(i).iter().any(|&j| group[j] != group[i])));
+        // The shapes at a node of the lower body use only its body's nodes,
+        // and reproduce a linear field there.
+        let shapes = NodalShapes::build(&pts, &sup).unwrap();
+        for i in 0..pts.len() {
+            let row = shapes.row(i);
+            assert!(row.clone().all(|q| group[shapes.nodes[q]] == group[i]));
+            let f: f64 = row
+                .map(|q| shapes.phi[q] * (2.0 * pts[shapes.nodes[q]][2] + 1.0))
+                .sum();
+            assert!((f - (2.0 * pts[i][2] + 1.0)).abs() < 1e-10, "{i}: {f}");
+        }
+        // A body of k nodes cannot name k others.
+        let few = &pts[..a.len() + p.neighbours];
+        let e = Supports::compute_grouped(few, &group[..few.len()], p).unwrap_err();
+        assert!(e.to_string().contains("nodes of a body"), "{e}");
     }
 }

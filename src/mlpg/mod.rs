@@ -27,8 +27,10 @@
 //! see [`sphere::ALPHA`]. The time loop with materials, the anvil contact
 //! and the scene are the solver's, built on these pieces.
 
+pub mod contact;
 pub mod lattice;
 pub mod mls;
+pub mod penetration;
 pub mod profile;
 pub mod shift;
 pub mod solver;
@@ -41,6 +43,6 @@ mod measure;
 
 pub use lattice::{Cylinder, NodeLattice};
 pub use mls::{NodalShapes, SupportParams, Supports};
-pub use solver::{Mlpg3d, RodSetup};
+pub use solver::{Body, Mlpg3d, RodSetup};
 pub use sphere::{SphereRule, TestSphere};
 pub use weak::TractionOperator;

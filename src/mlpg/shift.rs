@@ -30,6 +30,8 @@ pub enum Freedom {
     /// node would (the images of the other nodes are never closer to a node
     /// above the anvil than the nodes themselves, so they are left out).
     Free,
+    /// In any direction, in a run with no anvil (no image, no plane).
+    Unbounded,
 }
 
 /// The shift of each node: `beta D Σ_j (1 − r_ij / l)² e_ij` over the nodes
@@ -83,13 +85,14 @@ pub fn shifts(
                     d[k] -= dn * n[k];
                 }
             }
+            Freedom::Unbounded => {}
             Freedom::Fixed => unreachable!("returned above"),
         }
         let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         if len > cap {
             *d = d.map(|x| x * cap / len);
         }
-        if xi[2] + d[2] < 0.0 {
+        if free[i] != Freedom::Unbounded && xi[2] + d[2] < 0.0 {
             d[2] = -xi[2];
         }
     });

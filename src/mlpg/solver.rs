@@ -51,6 +51,7 @@
 //! (eq. 12) to its distance from the tangent planes of the boundary nodes
 //! it names.
 
+use super::contact;
 use super::lattice::{Cylinder, NodeLattice, Surfaces};
 use super::mls::{NodalShapes, SupportParams, Supports, distance};
 use super::profile::{Phase, PhaseTimes};
@@ -136,6 +137,10 @@ pub struct RodSetup {
     /// (`SHIFT_CAP` at most); 0 (the default): Lagrangian nodes.
     #[serde(default)]
     pub shifting: f64,
+    /// Height of the rod's face at impact (m): 0, on the anvil, for a
+    /// Taylor run; above the plate for a penetration run.
+    #[serde(default)]
+    pub base: f64,
 }
 
 impl RodSetup {
@@ -152,8 +157,26 @@ impl RodSetup {
             rebuild_strain: REBUILD_STRAIN,
             smoothing: SMOOTHING,
             shifting: 0.0,
+            base: 0.0,
         }
     }
+}
+
+/// A further body of a run of several bodies (the first is the rod of the
+/// [`RodSetup`]): a cylinder on the ring lattice with its face at
+/// `z = base`, moving along z at `velocity`, of its own material.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Body {
+    /// The cylinder (axis along z).
+    pub cylinder: Cylinder,
+    /// Rings across its radius.
+    pub rings: usize,
+    /// Height of its face, its lowest layer (m).
+    pub base: f64,
+    /// Velocity along z at the start (m/s).
+    pub velocity: f64,
+    /// Its material.
+    pub material: Material,
 }
 
 /// What follows from the positions at the last build: supports, nodal
@@ -173,8 +196,23 @@ pub struct Mlpg3d {
     material: Material,
     #[serde(default)]
     material_state: MaterialState,
-    /// The reference lattice (positions at impact, volumes, surfaces, sets).
+    /// The reference lattice (positions at impact, volumes, surfaces, sets):
+    /// the rod's nodes first, then those of each further body; the sets
+    /// are the rod's.
     lattice: NodeLattice,
+    /// The bodies after the rod (none for a Taylor run).
+    #[serde(default)]
+    others: Vec<Body>,
+    /// The body of each node (0: the rod), empty for a run of one body.
+    #[serde(default)]
+    group: Vec<u8>,
+    /// Whether the rigid anvil at z = 0 is there (a Taylor run).
+    #[serde(default = "anvil_default")]
+    anvil: bool,
+    /// Contact reach between the nodes of different bodies
+    /// ([`contact`]): the smallest radial spacing of the bodies (m).
+    #[serde(default)]
+    reach: f64,
     /// The place at impact of the material each node is on: the lattice
     /// position, carried along when the node shifts (the reference map of
     /// the Nanson normals).
@@ -278,6 +316,14 @@ struct Scratch {
     free: Vec<Freedom>,
     carried: Vec<[f64; CARRIED]>,
     carried_out: Vec<[f64; CARRIED]>,
+    /// The node pairs of different bodies in contact.
+    pairs: Vec<(usize, usize)>,
+    /// The velocities before the step's forces (runs of several bodies).
+    before: Vec<[f64; 3]>,
+}
+
+fn anvil_default() -> bool {
+    true
 }
 
 impl Scratch {
@@ -321,31 +367,93 @@ impl Mlpg3d {
     /// The rod of `setup` of `material` at the instant of impact: every
     /// node moving at `-impact_speed` along z, the face on the anvil.
     pub fn new(setup: RodSetup, material: Material) -> Result<Self> {
-        material.validate()?;
-        let density = material.eos.reference_density().ok_or_else(|| {
-            Error::Inconsistent("the rod's equation of state has no reference density".into())
-        })?;
-        let lattice = NodeLattice::cylinder(setup.cylinder, setup.rings);
+        Self::assemble(setup, material, Vec::new(), true)
+    }
+
+    /// A run of several bodies with no anvil: the rod of `setup` (its face
+    /// at `setup.base`, moving at `-impact_speed`) and the `others`, in
+    /// contact through [`contact`]. At most 255 bodies.
+    pub fn bodies(setup: RodSetup, material: Material, others: Vec<Body>) -> Result<Self> {
+        if others.len() > 254 {
+            return Err(Error::OutOfRange {
+                name: "bodies".into(),
+                value: others.len() as f64 + 1.0,
+                range: "[1, 255]".into(),
+            });
+        }
+        Self::assemble(setup, material, others, false)
+    }
+
+    fn assemble(
+        setup: RodSetup,
+        material: Material,
+        others: Vec<Body>,
+        anvil: bool,
+    ) -> Result<Self> {
+        let density_of = |m: &Material| {
+            m.validate()?;
+            m.eos.reference_density().ok_or_else(|| {
+                Error::Inconsistent("a body's equation of state has no reference density".into())
+            })
+        };
+        let density = density_of(&material)?;
+        let mut lattice = NodeLattice::cylinder(setup.cylinder, setup.rings);
+        if setup.base != 0.0 {
+            for x in &mut lattice.position {
+                x[2] += setup.base;
+            }
+        }
+        let v0 = setup.impact_speed;
+        let n0 = lattice.len();
+        let mut mass: Vec<f64> = lattice.volume.iter().map(|v| density * v).collect();
+        let mut vel = vec![[0.0, 0.0, -v0]; n0];
+        let mut rho = vec![density; n0];
+        let mut temp = vec![material.reference_temperature; n0];
+        let mut group = Vec::new();
+        let mut reach = lattice.radial_spacing;
+        if !others.is_empty() {
+            group = vec![0u8; n0];
+        }
+        for (b, body) in others.iter().enumerate() {
+            let d = density_of(&body.material)?;
+            let l = NodeLattice::cylinder(body.cylinder, body.rings);
+            reach = reach.min(l.radial_spacing);
+            let k = l.len();
+            lattice
+                .position
+                .extend(l.position.iter().map(|x| [x[0], x[1], x[2] + body.base]));
+            lattice.volume.extend_from_slice(&l.volume);
+            lattice.surfaces.extend_from_slice(&l.surfaces);
+            mass.extend(l.volume.iter().map(|v| d * v));
+            vel.extend(std::iter::repeat_n([0.0, 0.0, body.velocity], k));
+            rho.extend(std::iter::repeat_n(d, k));
+            temp.extend(std::iter::repeat_n(body.material.reference_temperature, k));
+            group.extend(std::iter::repeat_n(b as u8 + 1, k));
+        }
         let n = lattice.len();
         let pos = lattice.position.clone();
-        let mass: Vec<f64> = lattice.volume.iter().map(|v| density * v).collect();
-        let total: f64 = mass.iter().sum();
-        let v0 = setup.impact_speed;
+        // One body: its impact energy as it always was (the same bits).
+        let initial_energy = if others.is_empty() {
+            0.5 * mass.iter().sum::<f64>() * v0 * v0
+        } else {
+            kinetic(&vel, &mass)
+        };
         let contact: Vec<bool> = lattice
             .surfaces
             .iter()
-            .map(|s| s.has(Surfaces::FACE))
+            .enumerate()
+            .map(|(i, s)| anvil && i < n0 && s.has(Surfaces::FACE))
             .collect();
         let mut s = Mlpg3d {
             material,
             material_state: MaterialState::default(),
-            vel: vec![[0.0, 0.0, -v0]; n],
+            vel,
             mass,
-            rho: vec![density; n],
+            rho,
             dev: vec![[0.0; 6]; n],
             pressure: vec![0.0; n],
             eps_p: vec![0.0; n],
-            temp: vec![material.reference_temperature; n],
+            temp,
             visc: vec![[0.0; 6]; n],
             built_contact: contact.clone(),
             contact,
@@ -355,6 +463,10 @@ impl Mlpg3d {
             built_reference: pos.clone(),
             pos,
             lattice,
+            others,
+            group,
+            anvil,
+            reach,
             geometry: None,
             time: 0.0,
             steps: 0,
@@ -363,7 +475,7 @@ impl Mlpg3d {
             damping_time: 0.0,
             d_min0: 0.0,
             min_spacing: 1.0,
-            initial_energy: 0.5 * total * v0 * v0,
+            initial_energy,
             internal_energy: 0.0,
             plastic_work: 0.0,
             damping_dissipation: 0.0,
@@ -397,14 +509,23 @@ impl Mlpg3d {
         stable_step(c, d, self.setup.safety) * ((1.0 + z * z).sqrt() - z)
     }
 
-    /// Longitudinal elastic wave speed of the reference state (m/s).
+    /// Longitudinal elastic wave speed of the reference state (m/s), the
+    /// fastest of the bodies'.
     pub fn wave_speed(&self) -> f64 {
-        let rho = self.rho0();
-        (self.material.longitudinal_modulus(rho, 0.0) / rho).sqrt()
+        let speed = |m: &Material| {
+            let rho = m.eos.reference_density().unwrap_or(self.rho[0]);
+            (m.longitudinal_modulus(rho, 0.0) / rho).sqrt()
+        };
+        self.others
+            .iter()
+            .map(|b| speed(&b.material))
+            .fold(speed(&self.material), f64::max)
     }
 
-    fn rho0(&self) -> f64 {
-        self.material.eos.reference_density().unwrap_or(self.rho[0])
+    /// The material of node `i`.
+    #[inline]
+    fn material_of(&self, i: usize) -> &Material {
+        material_of(&self.material, &self.others, &self.group, i)
     }
 
     /// The smallest current distance between a node and one it names.
@@ -456,8 +577,9 @@ impl Mlpg3d {
         g.shapes = NodalShapes::default();
         g.op = TractionOperator::default();
         if supports || g.supports.is_none() {
-            g.supports = Some(Supports::compute(
+            g.supports = Some(Supports::compute_grouped(
                 &self.supports_at,
+                &self.group,
                 SupportParams::default(),
             )?);
             self.profile.supports += 1;
@@ -739,6 +861,9 @@ impl Mlpg3d {
         g.op.apply(total, force);
         self.profile.lap(Phase::Force, &mut clock);
         // 2-3. Velocities, contact, positions.
+        if !self.group.is_empty() {
+            scratch.before.clone_from(&self.vel);
+        }
         let d0 = self.d_min0;
         let (volume, rho, mass) = (&g.op.volume, &self.rho, &self.mass);
         let kicked = &mut scratch.kicked;
@@ -799,6 +924,18 @@ impl Mlpg3d {
             self.smoothing_dissipation += before - kinetic(&self.vel, mass);
         }
         self.profile.lap(Phase::Smoothing, &mut clock);
+        // Contact between the bodies.
+        if !self.group.is_empty() {
+            contact::pairs(&self.pos, &self.group, self.reach, &mut scratch.pairs);
+            self.contact_dissipation += contact::resolve(
+                &scratch.pairs,
+                &self.pos,
+                &self.mass,
+                &scratch.before,
+                &mut self.vel,
+            );
+        }
+        let anvil = self.anvil;
         let moved = &mut scratch.moved;
         self.vel
             .par_iter_mut()
@@ -813,7 +950,7 @@ impl Mlpg3d {
                     x[d] += dt * v[d];
                 }
                 let mut lost = 0.0;
-                if !*touch && x[2] < 0.0 {
+                if anvil && !*touch && x[2] < 0.0 {
                     if x[2] < -0.5 * d0 {
                         through = Some(x[2]);
                     }
@@ -878,7 +1015,7 @@ impl Mlpg3d {
         let grad = &mut scratch.grad;
         g.shapes.velocity_gradients(&self.vel, grad);
         self.profile.lap(Phase::Gradients, &mut clock);
-        let material = self.material;
+        let (rod_material, others, group) = (&self.material, &self.others, &self.group);
         let c = self.damping_time;
         let (mass, vel) = (&self.mass, &self.vel);
         let results = &mut scratch.results;
@@ -895,6 +1032,7 @@ impl Mlpg3d {
             .for_each(
                 |(i, (((((((dev, p), eps), temp), rho), visc), state), out))| {
                     *out = (|| {
+                        let material = material_of(rod_material, others, group, i);
                         let l = &grad[i];
                         let d = |a: usize, b: usize| 0.5 * (l[a][b] + l[b][a]);
                         let w = |a: usize, b: usize| 0.5 * (l[a][b] - l[b][a]);
@@ -948,7 +1086,7 @@ impl Mlpg3d {
                             kinetic: kinetic1(vel[i], mass[i]),
                             momentum: mass[i] * vel[i][2],
                             mass: mass[i],
-                            worst_speed: (material.longitudinal_modulus(rho_new, new.pressure)
+                            worst_speed: (material.wave_modulus(rho_new, new.pressure, state)
                                 / rho_new)
                                 .sqrt()
                                 + norm(vel[i]),
@@ -1025,10 +1163,12 @@ impl Mlpg3d {
         self.dt = self.stable_dt(t.worst_speed, d_min);
         check_time_step(self.dt, self.dt0, self.time)?;
         let touching = self.contact.iter().any(|&c| c);
-        if -t.momentum / t.mass <= 0.0 && !touching {
+        if self.anvil && -t.momentum / t.mass <= 0.0 && !touching {
             self.at_rest = true;
         }
-        if t.kinetic <= QUIET_FRACTION * self.initial_energy {
+        if !self.anvil {
+            // A run of several bodies ends at its end time.
+        } else if t.kinetic <= QUIET_FRACTION * self.initial_energy {
             let since = *self.quiet_since.get_or_insert(self.time);
             let window = QUIET_TRANSITS * self.setup.cylinder.length / self.wave_speed();
             if self.time - since >= window {
@@ -1054,9 +1194,11 @@ impl Mlpg3d {
     fn shift(&mut self, scratch: &mut Scratch) -> Result<()> {
         let spacing = self.d_min0;
         let g = self.geometry.as_ref().expect("built before the step");
-        let (surf, contact) = (&self.lattice.surfaces, &self.contact);
+        let (surf, contact, anvil) = (&self.lattice.surfaces, &self.contact, self.anvil);
         scratch.free.par_iter_mut().enumerate().for_each(|(i, f)| {
-            *f = if !surf[i].interior() {
+            *f = if !anvil {
+                Freedom::Unbounded
+            } else if !surf[i].interior() {
                 Freedom::Fixed
             } else if contact[i] {
                 Freedom::InPlane([0.0, 0.0, 1.0])
@@ -1121,7 +1263,7 @@ impl Mlpg3d {
             self.temp[i] = f[11];
             self.reference[i] = [f[12], f[13], f[14]];
             self.pressure[i] =
-                self.material
+                self.material_of(i)
                     .pressure(f[9], f[11])
                     .map_err(|l| Error::CompressionLimit {
                         particle: i,
@@ -1312,6 +1454,27 @@ impl Mlpg3d {
     pub fn material(&self) -> &Material {
         &self.material
     }
+
+    /// The bodies after the rod (none for a Taylor run).
+    pub fn others(&self) -> &[Body] {
+        &self.others
+    }
+
+    /// The body of each node (0: the rod); empty for a run of one body.
+    pub fn group(&self) -> &[u8] {
+        &self.group
+    }
+
+    /// The material state of each node (its damage variables; empty before
+    /// the first step).
+    pub fn material_points(&self) -> &[crate::material::PointState] {
+        self.material_state.points()
+    }
+
+    /// The contact reach between the bodies (m; [`contact`]).
+    pub fn contact_reach(&self) -> f64 {
+        self.reach
+    }
 }
 
 /// The energies of a run (J) and its relative energy error.
@@ -1356,6 +1519,15 @@ fn with_time(e: Error, time: f64) -> Error {
             limit,
         },
         e => e,
+    }
+}
+
+/// The material of node `i`: the rod's, or that of its body in `others`.
+#[inline]
+fn material_of<'a>(rod: &'a Material, others: &'a [Body], group: &[u8], i: usize) -> &'a Material {
+    match group.get(i) {
+        Some(&g) if g > 0 => &others[g as usize - 1].material,
+        _ => rod,
     }
 }
 
@@ -1447,6 +1619,7 @@ impl Mlpg3d {
             json(&(
                 &s.setup,
                 &s.material,
+                (&s.others, &s.group, s.anvil, s.reach),
                 &s.lattice,
                 &s.mass,
                 s.dt0,
@@ -1493,6 +1666,13 @@ impl Mlpg3d {
         if self.contact.len() != n || self.built_contact.len() != n {
             return Err(format!("its contact flags are not {n}"));
         }
+        let damaging = std::iter::once(&self.material)
+            .chain(self.others.iter().map(|b| &b.material))
+            .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)));
+        if damaging && self.steps > 0 && !self.material_state.has_damage() {
+            return Err("its damage variables are missing".into());
+        }
+        self.material_state.check_len(n)?;
         crate::solver::check_restored_clock(
             self.time,
             self.dt,

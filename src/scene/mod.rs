@@ -4,6 +4,7 @@
 
 pub mod noh;
 pub mod params;
+pub mod penetration;
 pub mod registry;
 pub mod table1;
 pub mod taylor;
@@ -593,7 +594,7 @@ mod tests {
                     let msg = e.to_string();
                     assert!(
                         msg.starts_with(&format!(
-                            "unknown scene `{name}`; allowed: taylor, noh, taylor3d, table1-1,"
+                            "unknown scene `{name}`; allowed: taylor, noh, taylor3d, penetration, table1-1,"
                         )),
                         "{msg}"
                     );
@@ -615,7 +616,11 @@ mod tests {
                     scene,
                     Scene::default_of(SceneKind::named("taylor3d").unwrap())
                 ),
-                3..15 => assert_eq!(scene, rows[k - 3].scene(), "{name}"),
+                3 => assert_eq!(
+                    scene,
+                    Scene::default_of(SceneKind::named("penetration").unwrap())
+                ),
+                4..16 => assert_eq!(scene, rows[k - 4].scene(), "{name}"),
                 _ => {
                     assert_eq!(name, "taylor3d-aisi310");
                     assert_eq!(scene.kind().name(), "taylor3d");
@@ -624,7 +629,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(builtin_names().len(), 16);
+        assert_eq!(builtin_names().len(), 17);
     }
 
     /// A `[material]` table chooses the models; the table then lists only

@@ -114,6 +114,47 @@ impl ParamSpec {
     }
 }
 
+/// One row of a parameter table.
+pub const fn spec(
+    name: &'static str,
+    unit: &'static str,
+    default: f64,
+    range: Range,
+    description: &'static str,
+) -> ParamSpec {
+    ParamSpec {
+        name,
+        unit,
+        default,
+        range,
+        description,
+    }
+}
+
+/// The tables `parts` one after the other, at compile time; `N` is their
+/// total length (a wrong `N` stops the build).
+pub const fn concat<const N: usize>(parts: &[&[ParamSpec]]) -> [ParamSpec; N] {
+    let mut out = [ParamSpec {
+        name: "",
+        unit: "",
+        default: 0.0,
+        range: Range::closed(0.0, 0.0),
+        description: "",
+    }; N];
+    let (mut k, mut p) = (0, 0);
+    while p < parts.len() {
+        let mut i = 0;
+        while i < parts[p].len() {
+            out[k] = parts[p][i];
+            k += 1;
+            i += 1;
+        }
+        p += 1;
+    }
+    assert!(k == N, "the parts do not add up to N rows");
+    out
+}
+
 /// Declares a parameter struct together with its table, `Default`, and
 /// name-based access, so that the three can never disagree.
 macro_rules! param_table {

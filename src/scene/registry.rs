@@ -95,7 +95,12 @@ pub fn fmus() -> Vec<(SceneKind, FmuIdentity)> {
 }
 
 /// Every kind of scene, in the order they are listed.
-pub static SCENES: &[&SceneRow] = &[&super::taylor::ROW, &super::noh::ROW, &super::taylor3d::ROW];
+pub static SCENES: &[&SceneRow] = &[
+    &super::taylor::ROW,
+    &super::noh::ROW,
+    &super::taylor3d::ROW,
+    &super::penetration::ROW,
+];
 
 /// The row called `name`.
 pub fn row(name: &str) -> Result<&'static SceneRow> {

@@ -161,21 +161,7 @@ pub(super) const END_TIME: ParamSpec = spec(
     "latest simulated time; the run normally ends earlier, when the rod is at rest",
 );
 
-pub(super) const fn spec(
-    name: &'static str,
-    unit: &'static str,
-    default: f64,
-    range: Range,
-    description: &'static str,
-) -> ParamSpec {
-    ParamSpec {
-        name,
-        unit,
-        default,
-        range,
-        description,
-    }
-}
+pub(super) use super::params::spec;
 
 choice_tables! {
     BEFORE, AFTER, params_of;

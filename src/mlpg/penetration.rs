@@ -1,0 +1,330 @@
+//! Ballistic penetration by the 3-D MLPG mixed method (seed 004, section
+//! 5.2): a cylindrical projectile striking a circular plate normally, both
+//! on the ring lattice, in contact through [`super::contact`], the plate
+//! free at its rim.
+//!
+//! # The bodies
+//!
+//! The projectile (body 0, the rod of [`RodSetup`]) has `rings` rings
+//! across its radius, spacing `Δ = R_p / rings`; the plate (body 1) has
+//! `round(R_plate / Δ)` rings, so that both have the spacing `Δ` when the
+//! radii are in a whole ratio (the seed's 5 and 40 mm are), and its rings
+//! lie under the projectile's. The plate occupies `−h ≤ z ≤ 0`; the
+//! projectile's face starts one contact reach above it (the nodes of the
+//! two surfaces then just touch, [`super::contact`]), moving at
+//! `−impact_speed`. No anvil. The run ends at its end time.
+
+use super::lattice::Cylinder;
+use super::solver::{Body, Energies, MLPG_FIELDS, Mlpg3d, RodSetup};
+use crate::error::Result;
+use crate::material::Damage;
+use crate::material::Material;
+use crate::material::rajendran_grove::RajendranGrove;
+use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
+
+/// Fraction of the crack density at pulverization past which a plate node
+/// counts as damaged (`damaged_fraction`).
+pub const DAMAGED_AT: f64 = 0.01;
+
+/// The geometry and resolution of a penetration run.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PenetrationSetup {
+    /// The projectile (m).
+    pub projectile: Cylinder,
+    /// The plate: its radius and thickness (m).
+    pub plate: Cylinder,
+    /// Speed of the projectile toward the plate (m/s).
+    pub impact_speed: f64,
+    /// Rings across the projectile's radius.
+    pub rings: usize,
+    /// Latest simulated time (s).
+    pub end_time: f64,
+}
+
+/// A penetration run: the two-body MLPG run and what its observables need.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct Penetration {
+    setup: PenetrationSetup,
+    run: Mlpg3d,
+}
+
+impl Penetration {
+    /// The projectile of `projectile` material over the plate of `plate`
+    /// material at the instant of impact; `numerics` gives the solver's
+    /// choices (damping, smoothing, safety, rebuild strain, shifting).
+    pub fn new(
+        setup: PenetrationSetup,
+        projectile: Material,
+        plate: Material,
+        numerics: RodSetup,
+    ) -> Result<Self> {
+        let rings = setup.rings.max(1);
+        let spacing = setup.projectile.radius / rings as f64;
+        let plate_rings = ((setup.plate.radius / spacing).round() as usize).max(1);
+        let reach = spacing.min(setup.plate.radius / plate_rings as f64);
+        let mut rod = RodSetup::new(setup.projectile, rings, setup.impact_speed, setup.end_time);
+        rod.damping = numerics.damping;
+        rod.safety = numerics.safety;
+        rod.rebuild_strain = numerics.rebuild_strain;
+        rod.smoothing = numerics.smoothing;
+        rod.shifting = numerics.shifting;
+        rod.base = reach;
+        let plate_body = Body {
+            cylinder: setup.plate,
+            rings: plate_rings,
+            base: -setup.plate.length,
+            velocity: 0.0,
+            material: plate,
+        };
+        let run = Mlpg3d::bodies(rod, projectile, vec![plate_body])?;
+        Ok(Penetration { setup, run })
+    }
+
+    /// The two-body run.
+    pub fn run(&self) -> &Mlpg3d {
+        &self.run
+    }
+
+    /// The setup.
+    pub fn setup(&self) -> &PenetrationSetup {
+        &self.setup
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.run.time()
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.run.steps()
+    }
+
+    /// Nodes of both bodies.
+    pub fn particles(&self) -> usize {
+        self.run.particles()
+    }
+
+    /// Whether the end time is reached.
+    pub fn finished(&self) -> bool {
+        self.run.finished()
+    }
+
+    /// One step.
+    pub fn step(&mut self) -> Result<()> {
+        self.run.step()
+    }
+
+    /// The energies of both bodies.
+    pub fn energies(&self) -> Energies {
+        self.run.energies()
+    }
+
+    /// The nodes of body `b` (0: projectile, 1: plate).
+    fn nodes(&self, b: u8) -> impl Iterator<Item = usize> + '_ {
+        self.run
+            .group()
+            .iter()
+            .enumerate()
+            .filter(move |(_, g)| **g == b)
+            .map(|(i, _)| i)
+    }
+
+    /// Axial velocity of the projectile's centre of mass, positive in its
+    /// direction of flight (m/s).
+    pub fn projectile_velocity(&self) -> f64 {
+        let (m, v) = (self.run.masses(), self.run.velocities());
+        let (mut p, mut total) = (0.0, 0.0);
+        for i in self.nodes(0) {
+            p += m[i] * v[i][2];
+            total += m[i];
+        }
+        -p / total
+    }
+
+    /// Extent of the projectile along the axis (m).
+    pub fn projectile_length(&self) -> f64 {
+        let x = self.run.positions();
+        let (lo, hi) = self
+            .nodes(0)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), i| {
+                (lo.min(x[i][2]), hi.max(x[i][2]))
+            });
+        hi - lo
+    }
+
+    /// The plate's ceramic, if it is one.
+    fn ceramic(&self) -> Option<&RajendranGrove> {
+        match &self.run.others()[0].material.damage {
+            Damage::RajendranGrove(c) => Some(c),
+            Damage::None => None,
+        }
+    }
+
+    /// Crack density and pulverization of each plate node, with its mass:
+    /// `(γ, pulverized, mass)`; γ = 0 for a plate without damage.
+    fn plate_damage(&self) -> Vec<(f64, bool, f64)> {
+        let points = self.run.material_points();
+        let m = self.run.masses();
+        let c = self.ceramic();
+        self.nodes(1)
+            .map(|i| {
+                let vars = points.get(i).and_then(|p| p.ceramic());
+                match (c, vars) {
+                    (Some(c), Some(v)) => {
+                        (c.crack_density(v.crack_size), v.pulverized.is_some(), m[i])
+                    }
+                    (Some(c), None) => (c.crack_density(c.initial_crack_size), false, m[i]),
+                    _ => (0.0, false, m[i]),
+                }
+            })
+            .collect()
+    }
+
+    /// Radius of the channel about the axis free of intact plate material
+    /// within the plate's original thickness (m): the smallest distance
+    /// from the axis of a plate node there that is not pulverized.
+    pub fn hole_radius(&self) -> f64 {
+        let x = self.run.positions();
+        let h = self.setup.plate.length;
+        let points = self.run.material_points();
+        self.nodes(1)
+            .filter(|&i| x[i][2] >= -h && x[i][2] <= 0.0)
+            .filter(|&i| {
+                points
+                    .get(i)
+                    .and_then(|p| p.ceramic())
+                    .is_none_or(|v| v.pulverized.is_none())
+            })
+            .map(|i| (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt())
+            .fold(f64::INFINITY, f64::min)
+            .min(self.setup.plate.radius)
+    }
+
+    /// `(damaged_fraction, pulverized_fraction, max_damage)` of the plate.
+    pub fn damage(&self) -> (f64, f64, f64) {
+        let critical = self.ceramic().map_or(f64::INFINITY, |c| c.critical_damage);
+        let (mut damaged, mut pulverized, mut total, mut max) = (0.0, 0.0, 0.0, 0.0f64);
+        for (g, p, m) in self.plate_damage() {
+            total += m;
+            if g >= DAMAGED_AT * critical {
+                damaged += m;
+            }
+            if p {
+                pulverized += m;
+            }
+            max = max.max(g);
+        }
+        (damaged / total, pulverized / total, max)
+    }
+
+    /// Current values of [`PENETRATION_OBSERVABLES`], in that order.
+    pub fn observables(&self) -> Vec<f64> {
+        let e = self.energies();
+        let (damaged, pulverized, max) = self.damage();
+        let values = vec![
+            self.projectile_velocity(),
+            self.projectile_length(),
+            self.hole_radius(),
+            damaged,
+            pulverized,
+            max,
+            e.kinetic,
+            e.internal,
+            e.contact,
+            e.smoothing,
+            e.error,
+        ];
+        debug_assert_eq!(values.len(), PENETRATION_OBSERVABLES.len());
+        values
+    }
+
+    /// The node field `name` (one of [`PENETRATION_FIELDS`]).
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        let n = self.particles();
+        let damage = || {
+            let points = self.run.material_points();
+            let c = self.ceramic();
+            (0..n).map(move |i| {
+                let vars = points.get(i).and_then(|p| p.ceramic());
+                (c, vars, self.run.group()[i])
+            })
+        };
+        Some(match name {
+            "body" => self.run.group().iter().map(|&g| g as f64).collect(),
+            "mass" => self.run.masses().to_vec(),
+            "damage" => damage()
+                .map(|(c, v, g)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => c.crack_density(v.crack_size),
+                    _ => 0.0,
+                })
+                .collect(),
+            "pulverized" => damage()
+                .map(|(_, v, _)| v.is_some_and(|v| v.pulverized.is_some()) as u8 as f64)
+                .collect(),
+            "porosity" => damage()
+                .map(|(_, v, _)| v.map_or(0.0, |v| v.porosity))
+                .collect(),
+            _ => return self.run.field(name),
+        })
+    }
+}
+
+/// The node fields of a penetration run: those of the 3-D solver, then the
+/// body of each node (0 projectile, 1 plate), the crack density γ, the
+/// pulverized flag, the porosity and the node mass.
+pub const PENETRATION_FIELDS: &[FieldSpec] = &{
+    const fn scalar(
+        name: &'static str,
+        unit: &'static str,
+        component: &'static [&'static str],
+    ) -> FieldSpec {
+        FieldSpec {
+            name,
+            unit,
+            components: component,
+        }
+    }
+    let own = [
+        scalar("body", "1", &["body"]),
+        scalar("damage", "1", &["gamma"]),
+        scalar("pulverized", "bool", &["pulverized"]),
+        scalar("porosity", "1", &["f"]),
+        scalar("mass", "kg", &["m"]),
+    ];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 5];
+    let mut i = 0;
+    while i < out.len() {
+        out[i] = if i < MLPG_FIELDS.len() {
+            MLPG_FIELDS[i]
+        } else {
+            own[i - MLPG_FIELDS.len()]
+        };
+        i += 1;
+    }
+    out
+};
+
+impl crate::model::Model for Penetration {
+    crate::model::inherent_basics!();
+    fn field_specs(&self) -> &'static [FieldSpec] {
+        PENETRATION_FIELDS
+    }
+    /// 40 records over the run.
+    fn record_interval(&self) -> f64 {
+        self.setup.end_time / 40.0
+    }
+    fn min_spacing_ratio(&self) -> Option<f64> {
+        Some(self.run.min_spacing_ratio())
+    }
+    fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
+        let fresh: &Penetration = crate::model::same_solver(fresh)?;
+        if self.setup != fresh.setup {
+            return Err("its setup does not follow from its parameters".into());
+        }
+        self.run.check_restored(&fresh.run)
+    }
+    fn set_isa(&mut self, isa: crate::isa::Isa) {
+        self.run.set_isa(isa);
+    }
+}

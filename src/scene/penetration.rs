@@ -1,0 +1,297 @@
+//! The `penetration` scene: a projectile perforating a plate in 3-D by the
+//! MLPG mixed method (seed 004, section 5.2; [`crate::mlpg::penetration`]).
+//! Its defaults are the seed's case: a tungsten cylinder 10 mm long and
+//! 10 mm in diameter at 1500 m/s, normal to an AD85 plate 5 mm thick and
+//! 80 mm in diameter (free rim), run to 20 µs. The projectile is bilinear
+//! J2 with the linear EOS (`projectile_` block, defaults the preset
+//! `tungsten_seed`); the plate is the Rajendran-Grove ceramic (`plate_`
+//! block, defaults AD85 of the seed's Table 1).
+
+use super::Scene;
+use super::params::{ParamSpec, Range, concat, spec as row};
+use super::registry::{SceneRow, no_variants, restore};
+use crate::error::{Error, Result};
+use crate::material::Material;
+use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
+use crate::material::choice::{MaterialChoice, Prefix};
+use crate::mlpg::Cylinder;
+use crate::mlpg::penetration::{Penetration, PenetrationSetup};
+use crate::mlpg::solver::{DAMPING, REBUILD_STRAIN, RodSetup};
+use crate::observe::PENETRATION_OBSERVABLES;
+use std::collections::BTreeMap;
+
+/// The registry row of the `penetration` scene.
+pub static ROW: SceneRow = SceneRow {
+    name: "penetration",
+    title: "Ballistic penetration in 3-D by MLPG: tungsten rod (10 x 10 mm, 1500 m/s) through a 5 mm AD85 plate",
+    params: PENETRATION_PARAMS,
+    material: None,
+    observables: PENETRATION_OBSERVABLES,
+    reference: || BTreeMap::from([("projectile_velocity".to_string(), RESIDUAL_VELOCITY)]),
+    variants: no_variants,
+    check: |s| setup(s).map(|_| ()),
+    build: |s: &Scene| {
+        let (setup, (projectile, plate), numerics) = setup(s)?;
+        Ok(Box::new(Penetration::new(
+            setup, projectile, plate, numerics,
+        )?))
+    },
+    restore: restore::<Penetration>,
+    fmu: None,
+};
+
+/// The seed's residual velocity of its case (m/s; seed 004, section 5.2).
+pub const RESIDUAL_VELOCITY: f64 = 1240.0;
+
+/// The most nodes a run may have: past it the scene is refused before any
+/// memory is taken (about 2 kB per node).
+pub const MAX_NODES: usize = 2_000_000;
+
+/// The geometry and the projectile's material, before the plate's block.
+const BEFORE: &[ParamSpec] = &[
+    row(
+        "impact_speed",
+        "m/s",
+        1500.0,
+        Range::open_closed(0.0, 1.0e4),
+        "speed of the projectile toward the plate, normal to it",
+    ),
+    row(
+        "projectile_length",
+        "m",
+        0.01,
+        Range::open_closed(0.0, 1.0),
+        "length of the cylindrical projectile",
+    ),
+    row(
+        "projectile_diameter",
+        "m",
+        0.01,
+        Range::open_closed(0.0, 1.0),
+        "diameter of the cylindrical projectile",
+    ),
+    row(
+        "plate_thickness",
+        "m",
+        0.005,
+        Range::open_closed(0.0, 1.0),
+        "thickness of the plate",
+    ),
+    row(
+        "plate_diameter",
+        "m",
+        0.08,
+        Range::open_closed(0.0, 10.0),
+        "diameter of the circular plate (its rim is free)",
+    ),
+    row(
+        "projectile_density",
+        "kg/m3",
+        16980.0,
+        Range::closed(100.0, 1.0e5),
+        "projectile: reference mass density",
+    ),
+    row(
+        "projectile_shear_modulus",
+        "Pa",
+        123801652892.56198,
+        Range::closed(1.0e6, 1.0e14),
+        "projectile: shear modulus mu",
+    ),
+    row(
+        "projectile_bulk_modulus",
+        "Pa",
+        172183908045.977,
+        Range::closed(1.0e6, 1.0e15),
+        "projectile: bulk modulus K of the linear EOS P = K(rho/rho0 - 1)",
+    ),
+    row(
+        "projectile_specific_heat",
+        "J/(kg.K)",
+        134.0,
+        Range::closed(1.0, 1.0e5),
+        "projectile: specific heat C",
+    ),
+    row(
+        "projectile_taylor_quinney",
+        "1",
+        0.9,
+        Range::closed(0.0, 1.0),
+        "projectile: Taylor-Quinney coefficient, the fraction of plastic work that becomes heat",
+    ),
+    row(
+        "projectile_yield_stress",
+        "Pa",
+        1.5e9,
+        Range::closed(0.0, 1.0e11),
+        "projectile: bilinear J2 initial yield stress",
+    ),
+    row(
+        "projectile_hardening_modulus",
+        "Pa",
+        0.0,
+        Range::closed(0.0, 1.0e12),
+        "projectile: bilinear J2 plastic hardening modulus H",
+    ),
+    row(
+        "projectile_initial_temperature",
+        "K",
+        293.0,
+        Range::closed(1.0, 1.0e5),
+        "projectile: temperature at impact",
+    ),
+];
+
+/// The resolution, the solver's choices and the end time, after the
+/// plate's block.
+const AFTER: &[ParamSpec] = &[
+    row(
+        "particles_radial",
+        "1",
+        5.0,
+        Range::integer(2.0, 60.0),
+        "nodes across the projectile's radius, axis and mantle included (rings + 1); the plate has the same spacing",
+    ),
+    row(
+        "smoothing_coefficient",
+        "1",
+        0.0,
+        Range::closed(0.0, 0.5),
+        "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, penetration)",
+    ),
+    row(
+        "shifting",
+        "1",
+        0.0,
+        Range::closed(0.0, 1.0),
+        "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian",
+    ),
+    row(
+        "end_time",
+        "s",
+        20.0e-6,
+        Range::open_closed(0.0, 1.0e-3),
+        "simulated time at which the run ends",
+    ),
+];
+
+const LEN: usize = BEFORE.len() + PLATE_CERAMIC.len() + AFTER.len();
+
+/// Parameters of the penetration scene (SI units): the geometry, the
+/// projectile's block (bilinear, linear EOS; `tungsten_seed`), the plate's
+/// ceramic block (AD85), the resolution and the solver's choices.
+pub const PENETRATION_PARAMS: &[ParamSpec] = &concat::<LEN>(&[BEFORE, &PLATE_CERAMIC, AFTER]);
+
+/// The setup, the two materials and the solver's choices of a scene, with
+/// the cross-parameter checks.
+fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)> {
+    let v = |name: &str| s.get(name);
+    let projectile = Cylinder {
+        radius: 0.5 * v("projectile_diameter")?,
+        length: v("projectile_length")?,
+    };
+    let plate = Cylinder {
+        radius: 0.5 * v("plate_diameter")?,
+        length: v("plate_thickness")?,
+    };
+    let rings = v("particles_radial")? as usize - 1;
+    let spacing = projectile.radius / rings as f64;
+    if plate.radius < projectile.radius + 2.0 * spacing {
+        return Err(Error::Inconsistent(format!(
+            "plate_diameter = {} must exceed projectile_diameter = {} by at least four node spacings ({} m)",
+            2.0 * plate.radius,
+            2.0 * projectile.radius,
+            4.0 * spacing
+        )));
+    }
+    for (name, length) in [
+        ("projectile_length", projectile.length),
+        ("plate_thickness", plate.length),
+    ] {
+        if length < 2.0 * spacing {
+            return Err(Error::Inconsistent(format!(
+                "{name} = {length} m holds fewer than three layers of nodes at the spacing {spacing} m \
+                 (projectile_diameter / 2 / (particles_radial - 1)); raise particles_radial"
+            )));
+        }
+    }
+    // Nodes of the ring lattices: 1 + 3 k (k + 1) per layer.
+    let count = |c: &Cylinder| {
+        let k = (c.radius / spacing).round();
+        (1.0 + 3.0 * k * (k + 1.0)) * ((c.length / spacing).round() + 1.0)
+    };
+    let nodes = count(&projectile) + count(&plate);
+    if nodes > MAX_NODES as f64 {
+        return Err(Error::Inconsistent(format!(
+            "the run would have {nodes:.0} nodes, more than {MAX_NODES}: lower particles_radial \
+             or plate_diameter"
+        )));
+    }
+    let projectile_material = MaterialChoice::BILINEAR_LINEAR.material(Prefix::Projectile, v)?;
+    let plate_material = ceramic_material(v)?;
+    let end_time = v("end_time")?;
+    let setup = PenetrationSetup {
+        projectile,
+        plate,
+        impact_speed: v("impact_speed")?,
+        rings,
+        end_time,
+    };
+    let mut numerics = RodSetup::new(projectile, rings, setup.impact_speed, end_time);
+    numerics.damping = DAMPING;
+    numerics.rebuild_strain = REBUILD_STRAIN;
+    numerics.smoothing = v("smoothing_coefficient")?;
+    numerics.shifting = v("shifting")?;
+    Ok((setup, (projectile_material, plate_material), numerics))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::presets::Preset;
+
+    /// The projectile's defaults are the preset `tungsten_seed`, by value.
+    #[test]
+    fn projectile_defaults_are_the_tungsten_preset() {
+        let preset = Preset::named("tungsten_seed").unwrap();
+        for p in BEFORE.iter().filter(|p| p.name.starts_with("projectile_")) {
+            let base = &p.name["projectile_".len()..];
+            if let Some(v) = preset.value(base) {
+                assert_eq!(p.default, v, "{}", p.name);
+            }
+        }
+        let s = Scene::builtin("penetration").unwrap();
+        let (_, (w, _), _) = setup(&s).unwrap();
+        assert_eq!(w, preset.material().unwrap());
+    }
+
+    /// Every name is unique, and the default scene passes its checks.
+    #[test]
+    fn the_table_is_consistent() {
+        let mut names: Vec<_> = PENETRATION_PARAMS.iter().map(|p| p.name).collect();
+        names.sort_unstable();
+        let n = names.len();
+        names.dedup();
+        assert_eq!(names.len(), n);
+        for p in PENETRATION_PARAMS {
+            p.check(p.default).unwrap();
+        }
+        let s = Scene::builtin("penetration").unwrap();
+        (ROW.check)(&s).unwrap();
+    }
+
+    /// A plate no wider than the projectile, and a run too big, are refused
+    /// by name.
+    #[test]
+    fn inconsistent_scenes_are_refused() {
+        let mut s = Scene::builtin("penetration").unwrap();
+        s.set("plate_diameter", 0.01).unwrap();
+        let e = (ROW.check)(&s).unwrap_err().to_string();
+        assert!(e.contains("plate_diameter"), "{e}");
+        let mut s = Scene::builtin("penetration").unwrap();
+        s.set("particles_radial", 60.0).unwrap();
+        s.set("plate_diameter", 1.0).unwrap();
+        let e = (ROW.check)(&s).unwrap_err().to_string();
+        assert!(e.contains("nodes"), "{e}");
+    }
+}
