@@ -53,7 +53,7 @@ def main():
         want = float(value) if not isinstance(value, bool) else float(value)
         assert c[name] == want, f"{name}: C {c[name]!r} != Rust {want!r}"
         checked += 1
-    assert checked >= 13, checked
+    assert checked >= 12, checked  # penetration: 11 observables and steps
     print(f"{sys.argv[1]}: {checked} values equal the Rust API bit for bit")
 
 
