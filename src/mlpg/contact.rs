@@ -17,6 +17,14 @@
 //! that comes between two nodes of the other body's surface (half a spacing
 //! to each side) is caught at `0.87 reach` above them, so the contact does
 //! not leak between nodes.
+//!
+//! Within a body, pulverized nodes ([`loose_pairs`]) meet their neighbours
+//! by the same impulses when a pair comes closer than half a spacing: the
+//! powder of a crushed ceramic does not hold its place in the continuum,
+//! and the MLS gradients barely see two nodes close in (measured: the
+//! penetration run at 4 nodes across stopped with `SpacingCollapse` at
+//! 4.79 µs, two pulverized nodes of the plate's top surface 0.16 mm apart,
+//! and runs to 6.56 µs with these contacts).
 
 use crate::neighbors::cell_list;
 
@@ -56,6 +64,34 @@ pub fn pairs(pos: &[[f64; 3]], group: &[u8], reach: f64, out: &mut Vec<(usize, u
         for &b in list.of(a) {
             let j = index[b];
             if j > i && group[j] != group[i] && distance(&pos[i], &pos[j]) < reach {
+                out.push((i, j));
+            }
+        }
+    }
+}
+
+/// The pairs `(i, j)`, `i < j`, of nodes of one body closer than `reach`
+/// of which at least one is `loose` (pulverized: powder that meets its
+/// neighbours by contact, not through the continuum), ascending, appended
+/// to `out`.
+pub fn loose_pairs(
+    pos: &[[f64; 3]],
+    group: &[u8],
+    loose: &[bool],
+    reach: f64,
+    out: &mut Vec<(usize, usize)>,
+) {
+    if !loose.iter().any(|&l| l) {
+        return;
+    }
+    let list = cell_list(pos, reach);
+    for i in 0..pos.len() {
+        for &j in list.of(i) {
+            if j > i
+                && (loose[i] || loose[j])
+                && group.get(i) == group.get(j)
+                && distance(&pos[i], &pos[j]) < reach
+            {
                 out.push((i, j));
             }
         }
@@ -147,6 +183,31 @@ mod tests {
         }
         assert!(want.len() > 10, "{}", want.len());
         assert_eq!(got, want);
+    }
+
+    /// Pulverized nodes: pairs within one body closer than the reach with a
+    /// loose node, and no others.
+    #[test]
+    fn loose_pairs_are_those_with_a_pulverized_node() {
+        let pos = [
+            [0.0, 0.0, 0.0],
+            [0.3, 0.0, 0.0],
+            [0.0, 0.3, 0.0],
+            [5.0, 0.0, 0.0],
+            [5.3, 0.0, 0.0],
+            [0.0, 0.0, 0.2],
+        ];
+        let group = [0, 0, 0, 0, 0, 1];
+        let mut loose = [false, true, false, false, false, false];
+        let mut out = Vec::new();
+        loose_pairs(&pos, &group, &loose, 0.5, &mut out);
+        // 0-1 (1 loose, 0.3 apart); 1-2 is 0.42 apart; 0-2 has no loose
+        // node; 3-4 neither; 0-5 and 1-5 are of two bodies.
+        assert_eq!(out, vec![(0, 1), (1, 2)]);
+        loose[1] = false;
+        out.clear();
+        loose_pairs(&pos, &group, &loose, 0.5, &mut out);
+        assert!(out.is_empty());
     }
 
     /// Head-on and oblique collisions: momentum is conserved to round-off,

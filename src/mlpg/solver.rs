@@ -1,5 +1,7 @@
 //! The time loop of the 3-D MLPG mixed method (seed sections 2-3): a rod on
-//! the ring lattice striking a rigid smooth anvil at z = 0.
+//! the ring lattice striking a rigid smooth anvil at z = 0, or several
+//! bodies on ring lattices in contact with each other ([`Mlpg3d::bodies`]:
+//! the penetration run, `super::penetration`).
 //!
 //! # One step
 //!
@@ -16,6 +18,9 @@
 //!    pulls it away (`F_z > 0`: the contact force would be tensile); then
 //!    the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
 //!    ([`SMOOTHING`]), its kinetic energy booked as `smoothing_dissipation`;
+//!    in a run of several bodies, the contact impulses between them, and
+//!    in a material with damage, between pulverized nodes closer than half
+//!    a spacing ([`contact`]);
 //! 3. `x^{n+1} = x^n + dt v^{n+1/2}`; a node that reaches z = 0 stops on
 //!    the anvil (its kinetic energy toward the anvil is booked as
 //!    `contact_dissipation`), one that passes it by half a spacing is the
@@ -320,6 +325,8 @@ struct Scratch {
     pairs: Vec<(usize, usize)>,
     /// The velocities before the step's forces (runs of several bodies).
     before: Vec<[f64; 3]>,
+    /// Whether each node is pulverized (runs with damage).
+    loose: Vec<bool>,
 }
 
 fn anvil_default() -> bool {
@@ -861,7 +868,7 @@ impl Mlpg3d {
         g.op.apply(total, force);
         self.profile.lap(Phase::Force, &mut clock);
         // 2-3. Velocities, contact, positions.
-        if !self.group.is_empty() {
+        if !self.group.is_empty() || self.material_state.has_damage() {
             scratch.before.clone_from(&self.vel);
         }
         let d0 = self.d_min0;
@@ -924,9 +931,29 @@ impl Mlpg3d {
             self.smoothing_dissipation += before - kinetic(&self.vel, mass);
         }
         self.profile.lap(Phase::Smoothing, &mut clock);
-        // Contact between the bodies.
+        // Contact between the bodies, then between pulverized nodes closer
+        // than half a spacing.
+        scratch.pairs.clear();
         if !self.group.is_empty() {
             contact::pairs(&self.pos, &self.group, self.reach, &mut scratch.pairs);
+        }
+        if self.material_state.has_damage() {
+            let points = self.material_state.points();
+            scratch.loose.clear();
+            scratch.loose.extend(
+                points
+                    .iter()
+                    .map(|p| p.ceramic().is_some_and(|v| v.pulverized.is_some())),
+            );
+            contact::loose_pairs(
+                &self.pos,
+                &self.group,
+                &scratch.loose,
+                SHIFT_RANGE * self.d_min0,
+                &mut scratch.pairs,
+            );
+        }
+        if !scratch.pairs.is_empty() {
             self.contact_dissipation += contact::resolve(
                 &scratch.pairs,
                 &self.pos,
