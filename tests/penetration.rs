@@ -47,7 +47,11 @@ fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
     .expect("the seed's case builds")
 }
 
-/// Exploration: the seed's case, printed as it runs.
+/// Exploration: the seed's case, printed as it runs (`MI_RINGS` rings,
+/// `MI_ALPHA` smoothing, `MI_SHIFT` shifting, `MI_END` end time); with
+/// `MI_DIAGNOSE=e`, the nodes that gain the most kinetic energy in the
+/// first three steps past the energy error `e`; at a stop, the closest
+/// pair of one body.
 /// `MI_RINGS=4 cargo test --release --test penetration -- --ignored --nocapture explore`
 #[test]
 #[ignore]
@@ -72,8 +76,50 @@ fn explore_seed_case() {
     );
     let clock = std::time::Instant::now();
     let mut next = 0.0;
+    let diagnose: f64 = std::env::var("MI_DIAGNOSE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(f64::INFINITY);
+    let mut shown = 0;
     while !run.finished() {
-        if let Err(e) = run.step() {
+        let v_before = run.run().velocities().to_vec();
+        let step = run.step();
+        if step.is_ok() && run.energies().error > diagnose && shown < 3 {
+            shown += 1;
+            let (x, v, m) = (
+                run.run().positions(),
+                run.run().velocities(),
+                run.run().masses(),
+            );
+            let g = run.run().group();
+            let pul = run.field("pulverized").unwrap();
+            let surf = &run.run().lattice().surfaces;
+            let mut gain: Vec<(f64, usize)> = (0..x.len())
+                .map(|i| {
+                    let ke = |u: &[f64; 3]| 0.5 * m[i] * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+                    (ke(&v[i]) - ke(&v_before[i]), i)
+                })
+                .collect();
+            let total: f64 = gain.iter().map(|g| g.0).sum();
+            gain.sort_by(|a, b| b.0.total_cmp(&a.0));
+            println!(
+                "t {:.3} us: KE change of the step {total:.2} J; largest gains:",
+                run.time() * 1e6
+            );
+            for &(d, i) in gain.iter().take(8) {
+                let r = (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt();
+                println!(
+                    "  node {i} body {} surf {} pulv {} r {:.2} mm z {:.2} mm |v| {:.0} m/s dKE {d:.3} J",
+                    g[i],
+                    surf[i].0,
+                    pul[i],
+                    r * 1e3,
+                    x[i][2] * 1e3,
+                    (v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2]).sqrt()
+                );
+            }
+        }
+        if let Err(e) = step {
             println!("stopped: {e}");
             let x = run.run().positions();
             let g = run.run().group();
