@@ -529,6 +529,14 @@ impl Mlpg3d {
             .fold(speed(&self.material), f64::max)
     }
 
+    /// Whether a body's material has a damage model (no pass over the
+    /// nodes: the step asks every time).
+    fn damaging(&self) -> bool {
+        std::iter::once(&self.material)
+            .chain(self.others.iter().map(|b| &b.material))
+            .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)))
+    }
+
     /// The material of node `i`.
     #[inline]
     fn material_of(&self, i: usize) -> &Material {
@@ -868,7 +876,7 @@ impl Mlpg3d {
         g.op.apply(total, force);
         self.profile.lap(Phase::Force, &mut clock);
         // 2-3. Velocities, contact, positions.
-        if !self.group.is_empty() || self.material_state.has_damage() {
+        if !self.group.is_empty() || self.damaging() {
             scratch.before.clone_from(&self.vel);
         }
         let d0 = self.d_min0;
@@ -937,7 +945,7 @@ impl Mlpg3d {
         if !self.group.is_empty() {
             contact::pairs(&self.pos, &self.group, self.reach, &mut scratch.pairs);
         }
-        if self.material_state.has_damage() {
+        if self.damaging() {
             let points = self.material_state.points();
             scratch.loose.clear();
             scratch.loose.extend(
@@ -1693,10 +1701,7 @@ impl Mlpg3d {
         if self.contact.len() != n || self.built_contact.len() != n {
             return Err(format!("its contact flags are not {n}"));
         }
-        let damaging = std::iter::once(&self.material)
-            .chain(self.others.iter().map(|b| &b.material))
-            .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)));
-        if damaging && self.steps > 0 && !self.material_state.has_damage() {
+        if self.damaging() && self.steps > 0 && !self.material_state.has_damage() {
             return Err("its damage variables are missing".into());
         }
         self.material_state.check_len(n)?;
