@@ -223,7 +223,7 @@ fn the_seed_case_transfers_momentum_to_the_plate() {
         o("energy_error"),
         o("pulverized_fraction"),
         o("max_damage"),
-        o("projectile_length") * 1e3
+        o("projectile_extent") * 1e3
     );
     assert!(
         (p / p0 - 1.0).abs() < 0.01,
@@ -245,7 +245,7 @@ fn the_seed_case_transfers_momentum_to_the_plate() {
         (o("max_damage") - 0.75).abs() < 1e-12,
         "pulverized at the critical crack density"
     );
-    assert!(o("projectile_length") < 0.01);
+    assert!(o("projectile_extent") < 0.01);
     assert!(o("energy_error") < 0.05, "{}", o("energy_error"));
 }
 

@@ -143,7 +143,7 @@ impl Penetration {
     }
 
     /// Extent of the projectile along the axis (m).
-    pub fn projectile_length(&self) -> f64 {
+    pub fn projectile_extent(&self) -> f64 {
         let x = self.run.positions();
         let (lo, hi) = self
             .nodes(0)
@@ -224,7 +224,7 @@ impl Penetration {
         let (damaged, pulverized, max) = self.damage();
         let values = vec![
             self.projectile_velocity(),
-            self.projectile_length(),
+            self.projectile_extent(),
             self.hole_radius(),
             damaged,
             pulverized,
