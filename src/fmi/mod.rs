@@ -3,8 +3,10 @@
 //! ([`crate::scene::registry::FmuIdentity`]; today `TaylorImpact`, the
 //! `taylor` scene, and one FMU per other material choice of it:
 //! `TaylorImpactBilinear`, `TaylorImpactMieGruneisen`,
-//! `TaylorImpactBilinearMieGruneisen`). One library serves every FMU: an
-//! instance takes the FMU whose instantiation token the host gives.
+//! `TaylorImpactBilinearMieGruneisen`; `Taylor3dImpact`, the `taylor3d`
+//! scene; `BallisticImpact`, the `penetration` scene). One library serves
+//! every FMU: an instance takes the FMU whose instantiation token the host
+//! gives.
 //!
 //! An FMU exposes its scene: every parameter of the row's table as a fixed
 //! parameter, every observable as an output. [`Fmu::variables`] derives the

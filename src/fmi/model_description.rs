@@ -25,12 +25,24 @@ pub fn base_units(unit: &str) -> Option<&'static [(&'static str, i32)]> {
         "K" => &[("K", 1)],
         "m/s" => &[("m", 1), ("s", -1)],
         "1/s" => &[("s", -1)],
+        "1/m3" => &[("m", -3)],
         "kg/m3" => &[("kg", 1), ("m", -3)],
         "Pa" => &[("kg", 1), ("m", -1), ("s", -2)],
         "J" => &[("kg", 1), ("m", 2), ("s", -2)],
         "J/(kg.K)" => &[("m", 2), ("s", -2), ("K", -1)],
         _ => return None,
     })
+}
+
+/// Units of the tables that FMI's `BaseUnit` cannot express, its exponents
+/// being integers: declared by name alone. Fracture toughness, Pa.m^(1/2),
+/// is kg m^(-1/2) s^-2.
+pub const NAME_ONLY_UNITS: &[&str] = &["Pa.m^(1/2)"];
+
+/// Whether the model description can declare `unit`: by its base units
+/// ([`base_units`]) or by name alone ([`NAME_ONLY_UNITS`]).
+pub fn is_declared_unit(unit: &str) -> bool {
+    base_units(unit).is_some() || NAME_ONLY_UNITS.contains(&unit)
 }
 
 /// The declared unit of a variable (none for flags).
@@ -84,10 +96,20 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
         .into_iter()
         .filter(|v| version == FmiVersion::Fmi3 || v.kind != VarKind::Time)
         .collect();
+    // FMI requires unique names: a scene's parameter and observable tables
+    // must not share one.
+    for (k, v) in vars.iter().enumerate() {
+        if vars[..k].iter().any(|w| w.name == v.name) {
+            return Err(format!(
+                "variable name `{}` is used twice (a parameter and an output of the scene share it)",
+                v.name
+            ));
+        }
+    }
     let mut units: Vec<&str> = Vec::new();
     for v in &vars {
         if let Some(u) = declared_unit(v) {
-            if base_units(u).is_none() {
+            if !is_declared_unit(u) {
                 return Err(format!(
                     "variable `{}`: unit `{u}` has no base-unit definition",
                     v.name
@@ -141,13 +163,17 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
     }
     x.push_str("  <UnitDefinitions>\n");
     for u in &units {
-        let exps = base_units(u).expect("checked above");
-        let attrs: String = exps.iter().map(|(b, e)| format!(" {b}=\"{e}\"")).collect();
-        writeln!(
-            x,
-            "    <Unit name=\"{}\">\n      <BaseUnit{attrs}/>\n    </Unit>",
-            escape(u)
-        )
+        match base_units(u) {
+            Some(exps) => {
+                let attrs: String = exps.iter().map(|(b, e)| format!(" {b}=\"{e}\"")).collect();
+                writeln!(
+                    x,
+                    "    <Unit name=\"{}\">\n      <BaseUnit{attrs}/>\n    </Unit>",
+                    escape(u)
+                )
+            }
+            None => writeln!(x, "    <Unit name=\"{}\"/>", escape(u)),
+        }
         .unwrap();
     }
     x.push_str("  </UnitDefinitions>\n");
@@ -281,8 +307,20 @@ mod tests {
         for fmu in Fmu::all() {
             for v in fmu.variables() {
                 if let Some(u) = declared_unit(&v) {
-                    assert!(base_units(u).is_some(), "unit {u} of {}", v.name);
+                    assert!(is_declared_unit(u), "unit {u} of {}", v.name);
                 }
+            }
+        }
+    }
+
+    /// Every FMU of the registry has a model description in both standards
+    /// (unique names, every unit declared).
+    #[test]
+    fn every_fmu_is_described() {
+        for fmu in Fmu::all() {
+            for version in [FmiVersion::Fmi3, FmiVersion::Fmi2] {
+                let id = fmu.identity().model_identifier;
+                model_description(fmu, version).unwrap_or_else(|e| panic!("{id}: {e}"));
             }
         }
     }

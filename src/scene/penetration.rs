@@ -37,7 +37,13 @@ pub static ROW: SceneRow = SceneRow {
         )?))
     },
     restore: restore::<Penetration>,
-    fmu: None,
+    fmu: Some(super::registry::FmuIdentity {
+        model_identifier: "BallisticImpact",
+        model_name: "BallisticImpact",
+        description: "Ballistic penetration in 3-D: a bilinear elastoplastic projectile through a Rajendran-Grove \
+                      ceramic plate by the MLPG mixed method (Han, Liu, Rajendran & Atluri); defaults are the \
+                      tungsten rod on AD85 at 1500 m/s",
+    }),
 };
 
 /// The seed's residual velocity of its case (m/s; seed 004, section 5.2).

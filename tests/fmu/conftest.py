@@ -105,6 +105,29 @@ def assert_simulated_equal_to_cli(r, ref, names):
             assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
 
 
+def assert_variables_are_the_scene_tables(identifier, scene):
+    """Both FMUs of `identifier` have as parameters those of `meshless-impact
+    params SCENE` (names and starts, in order; `particles_radial` an
+    integer), as outputs those of `observables SCENE`, value references from
+    `time` = 0 in that order, and one model identifier and GUID. Returns the
+    FMI 3 model and the observable names."""
+    m3, m2 = model(identifier), model(identifier, "_fmi2")
+    want = params_of(scene)
+    params = [v for v in m3.md.modelVariables if v.causality == "parameter"]
+    assert [v.name for v in params] == [n for n, _ in want]
+    assert [float(v.start) for v in params] == [v for _, v in want]
+    assert [v.name for v in m2.md.modelVariables if v.causality == "parameter"] == [n for n, _ in want]
+    assert m3.var("particles_radial").type == "Int32" and m2.var("particles_radial").type == "Integer"
+    observables = [line.split()[0] for line in cli("observables", scene).splitlines()]
+    assert [v.name for v in m3.outputs] == observables
+    assert [v.name for v in m2.outputs] == observables
+    # Value references: time 0 (FMI 3), the parameters from 1, then the outputs.
+    assert [v.valueReference for v in m3.md.modelVariables] == list(range(len(m3.md.modelVariables)))
+    assert m3.md.coSimulation.modelIdentifier == identifier == m2.md.coSimulation.modelIdentifier
+    assert m3.md.guid == m2.md.guid
+    return m3, observables
+
+
 def check_fmu_file(path):
     """fmpy's validation (library and command line) and fmutool's check
     pass on the FMU at `path`."""

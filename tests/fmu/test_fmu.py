@@ -97,6 +97,24 @@ def assert_set_refused(m, make, params, needle):
     s.freeInstance()
 
 
+def assert_initialization_refused(m, make, params, needle):
+    """A new instance (`make(m)`: slave3 or slave2) with `params` set fails
+    to initialize with Error, and the host's log has a message containing
+    `needle`."""
+    s = make(m)
+    set_params(s, m, params)
+    MESSAGES.clear()
+    with pytest.raises(FMICallException):
+        if make is slave3:
+            s.enterInitializationMode(startTime=0.0)
+        else:
+            s.setupExperiment(startTime=0.0)
+            s.enterInitializationMode()
+        s.exitInitializationMode()
+    assert any(needle in x for x in messages()), MESSAGES
+    s.freeInstance()
+
+
 def outputs(s, m):
     out = {}
     for v in m.outputs:
@@ -139,6 +157,51 @@ def run3(m, params, step=1e-6, **kw):
     s.terminate()
     s.freeInstance()
     return out
+
+
+def assert_state_rolls_back_and_resumes(m, init, params, step, k, ref):
+    """Through FMI 3 (`init` = init3) or FMI 2 (init2), with `params`: a
+    state got after `k` steps of `step` and set again steps to the same
+    outputs; its serialized bytes (headed by the FMU's state header), in a
+    new instance, run on to the end with the final values `ref` bit for
+    bit. Returns FMI 2's last successful time then (None through FMI 3)."""
+    fmi3 = init is init3
+    s = init(m, params)
+    for n in range(k):
+        s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+    state = s.getFMUState() if fmi3 else s.getFMUstate()
+    s.doStep(currentCommunicationPoint=k * step, communicationStepSize=step)
+    after = outputs(s, m)
+    s.doStep(currentCommunicationPoint=(k + 1) * step, communicationStepSize=step)
+    assert outputs(s, m) != after
+    (s.setFMUState if fmi3 else s.setFMUstate)(state)
+    s.doStep(currentCommunicationPoint=k * step, communicationStepSize=step)
+    assert outputs(s, m) == after
+    data = (s.serializeFMUState if fmi3 else s.serializeFMUstate)(state)
+    header = f"{m.md.coSimulation.modelIdentifier} FMU state v2 postcard\n"
+    assert bytes(data).startswith(header.encode())
+    t = slave3(m, name="copy") if fmi3 else slave2(m, name="copy")
+    restored = (t.deserializeFMUState if fmi3 else t.deSerializeFMUstate)(data)
+    (t.setFMUState if fmi3 else t.setFMUstate)(restored)
+    n = k
+    while True:
+        try:
+            r = t.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+        except FMICallException as e:  # FMI 2: the early stop
+            assert not fmi3 and e.status == fmi2Discard
+            break
+        n += 1
+        if fmi3 and r[1]:
+            break
+    for name, value in outputs(t, m).items():
+        assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
+    last = None
+    if not fmi3:
+        assert t.getBooleanStatus(fmi2Terminated)
+        last = t.getRealStatus(fmi2LastSuccessfulTime)
+    for x in (s, t):
+        x.freeInstance()
+    return last
 
 
 def coarse_cli(tmp_path_factory, *sets):

@@ -9,7 +9,8 @@ from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from conftest import COARSE, cli_run
-from test_fmu import MESSAGES, assert_set_refused, init2, init3, messages, outputs, run3, set_params, slave2, slave3
+from test_fmu import (MESSAGES, assert_initialization_refused, assert_set_refused, init2, init3, messages, outputs,
+                      run3, slave2, slave3)
 
 BULK = 169.1e9
 
@@ -67,18 +68,7 @@ def test_invalid_value_is_refused_with_its_name(fmu3, fmu2, name, value, needle)
 
 def test_melt_at_room_temperature_is_refused_at_initialization(fmu3, fmu2):
     for m, make in ((fmu3, slave3), (fmu2, slave2)):
-        s = make(m)
-        set_params(s, m, {"melt_temperature": 293.0})
-        MESSAGES.clear()
-        with pytest.raises(FMICallException):
-            if m is fmu3:
-                s.enterInitializationMode(startTime=0.0)
-            else:
-                s.setupExperiment(startTime=0.0)
-                s.enterInitializationMode()
-            s.exitInitializationMode()
-        assert any("must exceed room_temperature" in x for x in messages()), MESSAGES
-        s.freeInstance()
+        assert_initialization_refused(m, make, {"melt_temperature": 293.0}, "must exceed room_temperature")
 
 
 def test_unknown_parameter_name_is_refused(fmu3, fmu2):

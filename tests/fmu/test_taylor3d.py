@@ -11,10 +11,11 @@ refused with their names."""
 import pytest
 from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import fmi2Discard, fmi2LastSuccessfulTime, fmi2Terminated
 
-from conftest import assert_simulated_equal_to_cli, check_fmu_file, cli, cli_json, model, params_of
-from test_fmu import MESSAGES, assert_set_refused, init2, init3, messages, outputs, slave2, slave3
+from conftest import (assert_simulated_equal_to_cli, assert_variables_are_the_scene_tables, check_fmu_file, cli_json,
+                      model)
+from test_fmu import (MESSAGES, assert_set_refused, assert_state_rolls_back_and_resumes, init2, init3, messages,
+                      slave2, slave3)
 
 ID = "Taylor3dImpact"
 NODES = 3  # particles_radial: 3 nodes across the radius, 2 rings
@@ -38,23 +39,10 @@ def test_validate_and_fmutool_check(suffix):
 
 
 def test_variables_are_the_scene_tables():
-    m3, m2 = fmu(), fmu("_fmi2")
-    want = params_of("taylor3d")
-    params = [v for v in m3.md.modelVariables if v.causality == "parameter"]
-    assert [v.name for v in params] == [n for n, _ in want]
-    assert [float(v.start) for v in params] == [v for _, v in want]
-    assert [v.name for v in m2.md.modelVariables if v.causality == "parameter"] == [n for n, _ in want]
-    assert m3.var("particles_radial").type == "Int32" and m2.var("particles_radial").type == "Integer"
-    observables = [line.split()[0] for line in cli("observables", "taylor3d").splitlines()]
-    assert [v.name for v in m3.outputs] == observables
-    assert [v.name for v in m2.outputs] == observables
+    m3, observables = assert_variables_are_the_scene_tables(ID, "taylor3d")
     assert {"rod_length", "mushroom_radius", "mushroom_radius_spread", "energy_error"} <= set(observables)
     assert m3.var("at_rest").type == "Boolean"
-    # Value references: time 0 (FMI 3), the parameters from 1, then the outputs.
-    assert [v.valueReference for v in m3.md.modelVariables] == list(range(len(m3.md.modelVariables)))
-    assert m3.md.coSimulation.modelIdentifier == ID == m2.md.coSimulation.modelIdentifier
-    taylor = model("TaylorImpact")
-    assert m3.md.guid == m2.md.guid != taylor.md.guid
+    assert m3.md.guid != model("TaylorImpact").md.guid
 
 
 @pytest.mark.parametrize("suffix", ["", "_fmi2"])
@@ -98,43 +86,9 @@ def test_fmu_state_rolls_back_and_moves_between_instances(tmp_path_factory):
     outputs; its bytes, in a new instance, run to the end with the CLI's
     final values bit for bit."""
     ref = cli3d(tmp_path_factory)
-    step = 1e-6
-    for m, init in ((fmu(), init3), (fmu("_fmi2"), init2)):
-        s = init(m, {"particles_radial": NODES})
-        for n in range(10):
-            s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
-        fmi3 = init is init3
-        state = s.getFMUState() if fmi3 else s.getFMUstate()
-        s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
-        after = outputs(s, m)
-        s.doStep(currentCommunicationPoint=11 * step, communicationStepSize=step)
-        assert outputs(s, m) != after
-        (s.setFMUState if fmi3 else s.setFMUstate)(state)
-        s.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
-        assert outputs(s, m) == after
-        data = (s.serializeFMUState if fmi3 else s.serializeFMUstate)(state)
-        assert bytes(data).startswith(b"Taylor3dImpact FMU state v2 postcard\n")
-        t = slave3(m, name="copy") if fmi3 else slave2(m, name="copy")
-        restored = (t.deserializeFMUState if fmi3 else t.deSerializeFMUstate)(data)
-        (t.setFMUState if fmi3 else t.setFMUstate)(restored)
-        n = 10
-        while True:
-            try:
-                r = t.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
-            except FMICallException as e:  # FMI 2: the early stop
-                assert not fmi3 and e.status == fmi2Discard
-                break
-            n += 1
-            if fmi3 and r[1]:
-                break
-        out = outputs(t, m)
-        for name, value in out.items():
-            assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
-        if not fmi3:
-            assert t.getBooleanStatus(fmi2Terminated)
-            assert t.getRealStatus(fmi2LastSuccessfulTime) == ref["end_time"]
-        for x in (s, t):
-            x.freeInstance()
+    assert assert_state_rolls_back_and_resumes(fmu(), init3, {"particles_radial": NODES}, 1e-6, 10, ref) is None
+    last = assert_state_rolls_back_and_resumes(fmu("_fmi2"), init2, {"particles_radial": NODES}, 1e-6, 10, ref)
+    assert last == ref["end_time"]
 
 
 def test_bad_values_and_foreign_states_are_refused_with_their_names():
