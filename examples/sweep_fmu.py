@@ -107,6 +107,37 @@ def add_errors(result, case):
     return result
 
 
+def parse_sets(items, parameter_names, ap):
+    """`--set NAME=VALUE` items as {NAME: float}; an unknown name is an
+    error of the argument parser `ap`."""
+    out = {}
+    for item in items:
+        name, _, value = item.partition("=")
+        if name not in parameter_names:
+            ap.error(f"unknown parameter {name!r}; allowed: {', '.join(sorted(parameter_names))}")
+        out[name] = float(value)
+    return out
+
+
+def run_jobs(run, jobs, workers, scheduler):
+    """`run(*job)` for every job, results in order: on the Dask cluster at
+    `scheduler` when given, else on a local pool of `workers` processes.
+    `run` must be a function of the script that is run (`__main__`), which
+    travels to Dask workers by value, and open the FMU itself: the FMU must
+    exist at its path on every worker (a shared file system or a copy), with
+    fmpy installed."""
+    if scheduler:
+        from dask.distributed import Client
+
+        with Client(scheduler) as client:
+            futures = [client.submit(run, *job, pure=False) for job in jobs]
+            return client.gather(futures)
+    # "spawn": each worker starts clean (no inherited solver threads).
+    with ProcessPoolExecutor(max_workers=max(1, min(workers or 1, len(jobs))),
+                             mp_context=multiprocessing.get_context("spawn")) as pool:
+        return list(pool.map(run, *zip(*jobs)))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--fmu", default=str(DEFAULT_FMU), help="FMU to run (FMI 3 or FMI 2); default %(default)s")
@@ -137,31 +168,13 @@ def main(argv=None):
         if missing:
             ap.error(f"no case file {args.cases!r} and no Table 1 tests {sorted(missing)}")
 
-    common = {}
-    for item in args.set:
-        name, _, value = item.partition("=")
-        if name not in parameter_names:
-            ap.error(f"unknown parameter {name!r}; allowed: {', '.join(sorted(parameter_names))}")
-        common[name] = float(value)
+    common = parse_sets(args.set, parameter_names, ap)
     if args.particles_radial is not None:
         common["particles_radial"] = args.particles_radial
 
     jobs = [(args.fmu, c["test"], {**case_parameters(c, parameter_names), **common}, args.step) for c in cases]
     t0 = time.perf_counter()
-    if args.scheduler:
-        from dask.distributed import Client
-
-        with Client(args.scheduler) as client:
-            # Run as a script, run_case travels to the workers by value.
-            # The workers open --fmu themselves: it must exist at that path on
-            # every worker (a shared file system or a copy), with fmpy installed.
-            futures = [client.submit(run_case, *job, pure=False) for job in jobs]
-            results = client.gather(futures)
-    else:
-        # "spawn": each worker starts clean (no inherited solver threads).
-        with ProcessPoolExecutor(max_workers=max(1, min(args.workers or 1, len(jobs))),
-                                 mp_context=multiprocessing.get_context("spawn")) as pool:
-            results = list(pool.map(run_case, *zip(*jobs)))
+    results = run_jobs(run_case, jobs, args.workers, args.scheduler)
     wall = time.perf_counter() - t0
 
     rows = [add_errors(r, c) for r, c in zip(results, cases)]

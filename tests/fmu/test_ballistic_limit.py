@@ -1,0 +1,119 @@
+"""examples/ballistic_limit.py on a tiny case: what its machinery can be
+held to while the 3-D solver cannot yet run a perforation to its end
+(VALIDATION.md, "Ballistic penetration"): every shot's values are the
+command line's bit for bit, a shot's status follows from its values (the
+capture speed computed here from the masses), a solver stop is reported
+with the command line's message and left out of the fit, the fit printed is
+lambert_jonas.fit of the shots it says it fits, and the plot is written.
+
+The case: 3 nodes across the projectile's radius, a plate 20 mm across
+(278 nodes), 10 µs. At that resolution and plate size the shots are not
+residual velocities (the velocities still change at 10 µs, and 1500 m/s
+stops with a spacing collapse at 8.5 µs): the fit is run on them
+(--fit-unsettled) to test the machinery, not for its numbers."""
+
+import csv
+import importlib.util
+import math
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+from dask.distributed import LocalCluster
+
+from conftest import ROOT
+from test_ballistic import cli_pen, cli_stop
+
+spec = importlib.util.spec_from_file_location("lambert_jonas", ROOT / "examples" / "lambert_jonas.py")
+lj = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(lj)
+
+SCRIPT = ROOT / "examples" / "ballistic_limit.py"
+PARAMS = {"particles_radial": 3, "plate_diameter": 0.02, "end_time": 1e-5}
+ARGS = ["--particles-radial", "3", "--set", "plate_diameter=0.02", "--end-time", "1e-5"]
+OUTPUTS = ["projectile_velocity", "projectile_extent", "hole_radius", "damaged_fraction", "pulverized_fraction",
+           "max_damage", "energy_error"]
+
+
+def run_script(*args):
+    """Runs the sweep as users do: `python examples/ballistic_limit.py ...`."""
+    r = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=300)
+    return r.returncode, r.stdout + r.stderr
+
+
+def read(path):
+    with open(path, newline="") as f:
+        return {float(r["V_mps"]): r for r in csv.DictReader(f)}
+
+
+def capture_speed(v):
+    """m_p V / (m_p + m_plate) of the tiny case (the scene's defaults: a
+    tungsten rod 10 x 10 mm, an AD85 plate 5 mm thick, here 20 mm across)."""
+    mp = 16980.0 * math.pi / 4 * 0.01**2 * 0.01
+    mt = 3420.0 * math.pi / 4 * 0.02**2 * 0.005
+    return mp * v / (mp + mt)
+
+
+def check_shots(rows, tmp_path, tmp_path_factory):
+    """Each shot against the command line on its parameters; returns the
+    shots (V, V_r) the script should fit with --fit-unsettled."""
+    fitted = []
+    for v, r in sorted(rows.items()):
+        params = {**PARAMS, "impact_speed": v}
+        assert float(r["capture_speed_mps"]) == capture_speed(v)
+        if r["status"] == "error":
+            message, ref = cli_stop(tmp_path, params)
+            assert r["error"] == f"fmi3DoStep: the solver stopped: {message}"
+            assert r["Vr_mps"] == "" and r["velocity_change_mps"] == ""
+        else:
+            ref = cli_pen(tmp_path_factory, params)
+            assert r["error"] == ""
+            vr = float(r["Vr_mps"])
+            if ref["projectile_velocity"] <= capture_speed(v):
+                assert r["status"] == "stopped" and vr == 0.0
+            else:
+                settled = float(r["velocity_change_mps"]) <= 0.01 * v
+                assert r["status"] == ("through" if settled else "unsettled")
+                assert vr == ref["projectile_velocity"]
+            fitted.append((v, vr))
+        for name in OUTPUTS:  # bit for bit, at the end or at the stop
+            assert float(r[name]) == ref[name], f"{v} m/s, {name}: {r[name]} CLI {ref[name]!r}"
+    return fitted
+
+
+def test_sweep_on_the_local_process_pool(tmp_path, tmp_path_factory):
+    out, plot = tmp_path / "shots.csv", tmp_path / "shots.svg"
+    code, log = run_script("--speeds", "100,600,900,1500", *ARGS, "--fit-unsettled", "--workers", "2",
+                           "--out", str(out), "--plot", str(plot))
+    assert code == 1, log  # a shot stopped with an error
+    rows = read(out)
+    assert sorted(rows) == [100.0, 600.0, 900.0, 1500.0]
+    assert [rows[v]["status"] for v in sorted(rows)] == ["stopped", "unsettled", "unsettled", "error"], log
+    fitted = check_shots(rows, tmp_path, tmp_path_factory)
+    assert "shot at 1500 m/s: ERROR (left out of the fit): fmi3DoStep: the solver stopped: particle spacing" in log
+    assert "warning: 2 shots unsettled at end_time = 1e-05 s" in log and "fitted anyway" in log
+    fit = lj.fit(fitted)
+    assert (f"ballistic limit V_bl = {fit.v_bl:.1f} m/s, a = {fit.a:.4f}, p = {fit.p:.3f}, "
+            f"rms residual {fit.rms:.2f} m/s (3 shots fitted)") in log, log
+    assert 100.0 <= fit.v_bl < 600.0
+    svg = ET.parse(plot).getroot()
+    ns = "{http://www.w3.org/2000/svg}"
+    assert len(svg.findall(f"{ns}circle")) == 3 and len(svg.findall(f"{ns}path")) == 1  # the error's cross
+    assert len(svg.findall(f"{ns}polyline")) == 1
+    assert f"plot (SVG written without matplotlib) -> {plot}" in log or f"plot -> {plot}" in log
+
+
+def test_sweep_on_a_local_dask_cluster_leaves_unsettled_shots_out(tmp_path, tmp_path_factory):
+    """On Dask, without --fit-unsettled: no residual velocities, so no fit,
+    and the script says why; the shots are those of the command line."""
+    out = tmp_path / "dask.csv"
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        code, log = run_script("--scheduler", cluster.scheduler_address, "--speeds", "100,600", *ARGS,
+                               "--out", str(out), "--no-plot")
+    assert code == 1, log
+    rows = read(out)
+    assert [rows[v]["status"] for v in sorted(rows)] == ["stopped", "unsettled"], log
+    check_shots(rows, tmp_path, tmp_path_factory)
+    assert "left out of the fit: 600 m/s" in log
+    assert "no fit: 0 perforating shots; the fit needs at least 2 (1 shots fitted)" in log, log
+    assert "no plot (--no-plot)" in log
