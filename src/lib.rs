@@ -136,7 +136,7 @@ pub mod internals {
     pub mod mlpg {
         pub use crate::mlpg::mls::distance;
         pub use crate::mlpg::penetration::{Penetration, PenetrationSetup};
-        pub use crate::mlpg::solver::SMOOTHING;
+        pub use crate::mlpg::solver::{SMOOTHING, WeakForm};
         pub use crate::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
         pub use crate::mlpg::step::{OMEGA_FACTOR, largest_eigenvalue, stable_step};
         pub use crate::mlpg::weak::VOIGT;

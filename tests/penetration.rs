@@ -38,6 +38,9 @@ fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0.0);
+    if std::env::var("MI_WEAK").is_ok_and(|w| w == "1") {
+        numerics.weak_form = meshless_impact::internals::mlpg::WeakForm::Nodal;
+    }
     Penetration::new(
         setup,
         tungsten(),
@@ -48,7 +51,8 @@ fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
 }
 
 /// Exploration: the seed's case, printed as it runs (`MI_RINGS` rings,
-/// `MI_ALPHA` smoothing, `MI_SHIFT` shifting, `MI_END` end time); with
+/// `MI_ALPHA` smoothing, `MI_SHIFT` shifting, `MI_END` end time,
+/// `MI_WEAK=1` the nodal weak form); with
 /// `MI_DIAGNOSE=e`, the nodes that gain the most kinetic energy in the
 /// first three steps past the energy error `e`; at a stop, the closest
 /// pair of one body.

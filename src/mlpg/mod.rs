@@ -30,6 +30,7 @@
 pub mod contact;
 pub mod lattice;
 pub mod mls;
+pub mod nodal;
 pub mod penetration;
 pub mod profile;
 pub mod shift;

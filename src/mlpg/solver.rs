@@ -59,6 +59,7 @@
 use super::contact;
 use super::lattice::{Cylinder, NodeLattice, Surfaces};
 use super::mls::{NodalShapes, SupportParams, Supports, distance};
+use super::nodal::NodalOperator;
 use super::profile::{Phase, PhaseTimes};
 use super::shift::{Freedom, carry, shifts};
 use super::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii};
@@ -146,6 +147,36 @@ pub struct RodSetup {
     /// Taylor run; above the plate for a penetration run.
     #[serde(default)]
     pub base: f64,
+    /// The weak form of the forces ([`WeakForm`]; the seed's by default).
+    #[serde(default)]
+    pub weak_form: WeakForm,
+}
+
+/// The weak form of the nodal forces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum WeakForm {
+    /// The seed's local weak form with the Heaviside test function over
+    /// each node's test sphere (eq. 10, [`TractionOperator`]), the sphere's
+    /// inertia `ρ V_s`.
+    #[default]
+    Sphere,
+    /// The nodal Galerkin form, the adjoint of the collocated gradients
+    /// (eq. 4; [`super::nodal`]), the nodal mass as inertia: it conserves
+    /// momentum and creates no energy, and node shifting also moves the
+    /// nodes of the mantle in its tangent plane and the face nodes held on
+    /// the anvil in its plane (README, "3-D MLPG mixed method").
+    Nodal,
+}
+
+impl WeakForm {
+    /// The form of a scene's `weak_form` value: 0 the sphere, 1 nodal.
+    pub fn of(value: f64) -> Self {
+        if value >= 0.5 {
+            WeakForm::Nodal
+        } else {
+            WeakForm::Sphere
+        }
+    }
 }
 
 impl RodSetup {
@@ -163,6 +194,7 @@ impl RodSetup {
             smoothing: SMOOTHING,
             shifting: 0.0,
             base: 0.0,
+            weak_form: WeakForm::Sphere,
         }
     }
 }
@@ -192,6 +224,8 @@ struct Geometry {
     shapes: NodalShapes,
     spheres: Vec<TestSphere>,
     op: TractionOperator,
+    /// The nodal form's operator (empty with the sphere form).
+    nodal: NodalOperator,
 }
 
 /// A 3-D MLPG run of a rod striking a rigid smooth anvil.
@@ -315,6 +349,8 @@ struct Scratch {
     smooth: Vec<[f64; 3]>,
     moved: Vec<(f64, f64, bool, Option<f64>)>,
     grad: Vec<[[f64; 3]; 3]>,
+    /// The nodal volumes `m / ρ` (the nodal form).
+    volume: Vec<f64>,
     results: Vec<std::result::Result<Tally, (usize, Error)>>,
     /// The shifts and the carried fields (sized only with `shifting > 0`).
     shift: Vec<[f64; 3]>,
@@ -342,6 +378,7 @@ impl Scratch {
         self.smooth.resize(n, [0.0; 3]);
         self.moved.resize(n, (0.0, 0.0, false, None));
         self.grad.resize(n, [[0.0; 3]; 3]);
+        self.volume.resize(n, 0.0);
         self.results.resize(n, Ok(Tally::default()));
     }
 
@@ -591,6 +628,7 @@ impl Mlpg3d {
         // most of the heap (BENCHMARKS.md, "3-D MLPG speed").
         g.shapes = NodalShapes::default();
         g.op = TractionOperator::default();
+        g.nodal = NodalOperator::default();
         if supports || g.supports.is_none() {
             g.supports = Some(Supports::compute_grouped(
                 &self.supports_at,
@@ -604,17 +642,25 @@ impl Mlpg3d {
         let pts = &self.built_at;
         g.shapes = NodalShapes::build(pts, sup).map_err(at_time)?;
         self.profile.lap(Phase::Shapes, &mut clock);
-        g.spheres = self.spheres(pts, sup, &g.shapes);
-        self.profile.lap(Phase::Spheres, &mut clock);
-        g.op = TractionOperator::build(
-            self.isa,
-            pts,
-            sup,
-            &g.spheres,
-            &SphereRule::of(DEFAULT_RULE),
-            &SphereRule::of(BOUNDARY_RULE),
-        )
-        .map_err(at_time)?;
+        match self.setup.weak_form {
+            WeakForm::Sphere => {
+                g.spheres = self.spheres(pts, sup, &g.shapes);
+                self.profile.lap(Phase::Spheres, &mut clock);
+                g.op = TractionOperator::build(
+                    self.isa,
+                    pts,
+                    sup,
+                    &g.spheres,
+                    &SphereRule::of(DEFAULT_RULE),
+                    &SphereRule::of(BOUNDARY_RULE),
+                )
+                .map_err(at_time)?;
+            }
+            WeakForm::Nodal => {
+                g.spheres.clear();
+                g.nodal = NodalOperator::build(&g.shapes);
+            }
+        }
         self.profile.lap(Phase::Operator, &mut clock);
         self.profile.operators += 1;
         self.geometry = Some(g);
@@ -873,7 +919,17 @@ impl Mlpg3d {
         });
         let g = self.geometry.as_ref().expect("built above");
         let force = &mut scratch.force;
-        g.op.apply(total, force);
+        let nodal = self.setup.weak_form == WeakForm::Nodal;
+        if nodal {
+            let volume = &mut scratch.volume;
+            volume
+                .par_iter_mut()
+                .zip(self.mass.par_iter().zip(self.rho.par_iter()))
+                .for_each(|(v, (m, r))| *v = m / r);
+            g.nodal.apply(total, volume, force);
+        } else {
+            g.op.apply(total, force);
+        }
         self.profile.lap(Phase::Force, &mut clock);
         // 2-3. Velocities, contact, positions.
         if !self.group.is_empty() || self.damaging() {
@@ -889,7 +945,7 @@ impl Mlpg3d {
             .enumerate()
             .for_each(|(i, ((v, touch), out))| {
                 let f = force[i];
-                let inertia = rho[i] * volume[i];
+                let inertia = if nodal { mass[i] } else { rho[i] * volume[i] };
                 // A node held on the anvil loses the speed it had toward it
                 // (only at impact: afterwards it is zero); the anvil's
                 // reaction on a node at rest does no work.
@@ -1219,20 +1275,42 @@ impl Mlpg3d {
     /// Node shifting ([`super::shift`]): pushes apart the pairs closer than
     /// [`SHIFT_RANGE`] of the initial spacing and carries the fields of the
     /// moved nodes to their new places with the shapes of the last build.
-    /// The surfaces (face, mantle, top) stay put, an interior node on the
-    /// anvil moves in its plane. (Measured: letting the surface nodes move
-    /// in their tangent planes, the face nodes on the anvil in its plane,
-    /// made the Wilkins bar in 3-D stop earlier, EnergyDrift at 44.7 µs
-    /// against 55.6 µs; README, "3-D MLPG mixed method".) The kinetic energy the carrying changes is
-    /// booked with the smoothing. Fails with the compression limit of the
+    /// An interior node on the anvil moves in its plane. With the sphere
+    /// form the surfaces (face, mantle, top) stay put (measured: letting
+    /// the surface nodes move in their tangent planes, the face nodes on
+    /// the anvil in its plane, made the Wilkins bar in 3-D stop earlier,
+    /// EnergyDrift at 44.7 µs against 55.6 µs); with the nodal form, which
+    /// has no test sphere to cut, a node of the mantle alone moves in the
+    /// mantle's tangent plane (its Nanson normal, as the sphere form's cut
+    /// planes) and a face node held on the anvil in the anvil's plane, while
+    /// edges, the top and the free face stay put (measured: with the mantle
+    /// fixed, two mantle nodes of the Wilkins bar's bulge close to the
+    /// guard at 59.6 µs; README, "3-D MLPG mixed method"). The kinetic
+    /// energy the carrying changes is booked with the smoothing. Fails with the compression limit of the
     /// equation of state at a moved node.
     fn shift(&mut self, scratch: &mut Scratch) -> Result<()> {
         let spacing = self.d_min0;
         let g = self.geometry.as_ref().expect("built before the step");
         let (surf, contact, anvil) = (&self.lattice.surfaces, &self.contact, self.anvil);
+        let nodal = self.setup.weak_form == WeakForm::Nodal;
+        // F⁻¹ = ∂X/∂x at every node, for the mantle's normal (nodal form).
+        let finv = &mut scratch.grad;
+        if nodal && anvil {
+            g.shapes.velocity_gradients(&self.reference, finv);
+        }
+        let reference = &self.reference;
         scratch.free.par_iter_mut().enumerate().for_each(|(i, f)| {
             *f = if !anvil {
                 Freedom::Unbounded
+            } else if nodal && surf[i] == Surfaces(Surfaces::MANTLE) {
+                let x = reference[i];
+                let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
+                let big = [x[0] / r, x[1] / r, 0.0];
+                Freedom::InPlane(unit(std::array::from_fn(|b| {
+                    (0..3).map(|a| big[a] * finv[i][a][b]).sum::<f64>()
+                })))
+            } else if nodal && surf[i] == Surfaces(Surfaces::FACE) && contact[i] {
+                Freedom::InPlane([0.0, 0.0, 1.0])
             } else if !surf[i].interior() {
                 Freedom::Fixed
             } else if contact[i] {
@@ -1356,6 +1434,7 @@ impl Mlpg3d {
             + b(&k.smooth)
             + b(&k.moved)
             + b(&k.grad)
+            + b(&k.volume)
             + b(&k.results)
             + b(&k.shift)
             + b(&k.free)
@@ -1371,7 +1450,7 @@ impl Mlpg3d {
             shapes = b(&h.offsets) + b(&h.nodes) + b(&h.phi) + b(&h.grad);
             spheres = b(&g.spheres);
             let o = &g.op;
-            op = b(&o.offsets) + b(&o.nodes) + b(&o.b) + b(&o.volume);
+            op = b(&o.offsets) + b(&o.nodes) + b(&o.b) + b(&o.volume) + g.nodal.bytes();
         }
         [
             ("node fields", fields),
@@ -1379,7 +1458,7 @@ impl Mlpg3d {
             ("supports", supports),
             ("shapes at the nodes", shapes),
             ("test spheres", spheres),
-            ("traction operator", op),
+            ("traction operator (or the nodal one)", op),
         ]
     }
 

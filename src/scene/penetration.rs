@@ -16,7 +16,7 @@ use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::Cylinder;
 use crate::mlpg::penetration::{Penetration, PenetrationSetup};
-use crate::mlpg::solver::{DAMPING, REBUILD_STRAIN, RodSetup};
+use crate::mlpg::solver::{DAMPING, REBUILD_STRAIN, RodSetup, WeakForm};
 use crate::observe::PENETRATION_OBSERVABLES;
 use std::collections::BTreeMap;
 
@@ -172,6 +172,7 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(0.0, 1.0),
         "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian",
     ),
+    super::taylor3d::WEAK_FORM,
     row(
         "end_time",
         "s",
@@ -248,6 +249,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     numerics.rebuild_strain = REBUILD_STRAIN;
     numerics.smoothing = v("smoothing_coefficient")?;
     numerics.shifting = v("shifting")?;
+    numerics.weak_form = WeakForm::of(v("weak_form")?);
     Ok((setup, (projectile_material, plate_material), numerics))
 }
 

@@ -15,7 +15,7 @@ use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
 use crate::material::Material;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::Cylinder;
-use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
+use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING, WeakForm};
 use crate::observe::TAYLOR3D_OBSERVABLES;
 
 /// The registry row of the `taylor3d` scene.
@@ -55,6 +55,18 @@ fn material_choice(s: &Scene) -> MaterialChoice {
         .expect("the taylor3d scene has a material choice")
 }
 
+/// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
+/// over test spheres (eq. 10), 1 the nodal Galerkin form
+/// ([`crate::mlpg::nodal`]).
+pub(crate) const WEAK_FORM: ParamSpec = spec(
+    "weak_form",
+    "1",
+    0.0,
+    Range::integer(0.0, 1.0),
+    "forces of the MLPG solver: 0 = the seed's local weak form over test spheres (eq. 10), 1 = nodal Galerkin form, \
+     the adjoint of the collocated gradients, which conserves momentum and energy (README, 3-D MLPG)",
+);
+
 /// The numerical parameters and the end time: the rows after the material
 /// block.
 const AFTER: &[ParamSpec] = &[
@@ -93,6 +105,7 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(0.0, 1.0),
         "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the seed",
     ),
+    WEAK_FORM,
     END_TIME,
 ];
 
@@ -148,7 +161,7 @@ param_struct! {
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
         melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
         particles_radial, damping, smoothing_coefficient, rebuild_strain, shifting,
-        end_time,
+        weak_form, end_time,
     }
 }
 
@@ -208,6 +221,7 @@ impl Taylor3dParams {
         s.rebuild_strain = self.rebuild_strain;
         s.smoothing = self.smoothing_coefficient;
         s.shifting = self.shifting;
+        s.weak_form = WeakForm::of(self.weak_form);
         s
     }
 

@@ -1,0 +1,207 @@
+//! The nodal Galerkin form of the 3-D solver's forces: the adjoint of the
+//! collocated velocity gradients (eq. 4), an alternative to the seed's
+//! local weak form over test spheres (eq. 10, [`super::weak`]).
+//!
+//! The velocity gradient at node `i` is `L_i = Σ_J v_J ⊗ ∇φ_J(x_i)`
+//! (eq. 4). With the nodal volumes `V_i = m_i / ρ_i`, the stress power of
+//! the body is `P = Σ_i V_i σ_i : L_i`, and the nodal forces are taken as
+//! its derivative with respect to the nodal velocities,
+//!
+//! `F_J = −∂P/∂v_J = −Σ_i V_i σ_i · ∇φ_J(x_i)`,
+//!
+//! with the nodal mass `m_J` as the inertia. Then, whatever the shapes:
+//!
+//! - `Σ_J F_J · v_J = −P` exactly: the work of the forces is the stress
+//!   power the material update books, so the discrete equations exchange
+//!   kinetic and internal energy without creating either (the sphere form
+//!   does not: its `F` is not the adjoint of its `L`);
+//! - `Σ_J F_J = 0` to round-off, as the MLS derivatives sum to zero
+//!   (partition of unity): momentum is conserved;
+//! - the free surfaces are traction-free by construction (a natural
+//!   boundary condition), with no test sphere to cut and no normal to
+//!   estimate.
+//!
+//! This is direct nodal integration of the Galerkin weak form (Beissel &
+//! Belytschko 1996; Chen et al. 2001, who stabilise it); its zero-energy
+//! modes are those the velocity smoothing toward the MLS approximation
+//! damps (README, "3-D MLPG mixed method": the weak form, measured).
+//!
+//! The operator is stored transposed (a row per node `J` listing the `i`
+//! whose shapes name it), so that each force is a gather in a fixed order:
+//! the same bits for any number of threads.
+
+use super::mls::NodalShapes;
+use super::weak::VOIGT;
+use rayon::prelude::*;
+
+/// The transpose of the nodal shape-function gradients: for each node
+/// `J`, the nodes `i` (ascending) with `∇φ_J(x_i)`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NodalOperator {
+    /// Row `J` is `offsets[J]..offsets[J + 1]`.
+    pub offsets: Vec<usize>,
+    /// The nodes `i` whose shapes name `J`, ascending in each row.
+    pub nodes: Vec<usize>,
+    /// `∇φ_J(x_i)` (1/m).
+    pub grad: Vec<[f64; 3]>,
+}
+
+impl NodalOperator {
+    /// The transpose of `shapes` (a counting sort: rows in node order,
+    /// each in ascending `i`).
+    pub fn build(shapes: &NodalShapes) -> Self {
+        let n = shapes.offsets.len().saturating_sub(1);
+        let mut offsets = vec![0usize; n + 1];
+        for &j in &shapes.nodes {
+            offsets[j + 1] += 1;
+        }
+        for j in 0..n {
+            offsets[j + 1] += offsets[j];
+        }
+        let mut next = offsets.clone();
+        let mut nodes = vec![0usize; shapes.nodes.len()];
+        let mut grad = vec![[0.0; 3]; shapes.nodes.len()];
+        for i in 0..n {
+            for q in shapes.row(i) {
+                let j = shapes.nodes[q];
+                nodes[next[j]] = i;
+                grad[next[j]] = shapes.grad[q];
+                next[j] += 1;
+            }
+        }
+        NodalOperator {
+            offsets,
+            nodes,
+            grad,
+        }
+    }
+
+    /// The forces `F_J = −Σ_i V_i σ_i · ∇φ_J(x_i)` of the stresses
+    /// `stress` (`[xx, yy, zz, xy, yz, zx]`) on the nodal volumes
+    /// `volume`, written into `out`.
+    pub fn apply(&self, stress: &[[f64; 6]], volume: &[f64], out: &mut [[f64; 3]]) {
+        out.par_iter_mut().enumerate().for_each(|(j, f)| {
+            *f = [0.0; 3];
+            for q in self.offsets[j]..self.offsets[j + 1] {
+                let i = self.nodes[q];
+                let (s, g, v) = (&stress[i], self.grad[q], volume[i]);
+                for c in 0..3 {
+                    f[c] -=
+                        v * (s[VOIGT[c][0]] * g[0] + s[VOIGT[c][1]] * g[1] + s[VOIGT[c][2]] * g[2]);
+                }
+            }
+        });
+    }
+
+    /// Bytes held by the operator.
+    pub fn bytes(&self) -> usize {
+        self.offsets.capacity() * std::mem::size_of::<usize>()
+            + self.nodes.capacity() * std::mem::size_of::<usize>()
+            + self.grad.capacity() * std::mem::size_of::<[f64; 3]>()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mlpg::mls::tests::{jittered_cube, uniform};
+    use crate::mlpg::mls::{SupportParams, Supports};
+
+    /// A jittered cube, its nodal shapes, random stresses, velocities and
+    /// volumes.
+    #[allow(clippy::type_complexity)]
+    fn setup() -> (NodalShapes, Vec<[f64; 6]>, Vec<[f64; 3]>, Vec<f64>) {
+        let pts = jittered_cube(6, 1e-3, 0.3, 11);
+        let sup = Supports::compute(&pts, SupportParams::default()).unwrap();
+        let shapes = NodalShapes::build(&pts, &sup).unwrap();
+        let mut seed = 7u64;
+        let mut r = |scale: f64| scale * (2.0 * uniform(&mut seed) - 1.0);
+        let n = pts.len();
+        let stress: Vec<[f64; 6]> = (0..n).map(|_| std::array::from_fn(|_| r(1e9))).collect();
+        let vel: Vec<[f64; 3]> = (0..n).map(|_| std::array::from_fn(|_| r(100.0))).collect();
+        let vol: Vec<f64> = (0..n).map(|_| 1e-9 * (1.0 + 0.5 * r(1.0))).collect();
+        (shapes, stress, vel, vol)
+    }
+
+    /// The work of the forces is minus the stress power of the collocated
+    /// gradients (eq. 4), to round-off: the operator is their adjoint.
+    #[test]
+    fn the_forces_do_the_work_of_the_stress_power() {
+        let (shapes, stress, vel, vol) = setup();
+        let n = vel.len();
+        let op = NodalOperator::build(&shapes);
+        let mut f = vec![[0.0; 3]; n];
+        op.apply(&stress, &vol, &mut f);
+        let mut l = vec![[[0.0; 3]; 3]; n];
+        shapes.velocity_gradients(&vel, &mut l);
+        let power: f64 = (0..n)
+            .map(|i| {
+                let s = &stress[i];
+                let mut p = 0.0;
+                for a in 0..3 {
+                    for b in 0..3 {
+                        p += s[VOIGT[a][b]] * l[i][a][b];
+                    }
+                }
+                vol[i] * p
+            })
+            .sum();
+        let work: f64 = (0..n)
+            .map(|j| (0..3).map(|c| f[j][c] * vel[j][c]).sum::<f64>())
+            .sum();
+        // The scale of the terms summed: Σ V |σ| |L|.
+        let scale: f64 = (0..n)
+            .map(|i| {
+                let s: f64 = stress[i].iter().map(|x| x * x).sum::<f64>().sqrt();
+                let g: f64 = l[i].iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
+                vol[i] * s * g
+            })
+            .sum();
+        assert!(
+            (work + power).abs() < 1e-12 * scale,
+            "work {work:e}, stress power {power:e}, scale {scale:e}"
+        );
+        assert!(
+            power.abs() > 1e-3 * scale,
+            "a power far from zero is tested"
+        );
+    }
+
+    /// The forces sum to zero (momentum is conserved), to round-off.
+    #[test]
+    fn the_forces_sum_to_zero() {
+        let (shapes, stress, vel, vol) = setup();
+        let n = vel.len();
+        let op = NodalOperator::build(&shapes);
+        let mut f = vec![[0.0; 3]; n];
+        op.apply(&stress, &vol, &mut f);
+        let largest = f.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        for c in 0..3 {
+            let sum: f64 = f.iter().map(|x| x[c]).sum();
+            assert!(sum.abs() < 1e-12 * largest * n as f64, "Σ F_{c} = {sum:e}");
+        }
+        assert!(largest > 0.0);
+    }
+
+    /// The transpose holds every entry of the shapes once, each row in
+    /// ascending order.
+    #[test]
+    fn the_transpose_holds_the_shapes() {
+        let (shapes, _, vel, _) = setup();
+        let n = vel.len();
+        let op = NodalOperator::build(&shapes);
+        assert_eq!(op.nodes.len(), shapes.nodes.len());
+        for j in 0..n {
+            let row = op.offsets[j]..op.offsets[j + 1];
+            assert!(op.nodes[row.clone()].windows(2).all(|w| w[0] < w[1]));
+            for q in row {
+                let i = op.nodes[q];
+                let k = shapes
+                    .row(i)
+                    .find(|&k| shapes.nodes[k] == j)
+                    .expect("the entry is in row i of the shapes");
+                assert_eq!(shapes.grad[k], op.grad[q]);
+            }
+        }
+    }
+}
