@@ -161,7 +161,7 @@ pub enum WeakForm {
     #[default]
     Sphere,
     /// The nodal Galerkin form, the adjoint of the collocated gradients
-    /// (eq. 4; [`super::nodal`]), the nodal mass as inertia: it conserves
+    /// (eq. 4; `src/mlpg/nodal.rs`), the nodal mass as inertia: it conserves
     /// momentum and creates no energy, and node shifting also moves the
     /// nodes of the mantle in its tangent plane and the face nodes held on
     /// the anvil in its plane (README, "3-D MLPG mixed method").

@@ -57,7 +57,7 @@ fn material_choice(s: &Scene) -> MaterialChoice {
 
 /// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
 /// over test spheres (eq. 10), 1 the nodal Galerkin form
-/// ([`crate::mlpg::nodal`]).
+/// (`src/mlpg/nodal.rs`).
 pub(crate) const WEAK_FORM: ParamSpec = spec(
     "weak_form",
     "1",
