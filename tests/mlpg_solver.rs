@@ -467,15 +467,7 @@ fn a_shifting_run_restored_mid_way_resumes_to_the_bits() {
 #[test]
 #[ignore = "exploration"]
 fn explore_wilkins3d_face() {
-    let path = std::env::var("MI_SCENE_FILE").unwrap_or_else(|_| {
-        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml").into()
-    });
-    let mut scene = Scene::from_file(&path).unwrap();
-    for kv in std::env::var("MI_SET").unwrap_or_default().split(',') {
-        if let Some((k, v)) = kv.split_once('=') {
-            scene.set(k, v.parse().unwrap()).unwrap();
-        }
-    }
+    let scene = wilkins_or_env_scene();
     let mut s = build3d(&scene);
     let mut next = 2.5e-6;
     let mut releases = 0usize;
@@ -537,6 +529,21 @@ fn explore_wilkins3d_face() {
     println!("stop at {:.3} us: {err:?}", s.time() * 1e6);
 }
 
+/// The scene of the explorations: the file `MI_SCENE_FILE` (default the
+/// Wilkins bar in 3-D) with the `MI_SET` overrides ("name=value,...").
+fn wilkins_or_env_scene() -> Scene {
+    let path = std::env::var("MI_SCENE_FILE").unwrap_or_else(|_| {
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml").into()
+    });
+    let mut scene = Scene::from_file(&path).unwrap();
+    for kv in std::env::var("MI_SET").unwrap_or_default().split(',') {
+        if let Some((k, v)) = kv.split_once('=') {
+            scene.set(k, v.parse().unwrap()).unwrap();
+        }
+    }
+    scene
+}
+
 /// The 3-D solver of a `taylor3d` scene, with the scene's material choice.
 fn build3d(scene: &Scene) -> Mlpg3d {
     let material = scene
@@ -557,15 +564,7 @@ fn build3d(scene: &Scene) -> Mlpg3d {
 #[test]
 #[ignore = "exploration"]
 fn explore_energy_jump() {
-    let path = std::env::var("MI_SCENE_FILE").unwrap_or_else(|_| {
-        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml").into()
-    });
-    let mut scene = Scene::from_file(&path).unwrap();
-    for kv in std::env::var("MI_SET").unwrap_or_default().split(',') {
-        if let Some((k, v)) = kv.split_once('=') {
-            scene.set(k, v.parse().unwrap()).unwrap();
-        }
-    }
+    let scene = wilkins_or_env_scene();
     let jump: f64 = std::env::var("MI_JUMP")
         .ok()
         .and_then(|s| s.parse().ok())
