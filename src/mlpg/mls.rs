@@ -757,17 +757,24 @@ impl NodalShapes {
     /// `L_i[a][b] = ∂v_a/∂x_b (x_i) = Σ_J v_J[a] ∂φ_J/∂x_b (x_i)`, written
     /// into `out` (one per node), in parallel.
     pub fn velocity_gradients(&self, velocity: &[[f64; 3]], out: &mut [[[f64; 3]; 3]]) {
-        out.par_iter_mut().enumerate().for_each(|(i, l)| {
-            *l = [[0.0; 3]; 3];
-            for q in self.row(i) {
-                let (v, g) = (velocity[self.nodes[q]], self.grad[q]);
-                for a in 0..3 {
-                    for b in 0..3 {
-                        l[a][b] += v[a] * g[b];
-                    }
+        out.par_iter_mut()
+            .enumerate()
+            .for_each(|(i, l)| *l = self.gradient(i, velocity));
+    }
+
+    /// The collocated gradient (eq. 4) of the nodal vector field `field`
+    /// at node `i`: `Σ_J f_J ⊗ ∇φ_J(x_i)`.
+    pub fn gradient(&self, i: usize, field: &[[f64; 3]]) -> [[f64; 3]; 3] {
+        let mut l = [[0.0; 3]; 3];
+        for q in self.row(i) {
+            let (v, g) = (field[self.nodes[q]], self.grad[q]);
+            for a in 0..3 {
+                for b in 0..3 {
+                    l[a][b] += v[a] * g[b];
                 }
             }
-        });
+        }
+        l
     }
 }
 

@@ -684,17 +684,10 @@ impl Mlpg3d {
             .into_par_iter()
             .map(|i| {
                 let s = surf[i];
-                let nanson = |big: [f64; 3]| -> [f64; 3] {
-                    let g = &finv[i];
-                    unit(std::array::from_fn(|b| {
-                        (0..3).map(|a| big[a] * g[a][b]).sum::<f64>()
-                    }))
-                };
+                let nanson = |big: [f64; 3]| nanson(&finv[i], big);
                 let mut out = [[0.0; 3]; 2];
                 if s.has(Surfaces::MANTLE) {
-                    let x = reference[i];
-                    let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
-                    out[0] = nanson([x[0] / r, x[1] / r, 0.0]);
+                    out[0] = nanson(radial(reference[i]));
                 }
                 if s.has(Surfaces::FACE) {
                     out[1] = if contact[i] {
@@ -1293,22 +1286,14 @@ impl Mlpg3d {
         let g = self.geometry.as_ref().expect("built before the step");
         let (surf, contact, anvil) = (&self.lattice.surfaces, &self.contact, self.anvil);
         let nodal = self.setup.weak_form == WeakForm::Nodal;
-        // F⁻¹ = ∂X/∂x at every node, for the mantle's normal (nodal form).
-        let finv = &mut scratch.grad;
-        if nodal && anvil {
-            g.shapes.velocity_gradients(&self.reference, finv);
-        }
-        let reference = &self.reference;
+        let (shapes, reference) = (&g.shapes, &self.reference);
         scratch.free.par_iter_mut().enumerate().for_each(|(i, f)| {
             *f = if !anvil {
                 Freedom::Unbounded
             } else if nodal && surf[i] == Surfaces(Surfaces::MANTLE) {
-                let x = reference[i];
-                let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
-                let big = [x[0] / r, x[1] / r, 0.0];
-                Freedom::InPlane(unit(std::array::from_fn(|b| {
-                    (0..3).map(|a| big[a] * finv[i][a][b]).sum::<f64>()
-                })))
+                // F⁻¹ = ∂X/∂x at this node only (eq. 4 on the reference places).
+                let finv = shapes.gradient(i, reference);
+                Freedom::InPlane(nanson(&finv, radial(reference[i])))
             } else if nodal && surf[i] == Surfaces(Surfaces::FACE) && contact[i] {
                 Freedom::InPlane([0.0, 0.0, 1.0])
             } else if !surf[i].interior() {
@@ -1655,6 +1640,20 @@ fn kinetic(v: &[[f64; 3]], m: &[f64]) -> f64 {
 
 fn norm(a: [f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Nanson's current outward normal `n ∝ F⁻ᵀ N` of the reference normal
+/// `big`, with `finv = F⁻¹ = ∂X/∂x` at the node.
+fn nanson(finv: &[[f64; 3]; 3], big: [f64; 3]) -> [f64; 3] {
+    unit(std::array::from_fn(|b| {
+        (0..3).map(|a| big[a] * finv[a][b]).sum::<f64>()
+    }))
+}
+
+/// The mantle's reference normal at the reference place `x`: radial.
+fn radial(x: [f64; 3]) -> [f64; 3] {
+    let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
+    [x[0] / r, x[1] / r, 0.0]
 }
 
 fn unit(a: [f64; 3]) -> [f64; 3] {
