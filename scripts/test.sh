@@ -13,15 +13,15 @@ cargo clippy --all-targets --release -- -D warnings
 cargo clippy --all-targets --release --no-default-features -- -D warnings
 echo "== cargo doc (broken or private links fail)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
-echo "== cargo test (release)"
+echo "== cargo test (profile ci: release optimisation, fast build)"
 # Where the processor has AVX-512, the tests that compare its copy of the hot
 # loops with the portable one fail rather than skip if they cannot run it.
 if grep -qw avx512f /proc/cpuinfo 2>/dev/null && grep -qw avx512vl /proc/cpuinfo; then
   export MI_REQUIRE_AVX512=1
   echo "(AVX-512 here: MI_REQUIRE_AVX512=1)"
 fi
-cargo test --release --all-targets
-cargo test --release --doc
+cargo test --profile ci --all-targets
+cargo test --profile ci --doc
 if [ -f examples_c/Makefile ]; then
   echo "== C examples"
   make -C examples_c test
