@@ -372,15 +372,17 @@ fn shifting_keeps_the_pairs_apart_that_collapse_without_it() {
 /// With node shifting the loop gives the same bits on one thread and on
 /// two (the coarse Wilkins bar over the steps around its plain collapse,
 /// where nodes shift), in both weak forms: the scene's nodal form, whose
-/// forces are gathered per node, and the seed's test spheres.
+/// forces are gathered per node, and the seed's test spheres; and with the
+/// order-2 smoothing, whose transpose is gathered per node too.
 #[test]
 fn shifting_gives_the_same_bits_on_one_thread_and_two() {
-    for form in [1.0, 0.0] {
+    for (form, order) in [(1.0, 1.0), (0.0, 1.0), (1.0, 2.0)] {
         same_bits_on_one_thread_and_two(|| {
             let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml");
             let mut scene = Scene::from_file(path).unwrap();
             scene.set("particles_radial", 3.0).unwrap();
             scene.set("weak_form", form).unwrap();
+            scene.set("smoothing_order", order).unwrap();
             let mut s = build3d(&scene);
             while s.time() < 35e-6 {
                 s.step().unwrap();

@@ -34,8 +34,9 @@ use super::mls::NodalShapes;
 use super::weak::VOIGT;
 use rayon::prelude::*;
 
-/// The transpose of the nodal shape-function gradients: for each node
-/// `J`, the nodes `i` (ascending) with `∇φ_J(x_i)`.
+/// The transpose of the nodal shape functions and their gradients: for
+/// each node `J`, the nodes `i` (ascending) with `φ_J(x_i)` and
+/// `∇φ_J(x_i)`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct NodalOperator {
     /// Row `J` is `offsets[J]..offsets[J + 1]`.
@@ -44,6 +45,8 @@ pub struct NodalOperator {
     pub nodes: Vec<usize>,
     /// `∇φ_J(x_i)` (1/m).
     pub grad: Vec<[f64; 3]>,
+    /// `φ_J(x_i)`.
+    pub phi: Vec<f64>,
 }
 
 impl NodalOperator {
@@ -61,11 +64,13 @@ impl NodalOperator {
         let mut next = offsets.clone();
         let mut nodes = vec![0usize; shapes.nodes.len()];
         let mut grad = vec![[0.0; 3]; shapes.nodes.len()];
+        let mut phi = vec![0.0; shapes.nodes.len()];
         for i in 0..n {
             for q in shapes.row(i) {
                 let j = shapes.nodes[q];
                 nodes[next[j]] = i;
                 grad[next[j]] = shapes.grad[q];
+                phi[next[j]] = shapes.phi[q];
                 next[j] += 1;
             }
         }
@@ -73,7 +78,23 @@ impl NodalOperator {
             offsets,
             nodes,
             grad,
+            phi,
         }
+    }
+
+    /// `out = Hᵀ y`, the transpose of the defect operator `H = I − Φ` with
+    /// `(Φ v)_i = Σ_J φ_J(x_i) v_J`: `out_J = y_J − Σ_i φ_J(x_i) y_i`.
+    pub fn defect_transpose(&self, y: &[[f64; 3]], out: &mut [[f64; 3]]) {
+        out.par_iter_mut().enumerate().for_each(|(j, o)| {
+            let mut m = [0.0; 3];
+            for q in self.offsets[j]..self.offsets[j + 1] {
+                let (yi, p) = (y[self.nodes[q]], self.phi[q]);
+                for c in 0..3 {
+                    m[c] += p * yi[c];
+                }
+            }
+            *o = std::array::from_fn(|c| y[j][c] - m[c]);
+        });
     }
 
     /// The forces `F_J = −Σ_i V_i σ_i · ∇φ_J(x_i)` of the stresses
@@ -98,6 +119,7 @@ impl NodalOperator {
         self.offsets.capacity() * std::mem::size_of::<usize>()
             + self.nodes.capacity() * std::mem::size_of::<usize>()
             + self.grad.capacity() * std::mem::size_of::<[f64; 3]>()
+            + self.phi.capacity() * std::mem::size_of::<f64>()
     }
 }
 
@@ -201,7 +223,91 @@ mod tests {
                     .find(|&k| shapes.nodes[k] == j)
                     .expect("the entry is in row i of the shapes");
                 assert_eq!(shapes.grad[k], op.grad[q]);
+                assert_eq!(shapes.phi[k], op.phi[q]);
             }
         }
+    }
+
+    /// `H v = v − Φ v` at every node, by the shapes' rows.
+    fn defect(shapes: &NodalShapes, v: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        (0..v.len())
+            .map(|i| {
+                let mut m = [0.0; 3];
+                for q in shapes.row(i) {
+                    for c in 0..3 {
+                        m[c] += shapes.phi[q] * v[shapes.nodes[q]][c];
+                    }
+                }
+                std::array::from_fn(|c| v[i][c] - m[c])
+            })
+            .collect()
+    }
+
+    fn dot(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (0..3).map(|c| x[c] * y[c]).sum::<f64>())
+            .sum()
+    }
+
+    /// The order-2 smoothing's `Hᵀ` is the adjoint of `H`
+    /// (`⟨Hᵀ y, v⟩ = ⟨y, H v⟩` to round-off), its columns sum to zero (the
+    /// filter `M⁻¹ Hᵀ M H` conserves momentum), and the filter is zero on
+    /// linear fields (the shapes reproduce them) and removes kinetic
+    /// energy from any other: `⟨v, Hᵀ M H v⟩ = |H v|²_M ≥ 0`.
+    #[test]
+    fn the_smoothing_transpose_is_the_adjoint_of_the_defect() {
+        let (shapes, _, vel, vol) = setup();
+        let n = vel.len();
+        let op = NodalOperator::build(&shapes);
+        let mass: Vec<f64> = vol.iter().map(|v| 8000.0 * v).collect();
+        let y: Vec<[f64; 3]> = (0..n).map(|i| vel[(7 * i + 3) % n]).collect();
+        let mut hty = vec![[0.0; 3]; n];
+        op.defect_transpose(&y, &mut hty);
+        let hv = defect(&shapes, &vel);
+        let (left, right) = (dot(&hty, &vel), dot(&y, &hv));
+        let scale = dot(&y, &y).sqrt() * dot(&vel, &vel).sqrt();
+        assert!(
+            (left - right).abs() < 1e-12 * scale,
+            "{left:e} against {right:e} (scale {scale:e})"
+        );
+        assert!(right.abs() > 1e-3 * scale, "a product far from zero");
+        let largest = hty.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        for c in 0..3 {
+            let sum: f64 = hty.iter().map(|x| x[c]).sum();
+            assert!(
+                sum.abs() < 1e-12 * largest * n as f64,
+                "Σ (Hᵀ y)_{c} = {sum:e}"
+            );
+        }
+        // A linear field: zero defect, so no change.
+        let pts: Vec<[f64; 3]> = crate::mlpg::mls::tests::jittered_cube(6, 1e-3, 0.3, 11);
+        let linear: Vec<[f64; 3]> = pts
+            .iter()
+            .map(|x| {
+                [
+                    3.0 + 2e3 * x[0] - 1e3 * x[2],
+                    -1.0 + 5e2 * x[1],
+                    4e3 * x[0] + 7e2 * x[1],
+                ]
+            })
+            .collect();
+        let h_lin = defect(&shapes, &linear);
+        let top = linear.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(h_lin.iter().flatten().all(|x| x.abs() < 1e-10 * top));
+        // The kinetic energy removed to first order in α.
+        let mhv: Vec<[f64; 3]> = hv
+            .iter()
+            .zip(&mass)
+            .map(|(w, m)| w.map(|c| m * c))
+            .collect();
+        op.defect_transpose(&mhv, &mut hty);
+        let removed = dot(&vel, &hty);
+        let norm: f64 = hv
+            .iter()
+            .zip(&mass)
+            .map(|(w, m)| m * dot(&[*w], &[*w]))
+            .sum();
+        assert!(removed > 0.0 && (removed - norm).abs() < 1e-12 * norm);
     }
 }

@@ -62,13 +62,16 @@ impl Penetration {
         let spacing = setup.projectile.radius / rings as f64;
         let plate_rings = ((setup.plate.radius / spacing).round() as usize).max(1);
         let reach = spacing.min(setup.plate.radius / plate_rings as f64);
-        let mut rod = RodSetup::new(setup.projectile, rings, setup.impact_speed, setup.end_time);
-        rod.damping = numerics.damping;
-        rod.safety = numerics.safety;
-        rod.rebuild_strain = numerics.rebuild_strain;
-        rod.smoothing = numerics.smoothing;
-        rod.shifting = numerics.shifting;
-        rod.base = reach;
+        // Every choice of `numerics` (the weak form and the smoothing's
+        // order too), on the projectile of `setup`.
+        let rod = RodSetup {
+            cylinder: setup.projectile,
+            rings,
+            impact_speed: setup.impact_speed,
+            end_time: setup.end_time,
+            base: reach,
+            ..numerics
+        };
         let plate_body = Body {
             cylinder: setup.plate,
             rings: plate_rings,

@@ -113,6 +113,10 @@ pub const REBUILD_STRAIN: f64 = 0.05;
 /// chosen for the smallest energy error (README, "3-D MLPG").
 pub const SMOOTHING: f64 = 0.1;
 
+/// Default order of the velocity smoothing ([`RodSetup::smoothing_order`]):
+/// 1, the relaxation toward the MLS approximation.
+pub const SMOOTHING_ORDER: u32 = 1;
+
 /// Energy error past which a run stops with [`Error::EnergyDrift`].
 pub const ENERGY_ERROR_BOUND: f64 = 0.5;
 
@@ -134,9 +138,18 @@ pub struct RodSetup {
     pub end_time: f64,
     /// See `REBUILD_STRAIN`.
     pub rebuild_strain: f64,
-    /// α of the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
-    /// after each velocity update ([`SMOOTHING`]).
+    /// α of the velocity smoothing `v ← v − α (I − Φ)^k v` after each
+    /// velocity update, with `(Φ v)_i = Σ_J φ_J(x_i) v_J` the MLS
+    /// approximation at the node ([`SMOOTHING`]).
     pub smoothing: f64,
+    /// The order of the smoothing (default 1): 1,
+    /// `v ← v − α H v` with `H = I − Φ`, relaxes each node toward the MLS
+    /// approximation; 2, `v ← v − α M⁻¹ Hᵀ M H v` (M the nodal masses), is
+    /// its symmetric square: it conserves momentum, only removes kinetic
+    /// energy, and damps smooth fields far less than the modes the shapes
+    /// cannot represent.
+    #[serde(default = "one")]
+    pub smoothing_order: u32,
     /// β of the node shifting (`src/mlpg/shift.rs`; the `taylor` scene's
     /// `shifting`): pairs closer than `SHIFT_RANGE` of the initial
     /// spacing push apart by up to β times the spacing per step
@@ -192,6 +205,7 @@ impl RodSetup {
             end_time,
             rebuild_strain: REBUILD_STRAIN,
             smoothing: SMOOTHING,
+            smoothing_order: SMOOTHING_ORDER,
             shifting: 0.0,
             base: 0.0,
             weak_form: WeakForm::Sphere,
@@ -224,7 +238,8 @@ struct Geometry {
     shapes: NodalShapes,
     spheres: Vec<TestSphere>,
     op: TractionOperator,
-    /// The nodal form's operator (empty with the sphere form).
+    /// The transposed shapes: the nodal form's operator, and the order-2
+    /// smoothing's `Hᵀ` (empty otherwise).
     nodal: NodalOperator,
 }
 
@@ -347,6 +362,10 @@ struct Scratch {
     force: Vec<[f64; 3]>,
     kicked: Vec<(f64, bool)>,
     smooth: Vec<[f64; 3]>,
+    /// The smoothing's defect `H v` (then `M⁻¹ Hᵀ M H v`) and the
+    /// mass-weighted defect.
+    defect: Vec<[f64; 3]>,
+    pass: Vec<[f64; 3]>,
     moved: Vec<(f64, f64, bool, Option<f64>)>,
     grad: Vec<[[f64; 3]; 3]>,
     /// The nodal volumes `m / ρ` (the nodal form).
@@ -365,6 +384,10 @@ struct Scratch {
     loose: Vec<bool>,
 }
 
+fn one() -> u32 {
+    1
+}
+
 fn anvil_default() -> bool {
     true
 }
@@ -376,6 +399,8 @@ impl Scratch {
         self.force.resize(n, [0.0; 3]);
         self.kicked.resize(n, (0.0, false));
         self.smooth.resize(n, [0.0; 3]);
+        self.defect.resize(n, [0.0; 3]);
+        self.pass.resize(n, [0.0; 3]);
         self.moved.resize(n, (0.0, 0.0, false, None));
         self.grad.resize(n, [[0.0; 3]; 3]);
         self.volume.resize(n, 0.0);
@@ -658,8 +683,10 @@ impl Mlpg3d {
             }
             WeakForm::Nodal => {
                 g.spheres.clear();
-                g.nodal = NodalOperator::build(&g.shapes);
             }
+        }
+        if self.setup.weak_form == WeakForm::Nodal || self.setup.smoothing_order >= 2 {
+            g.nodal = NodalOperator::build(&g.shapes);
         }
         self.profile.lap(Phase::Operator, &mut clock);
         self.profile.operators += 1;
@@ -968,7 +995,10 @@ impl Mlpg3d {
             let shapes = &g.shapes;
             let vel = &self.vel;
             let smooth = &mut scratch.smooth;
-            smooth.par_iter_mut().enumerate().for_each(|(i, out)| {
+            // The defect `w = H v = (I − Φ) v`; with order 2 the filter
+            // is `M⁻¹ Hᵀ M H v`, symmetric in the mass inner product.
+            let defect = &mut scratch.defect;
+            defect.par_iter_mut().enumerate().for_each(|(i, out)| {
                 let mut m = [0.0; 3];
                 for q in shapes.row(i) {
                     let vj = vel[shapes.nodes[q]];
@@ -976,8 +1006,23 @@ impl Mlpg3d {
                         m[d] += shapes.phi[q] * vj[d];
                     }
                 }
-                let mut v: [f64; 3] =
-                    std::array::from_fn(|d| vel[i][d] + alpha * (m[d] - vel[i][d]));
+                *out = std::array::from_fn(|d| vel[i][d] - m[d]);
+            });
+            if self.setup.smoothing_order >= 2 {
+                let pass = &mut scratch.pass;
+                pass.par_iter_mut()
+                    .zip(defect.par_iter())
+                    .zip(mass.par_iter())
+                    .for_each(|((y, w), m)| *y = w.map(|c| m * c));
+                g.nodal.defect_transpose(pass, defect);
+                defect
+                    .par_iter_mut()
+                    .zip(mass.par_iter())
+                    .for_each(|(z, m)| *z = z.map(|c| c / m));
+            }
+            let defect = &*defect;
+            smooth.par_iter_mut().enumerate().for_each(|(i, out)| {
+                let mut v: [f64; 3] = std::array::from_fn(|d| vel[i][d] - alpha * defect[i][d]);
                 if self.contact[i] {
                     v[2] = 0.0;
                 }
@@ -1417,6 +1462,8 @@ impl Mlpg3d {
             + b(&k.force)
             + b(&k.kicked)
             + b(&k.smooth)
+            + b(&k.defect)
+            + b(&k.pass)
             + b(&k.moved)
             + b(&k.grad)
             + b(&k.volume)

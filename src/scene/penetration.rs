@@ -165,6 +165,7 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(0.0, 0.5),
         "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, penetration)",
     ),
+    super::taylor3d::SMOOTHING_ORDER_SPEC,
     row(
         "shifting",
         "1",
@@ -248,6 +249,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     numerics.damping = DAMPING;
     numerics.rebuild_strain = REBUILD_STRAIN;
     numerics.smoothing = v("smoothing_coefficient")?;
+    numerics.smoothing_order = v("smoothing_order")? as u32;
     numerics.shifting = v("shifting")?;
     numerics.weak_form = WeakForm::of(v("weak_form")?);
     Ok((setup, (projectile_material, plate_material), numerics))
@@ -290,6 +292,25 @@ mod tests {
 
     /// A plate no wider than the projectile, and a run too big, are refused
     /// by name.
+    /// The weak form and the smoothing's order reach the run (the weak
+    /// form was once dropped on the way, and `weak_form = 1` ran the
+    /// spheres).
+    #[test]
+    fn the_solver_choices_reach_the_run() {
+        let mut s = Scene::builtin("penetration").unwrap();
+        s.set("particles_radial", 3.0).unwrap();
+        s.set("weak_form", 1.0).unwrap();
+        s.set("smoothing_order", 2.0).unwrap();
+        s.set("smoothing_coefficient", 0.3).unwrap();
+        let (setup, (projectile, plate), numerics) = setup(&s).unwrap();
+        let run = Penetration::new(setup, projectile, plate, numerics).unwrap();
+        let chosen = run.run().setup();
+        assert_eq!(chosen.weak_form, WeakForm::Nodal);
+        assert_eq!(chosen.smoothing_order, 2);
+        assert_eq!(chosen.smoothing, 0.3);
+        assert_eq!(chosen.impact_speed, 1500.0);
+    }
+
     #[test]
     fn inconsistent_scenes_are_refused() {
         let mut s = Scene::builtin("penetration").unwrap();

@@ -15,7 +15,9 @@ use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
 use crate::material::Material;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::Cylinder;
-use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING, WeakForm};
+use crate::mlpg::solver::{
+    DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING, SMOOTHING_ORDER, WeakForm,
+};
 use crate::observe::TAYLOR3D_OBSERVABLES;
 
 /// The registry row of the `taylor3d` scene.
@@ -55,6 +57,15 @@ fn material_choice(s: &Scene) -> MaterialChoice {
         .expect("the taylor3d scene has a material choice")
 }
 
+/// The `smoothing_order` row of the 3-D scenes (`taylor3d`, `penetration`).
+pub(crate) const SMOOTHING_ORDER_SPEC: ParamSpec = spec(
+    "smoothing_order",
+    "1",
+    SMOOTHING_ORDER as f64,
+    Range::integer(1.0, 2.0),
+    "MLPG velocity smoothing with H = I - Phi (Phi: the MLS approximation at the nodes): 1 = v <- v - alpha H v, 2 = v <- v - alpha M^-1 H^T M H v, its symmetric square, which spares smooth fields (README, 3-D MLPG)",
+);
+
 /// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
 /// over test spheres (eq. 10), 1 the nodal Galerkin form
 /// (`src/mlpg/nodal.rs`).
@@ -91,6 +102,7 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(0.0, 0.5),
         "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, 3-D MLPG)",
     ),
+    SMOOTHING_ORDER_SPEC,
     spec(
         "rebuild_strain",
         "1",
@@ -160,8 +172,8 @@ param_struct! {
         impact_speed, initial_length, initial_diameter, density, shear_modulus,
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
         melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
-        particles_radial, damping, smoothing_coefficient, rebuild_strain, shifting,
-        weak_form, end_time,
+        particles_radial, damping, smoothing_coefficient, smoothing_order, rebuild_strain,
+        shifting, weak_form, end_time,
     }
 }
 
@@ -220,6 +232,7 @@ impl Taylor3dParams {
         s.damping = self.damping;
         s.rebuild_strain = self.rebuild_strain;
         s.smoothing = self.smoothing_coefficient;
+        s.smoothing_order = self.smoothing_order as u32;
         s.shifting = self.shifting;
         s.weak_form = WeakForm::of(self.weak_form);
         s
