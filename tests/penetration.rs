@@ -176,14 +176,106 @@ fn explore_seed_case() {
 }
 
 /// The default scene at 4 nodes across the projectile's radius (3 rings,
-/// 7463 nodes), to `t`.
+/// 7463 nodes), to `t`: the scene's solver choices (the nodal form, the
+/// order-2 smoothing, node shifting).
 fn coarse(t: f64) -> Simulation {
+    coarse_with(t, &[])
+}
+
+/// The solver's choices of the scene before 2026-11-26: the seed's test
+/// spheres, no smoothing, no shifting.
+const PLAIN: &[(&str, f64)] = &[
+    ("weak_form", 0.0),
+    ("smoothing_order", 1.0),
+    ("smoothing_coefficient", 0.0),
+    ("shifting", 0.0),
+];
+
+/// [`coarse`] with parameters set.
+fn coarse_with(t: f64, sets: &[(&str, f64)]) -> Simulation {
     let mut scene = Scene::builtin("penetration").unwrap();
     scene.set("particles_radial", 4.0).unwrap();
     scene.set("end_time", t).unwrap();
+    for (k, v) in sets {
+        scene.set(k, *v).unwrap();
+    }
     let mut sim = Simulation::new(scene).unwrap();
     sim.run().unwrap();
     sim
+}
+
+/// The seed's residual velocity (section 5.2), m/s.
+const SEED_RESIDUAL: f64 = 1240.0;
+
+/// The projectile's velocity at the end of a run and its change over the
+/// last 5 µs.
+fn residual(sim: &Simulation) -> (f64, f64) {
+    let h = sim.history();
+    let v = h.column("projectile_velocity").unwrap();
+    let end = sim.time();
+    let k = h.times.iter().position(|&t| t >= end - 5e-6).unwrap();
+    let last = sim.observable("projectile_velocity").unwrap();
+    (last, last - v[k])
+}
+
+/// The seed's case with the scene's choices at 4 nodes across (7463
+/// nodes) runs to 20 µs with no named stop and the projectile through the
+/// plate: every projectile node below the plate's top face, its centre of
+/// mass past the back face (5 mm down). Its velocity, 1050.5 m/s, is
+/// 15.3 % below the seed's 1240 m/s, within the 20 % this coarse spacing
+/// gives, and still falls (by 18.9 m/s over the last 5 µs; VALIDATION.md,
+/// "Ballistic penetration": 1050.5, 1099.3 and 1127.6 m/s at 4, 5 and
+/// 6 across, the last settled and within the issue's 10 %,
+/// `the_seed_case_at_the_default_resolution_is_within_ten_percent`). The
+/// energy error is reported (measured 6.8 %; bound 10 %).
+#[test]
+fn the_seed_case_perforates_the_plate() {
+    let sim = coarse(20e-6);
+    let (v, change) = residual(&sim);
+    let (x, body, m) = (
+        sim.field("position").unwrap(),
+        sim.field("body").unwrap(),
+        node_masses(&sim),
+    );
+    let projectile: Vec<usize> = (0..sim.particles()).filter(|&i| body[i] == 0.0).collect();
+    let top = projectile
+        .iter()
+        .map(|&i| x[3 * i + 2])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let mass: f64 = projectile.iter().map(|&i| m[i]).sum();
+    let z_cm = projectile.iter().map(|&i| m[i] * x[3 * i + 2]).sum::<f64>() / mass;
+    println!(
+        "4 across: residual {v:.1} m/s ({:+.2} % of the seed's), change over 5 us {change:.2} m/s, \
+         energy error {:.4}, centre of mass at {:.2} mm, highest node at {:.2} mm",
+        100.0 * (v / SEED_RESIDUAL - 1.0),
+        sim.observable("energy_error").unwrap(),
+        1e3 * z_cm,
+        1e3 * top
+    );
+    assert!(top < 0.0 && z_cm < -5e-3, "top {top}, centre {z_cm}");
+    assert!((v / SEED_RESIDUAL - 1.0).abs() < 0.20, "residual {v} m/s");
+    let e = sim.observable("energy_error").unwrap();
+    assert!(e < 0.10, "energy error {e}");
+}
+
+/// The seed's case as the scene sets it (6 across, 30 527 nodes; about
+/// 90 s on two cores): the residual velocity within the issue's 10 % of
+/// the seed's 1240 m/s (measured 1127.6 m/s, −9.1 %), settled over the
+/// last 5 µs (−2.3 m/s). Run by `scripts/validate.sh`.
+#[test]
+#[ignore = "slow: run by scripts/validate.sh"]
+fn the_seed_case_at_the_default_resolution_is_within_ten_percent() {
+    let mut sim = Simulation::new(Scene::builtin("penetration").unwrap()).unwrap();
+    sim.run().unwrap();
+    let (v, change) = residual(&sim);
+    println!(
+        "default: {} nodes, residual {v:.1} m/s ({:+.2} %), change over 5 us {change:.2} m/s, energy error {:.4}",
+        sim.particles(),
+        100.0 * (v / SEED_RESIDUAL - 1.0),
+        sim.observable("energy_error").unwrap()
+    );
+    assert!(change.abs() < 0.01 * v, "still changing: {change} m/s");
+    assert!((v / SEED_RESIDUAL - 1.0).abs() < 0.10, "residual {v} m/s");
 }
 
 /// Total axial momentum `Σ m v_z` of a run (kg m/s).
@@ -196,7 +288,8 @@ fn momentum(sim: &Simulation, masses: &[f64]) -> f64 {
         .sum()
 }
 
-/// The seed's case, coarse, to 2 µs: the projectile has slowed and the
+/// The seed's case, coarse, to 2 µs, with the seed's test spheres and no
+/// smoothing or shifting ([`PLAIN`]): the projectile has slowed and the
 /// plate has taken up the momentum it lost. The contact's impulses conserve
 /// momentum exactly; the MLPG forces (the Heaviside weak form, eq. 10:
 /// a node's sphere, not its mass, takes the force) do not, and over the
@@ -207,8 +300,8 @@ fn momentum(sim: &Simulation, masses: &[f64]) -> f64 {
 /// projectile has shortened to 9.57 mm.
 #[test]
 fn the_seed_case_transfers_momentum_to_the_plate() {
-    let start = coarse(1e-12);
-    let sim = coarse(2e-6);
+    let start = coarse_with(1e-12, PLAIN);
+    let sim = coarse_with(2e-6, PLAIN);
     let n = sim.particles();
     let body = sim.field("body").unwrap();
     let o = |name: &str| sim.observable(name).unwrap();

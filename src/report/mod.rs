@@ -1,7 +1,8 @@
 //! The verification report (`meshless-impact report --out DIR`): error against
 //! run time, sensitivity, Table 1, figures like the paper's, a stability
-//! matrix of stiff, extreme and invalid cases, and the large-strain
-//! benchmarks beside their references. It is written as `DIR/index.md`
+//! matrix of stiff, extreme and invalid cases, the large-strain
+//! benchmarks beside their references, and the seed's ballistic case with
+//! its damage zones. It is written as `DIR/index.md`
 //! with a CSV file for every table and an SVG file for every figure.
 //!
 //! The report is a module of the program, not of the library (cargo feature
@@ -18,6 +19,7 @@
 mod benchmarks;
 mod convergence;
 mod figures;
+mod penetration;
 pub mod plot;
 mod profiles;
 pub mod runner;
@@ -283,6 +285,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     sensitivity::table1(&plan, &mut doc)?;
     stability::matrix(&plan, &mut doc)?;
     benchmarks::run(&plan, &mut doc)?;
+    penetration::damage(&plan, &mut doc)?;
     let wall_s = start.elapsed().as_secs_f64();
     let _ = writeln!(doc.text, "---\n\nWhole report: {wall_s:.1} s wall time.");
     let index = dir.join("index.md");

@@ -222,37 +222,94 @@ pub fn map(path: &Path, title: &str, positions: &[[f64; 3]], values: &[f64]) -> 
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    let v1 = if v1 > v0 { v1 } else { v0 + 1.0 };
     let rmax = positions.iter().map(|p| p[0]).fold(0.0, f64::max) * 1e3;
     let zmax = positions.iter().map(|p| p[1]).fold(0.0, f64::max) * 1e3;
-    // Equal scales on both axes: the plot's height follows the rod's aspect.
+    let points: Vec<(f64, f64)> = positions.iter().map(|p| (p[0] * 1e3, p[1] * 1e3)).collect();
+    plane(
+        path,
+        &Plane {
+            title,
+            x: "R (mm)",
+            y: "Z (mm)",
+            xs: (0.0, rmax * 1.05),
+            ys: (0.0, zmax * 1.02),
+            values: (v0, v1),
+        },
+        &points,
+        values,
+        &[],
+    )
+}
+
+/// The frame of a [`plane`] map: titles and ranges.
+#[derive(Debug, Clone, Copy)]
+pub struct Plane<'a> {
+    /// Plot title.
+    pub title: &'a str,
+    /// Horizontal axis label.
+    pub x: &'a str,
+    /// Vertical axis label.
+    pub y: &'a str,
+    /// Horizontal range.
+    pub xs: (f64, f64),
+    /// Vertical range.
+    pub ys: (f64, f64),
+    /// Range of the colour scale.
+    pub values: (f64, f64),
+}
+
+/// Points in a plane coloured by `values` (viridis, over `frame.values`),
+/// with a colour bar, equal scales on both axes, and the `grey` points
+/// drawn grey underneath (a body without the coloured field).
+pub fn plane(
+    path: &Path,
+    frame: &Plane,
+    points: &[(f64, f64)],
+    values: &[f64],
+    grey: &[(f64, f64)],
+) -> Result<()> {
+    let (v0, v1) = frame.values;
+    let v1 = if v1 > v0 { v1 } else { v0 + 1.0 };
+    let (x0, x1) = frame.xs;
+    let (y0, y1) = frame.ys;
+    // Equal scales on both axes: the plot's height follows the aspect.
     let width = 420u32;
-    let height = ((width as f64 - 90.0) * zmax / rmax.max(1e-9) + 80.0).clamp(300.0, 900.0) as u32;
+    let height =
+        ((width as f64 - 90.0) * (y1 - y0) / (x1 - x0).max(1e-9) + 80.0).clamp(300.0, 900.0) as u32;
     let root = SVGBackend::new(path, (width + 110, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
     let (left, right) = root.split_horizontally(width);
     let mut chart = ChartBuilder::on(&left)
-        .caption(title, ("sans-serif", 16))
+        .caption(frame.title, ("sans-serif", 16))
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(45)
-        .build_cartesian_2d(0.0..rmax * 1.05, 0.0..zmax * 1.02)
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| plot_err(path, e))?;
     chart
         .configure_mesh()
         .disable_x_mesh()
         .disable_y_mesh()
-        .x_desc("R (mm)")
-        .y_desc("Z (mm)")
+        .x_desc(frame.x)
+        .y_desc(frame.y)
         .draw()
+        .map_err(|e| plot_err(path, e))?;
+    let inside = |p: &(f64, f64)| p.0 >= x0 && p.0 <= x1 && p.1 >= y0 && p.1 <= y1;
+    chart
+        .draw_series(
+            grey.iter()
+                .filter(|p| inside(p))
+                .map(|p| Circle::new(*p, 2, RGBColor(170, 170, 170).filled())),
+        )
         .map_err(|e| plot_err(path, e))?;
     let c = |v: f64| ViridisRGB::get_color_normalized(v, v0, v1);
     chart
         .draw_series(
-            positions
+            points
                 .iter()
                 .zip(values)
-                .map(|(p, &v)| Circle::new((p[0] * 1e3, p[1] * 1e3), 2, c(v).filled())),
+                .filter(|(p, _)| inside(p))
+                .map(|(p, &v)| Circle::new(*p, 2, c(v).filled())),
         )
         .map_err(|e| plot_err(path, e))?;
     // Colour bar.

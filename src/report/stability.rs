@@ -172,7 +172,73 @@ fn cases(plan: &Plan) -> Vec<Def> {
     .into_iter()
     .chain(invalid_inputs("", "taylor"))
     .chain(cases_3d(plan))
+    .chain(cases_penetration(plan))
     .collect()
+}
+
+/// The rows of the penetration scene (issue of the ballistic run): impact
+/// speeds of 500, 1000 and 2000 m/s, plates 2 and 10 mm thick, and each
+/// kind of invalid input, at 3 nodes across in the quick plan and the
+/// scene's default 6 in the full one.
+fn cases_penetration(plan: &Plan) -> Vec<Def> {
+    let t = |sets: &[(&'static str, f64)]| with(("particles_radial", nodes_3d(plan)), sets);
+    vec![
+        def(
+            "penetration_speed_500",
+            "penetration",
+            t(&[("impact_speed", 500.0)]),
+        ),
+        def(
+            "penetration_speed_1000",
+            "penetration",
+            t(&[("impact_speed", 1000.0)]),
+        ),
+        def(
+            "penetration_speed_2000",
+            "penetration",
+            t(&[("impact_speed", 2000.0)]),
+        ),
+        def(
+            "penetration_plate_2mm",
+            "penetration",
+            t(&[("plate_thickness", 2e-3)]),
+        ),
+        def(
+            "penetration_plate_10mm",
+            "penetration",
+            t(&[("plate_thickness", 10e-3)]),
+        ),
+        def(
+            "penetration_invalid_porosity",
+            "penetration",
+            vec![("plate_porosity", 0.7)],
+        ),
+        def(
+            "penetration_invalid_thickness",
+            "penetration",
+            vec![("plate_thickness", -1e-3)],
+        ),
+        def(
+            "penetration_invalid_speed_nan",
+            "penetration",
+            vec![("impact_speed", f64::NAN)],
+        ),
+        def(
+            "penetration_invalid_particles",
+            "penetration",
+            vec![("particles_radial", 1.0)],
+        ),
+        def(
+            "penetration_invalid_plate_diameter",
+            "penetration",
+            vec![("plate_diameter", 0.01)],
+        ),
+        def(
+            "penetration_invalid_name",
+            "penetration",
+            vec![("impact_sped", 1500.0)],
+        ),
+    ]
 }
 
 /// Nodes across the radius of the 3-D rows: 3 in the quick plan (each row
