@@ -9,15 +9,17 @@ One shot per process: locally with a process pool by default, or on a Dask
 cluster with --scheduler ADDRESS (as examples/sweep_fmu.py).
 
 Each shot runs to end_time. Its status:
-  through    faster than the capture speed (below) and settled (its velocity
+  through    faster than the capture speed (below), settled (its velocity
              changed by at most --settle-tol x V over the last tenth of the
-             run): taken as perforated, its final projectile_velocity is the
-             residual velocity V_r (the outputs do not say where the
-             projectile is: this is a reading of its velocity);
+             run) and wholly past the plate's original back face
+             (projectile_clearance > 0): perforated, its final
+             projectile_velocity is the residual velocity V_r;
   stopped    its final velocity is no more than the capture speed
              m_p V / (m_p + m_plate), at which projectile and whole plate move
              together (the plate's rim is free, so a stopped projectile moves
-             on with it): V_r = 0;
+             on with it), or it is settled with part of it still above the
+             plate's back face (embedded, moving on with the plate and its
+             fragments): V_r = 0;
   unsettled  faster than the capture speed, but its velocity still changed
              by more than --settle-tol x V over the last tenth of the run: the
              projectile is still slowing (in the plate, or pushed by its
@@ -51,7 +53,7 @@ from sweep_fmu import parse_sets, run_jobs
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_FMU = ROOT / "target" / "fmu" / "BallisticImpact.fmu"
 OUTPUTS = ["projectile_velocity", "projectile_extent", "hole_radius", "damaged_fraction",
-           "pulverized_fraction", "max_damage", "energy_error"]
+           "pulverized_fraction", "max_damage", "energy_error", "projectile_clearance"]
 COLUMNS = ["V_mps", "status", "Vr_mps", "capture_speed_mps", "velocity_change_mps", *OUTPUTS,
            "error", "wall_time_s"]
 
@@ -136,8 +138,13 @@ def classify(row, params, settle_tol):
         row["status"], row["Vr_mps"] = "stopped", 0.0
     else:
         settled = row["velocity_change_mps"] <= settle_tol * row["V_mps"]
-        row["status"] = "through" if settled else "unsettled"
-        row["Vr_mps"] = row["projectile_velocity"]
+        if settled and row["projectile_clearance"] <= 0.0:
+            # Settled with part of it still above the plate's back face:
+            # embedded, moving on with the plate and its fragments.
+            row["status"], row["Vr_mps"] = "stopped", 0.0
+        else:
+            row["status"] = "through" if settled else "unsettled"
+            row["Vr_mps"] = row["projectile_velocity"]
     return row
 
 

@@ -368,6 +368,7 @@ observables! {
     PENETRATION_OBSERVABLES, "Observables of the penetration scene (a projectile through a plate, 3-D MLPG), in output order.",
     projectile_velocity: "m/s", "axial velocity of the projectile's centre of mass, positive in its direction of flight; its final value is the residual velocity";
     projectile_extent: "m", "extent of the projectile along the axis (highest minus lowest node): its current length (the parameter `projectile_length` is its initial length)";
+    projectile_clearance: "m", "depth of the projectile's highest node below the plate's original back face (z = -plate_thickness): positive once the whole projectile has passed it, negative while any of it is above";
     hole_radius: "m", "radius of the channel about the axis free of intact (not pulverized) plate material within the plate's original thickness: the distance from the axis of the nearest such plate node (0, to round-off, before the plate is pierced)";
     damaged_fraction: "1", "mass fraction of the plate whose crack density has grown past 1% of its value at pulverization";
     pulverized_fraction: "1", "mass fraction of the plate that is pulverized";

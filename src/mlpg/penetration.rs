@@ -156,6 +156,18 @@ impl Penetration {
         hi - lo
     }
 
+    /// Depth of the projectile's highest node below the plate's original
+    /// back face, `z = −plate_thickness` (m): positive once the whole
+    /// projectile has passed that plane, negative while any of it is above.
+    pub fn projectile_clearance(&self) -> f64 {
+        let x = self.run.positions();
+        let hi = self
+            .nodes(0)
+            .map(|i| x[i][2])
+            .fold(f64::NEG_INFINITY, f64::max);
+        -self.setup.plate.length - hi
+    }
+
     /// The plate's ceramic, if it is one.
     fn ceramic(&self) -> Option<&RajendranGrove> {
         match &self.run.others()[0].material.damage {
@@ -228,6 +240,7 @@ impl Penetration {
         let values = vec![
             self.projectile_velocity(),
             self.projectile_extent(),
+            self.projectile_clearance(),
             self.hole_radius(),
             damaged,
             pulverized,

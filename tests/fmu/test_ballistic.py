@@ -68,7 +68,7 @@ def test_validate_and_fmutool_check(suffix):
 
 def test_variables_are_the_scene_tables():
     m3, observables = assert_variables_are_the_scene_tables(ID, "penetration")
-    assert {"projectile_velocity", "projectile_extent", "hole_radius", "damaged_fraction", "pulverized_fraction",
+    assert {"projectile_velocity", "projectile_extent", "projectile_clearance", "hole_radius", "damaged_fraction", "pulverized_fraction",
             "max_damage", "energy_error"} <= set(observables)
     assert all(v.type == "Float64" for v in m3.outputs)
     # The initial length is a parameter, the current one an output: FMI
