@@ -362,8 +362,8 @@ struct Scratch {
     force: Vec<[f64; 3]>,
     kicked: Vec<(f64, bool)>,
     smooth: Vec<[f64; 3]>,
-    /// The smoothing's defect `H v` (then `M⁻¹ Hᵀ M H v`) and the
-    /// mass-weighted defect.
+    /// The smoothing's defect `H v` (order 2: `Hᵀ M H v`) and, with
+    /// order 2, the mass-weighted defect `M H v`.
     defect: Vec<[f64; 3]>,
     pass: Vec<[f64; 3]>,
     moved: Vec<(f64, f64, bool, Option<f64>)>,
@@ -996,9 +996,16 @@ impl Mlpg3d {
             let vel = &self.vel;
             let smooth = &mut scratch.smooth;
             // The defect `w = H v = (I − Φ) v`; with order 2 the filter
-            // is `M⁻¹ Hᵀ M H v`, symmetric in the mass inner product.
-            let defect = &mut scratch.defect;
-            defect.par_iter_mut().enumerate().for_each(|(i, out)| {
+            // is `M⁻¹ Hᵀ M H v`, symmetric in the mass inner product: `M w`
+            // goes straight to `pass`, `Hᵀ M w` to `defect`, and `M⁻¹` is
+            // applied in the update.
+            let order2 = self.setup.smoothing_order >= 2;
+            let weighted = if order2 {
+                &mut scratch.pass
+            } else {
+                &mut scratch.defect
+            };
+            weighted.par_iter_mut().enumerate().for_each(|(i, out)| {
                 let mut m = [0.0; 3];
                 for q in shapes.row(i) {
                     let vj = vel[shapes.nodes[q]];
@@ -1006,23 +1013,19 @@ impl Mlpg3d {
                         m[d] += shapes.phi[q] * vj[d];
                     }
                 }
-                *out = std::array::from_fn(|d| vel[i][d] - m[d]);
+                let w: [f64; 3] = std::array::from_fn(|d| vel[i][d] - m[d]);
+                *out = if order2 { w.map(|c| mass[i] * c) } else { w };
             });
-            if self.setup.smoothing_order >= 2 {
-                let pass = &mut scratch.pass;
-                pass.par_iter_mut()
-                    .zip(defect.par_iter())
-                    .zip(mass.par_iter())
-                    .for_each(|((y, w), m)| *y = w.map(|c| m * c));
-                g.nodal.defect_transpose(pass, defect);
-                defect
-                    .par_iter_mut()
-                    .zip(mass.par_iter())
-                    .for_each(|(z, m)| *z = z.map(|c| c / m));
+            if order2 {
+                g.nodal.defect_transpose(&scratch.pass, &mut scratch.defect);
             }
-            let defect = &*defect;
+            let defect = &scratch.defect;
             smooth.par_iter_mut().enumerate().for_each(|(i, out)| {
-                let mut v: [f64; 3] = std::array::from_fn(|d| vel[i][d] - alpha * defect[i][d]);
+                let mut v: [f64; 3] = if order2 {
+                    std::array::from_fn(|d| vel[i][d] - alpha * (defect[i][d] / mass[i]))
+                } else {
+                    std::array::from_fn(|d| vel[i][d] - alpha * defect[i][d])
+                };
                 if self.contact[i] {
                     v[2] = 0.0;
                 }

@@ -33,7 +33,13 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
         scene("penetration", &[("particles_radial", across)]),
         &probe,
     );
-    let spacing = 5e-3 / (across - 1.0);
+    // The node spacing of the run: the projectile's radius over its rings.
+    let radius = run
+        .scene
+        .as_ref()
+        .and_then(|s| s.get("projectile_diameter").ok())
+        .map_or(f64::NAN, |d| 0.5 * d);
+    let spacing = radius / (across - 1.0);
     doc.para(&format!(
         "## 7. Ballistic penetration: the damage zones\n\n\
          The seed's case (004, section 5.2): a tungsten rod 10 mm long and 10 mm across at \
