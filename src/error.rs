@@ -124,7 +124,7 @@ pub enum Error {
     ThroughBoundary {
         /// Particle index.
         particle: usize,
-        /// "anvil" or "axis".
+        /// "anvil", "axis" or "symmetry plane".
         boundary: &'static str,
         /// Simulated time.
         time: f64,

@@ -115,6 +115,22 @@ pub fn resolve(
     before: &[[f64; 3]],
     vel: &mut [[f64; 3]],
 ) -> f64 {
+    resolve_with_images(pairs, pos, mass, before, vel, usize::MAX)
+}
+
+/// [`resolve`] in the quarter model (`src/mlpg/mirror.rs`): the nodes from
+/// `real` on are mirror images. A pair of a node and an image is one of two
+/// pairs the quarter holds of its four in the whole body (the other is the
+/// image of the first node with the second's node), so its dissipation
+/// counts half.
+pub fn resolve_with_images(
+    pairs: &[(usize, usize)],
+    pos: &[[f64; 3]],
+    mass: &[f64],
+    before: &[[f64; 3]],
+    vel: &mut [[f64; 3]],
+    real: usize,
+) -> f64 {
     let mut lost = 0.0;
     for &(i, j) in pairs {
         let d = distance(&pos[i], &pos[j]);
@@ -137,7 +153,8 @@ pub fn resolve(
             .map(|k| (before[j][k] - before[i][k]) * n[k])
             .sum::<f64>()
             .min(0.0);
-        lost += 0.5 * reduced * arriving.powi(2).min(vn * vn);
+        let share = if j >= real { 0.5 } else { 1.0 };
+        lost += share * 0.5 * reduced * arriving.powi(2).min(vn * vn);
     }
     lost
 }

@@ -166,6 +166,64 @@ impl NodeLattice {
         lattice
     }
 
+    /// The quarter `x ≥ 0`, `y ≥ 0` of the lattice (the quarter model,
+    /// `src/mlpg/mirror.rs`), with the planes each kept node lies on (bits
+    /// `X`, `Y` of `src/mlpg/mirror.rs`). A node on a plane (the
+    /// ring nodes at angles 0 and π/2, the axis) is put exactly on it and
+    /// keeps its share of its volume: half, a quarter on the axis. The
+    /// volumes sum to a quarter of the cylinder's; the sets keep the face
+    /// nodes of the quarter, the mantle generator (at angle 0) and the tail.
+    pub fn quarter(&self) -> (Self, Vec<u8>) {
+        use super::mirror::{X, Y};
+        let tol = 1e-9 * self.radial_spacing;
+        let mut index = vec![usize::MAX; self.len()];
+        let mut out = NodeLattice {
+            cylinder: self.cylinder,
+            position: Vec::new(),
+            volume: Vec::new(),
+            surfaces: Vec::new(),
+            sets: RodSets::default(),
+            radial_spacing: self.radial_spacing,
+            axial_spacing: self.axial_spacing,
+        };
+        let mut plane = Vec::new();
+        for (i, p) in self.position.iter().enumerate() {
+            if p[0] < -tol || p[1] < -tol {
+                continue;
+            }
+            let mut on = 0;
+            let mut q = *p;
+            let mut share = 1.0;
+            if q[0].abs() <= tol {
+                q[0] = 0.0;
+                on |= X;
+                share *= 0.5;
+            }
+            if q[1].abs() <= tol {
+                q[1] = 0.0;
+                on |= Y;
+                share *= 0.5;
+            }
+            index[i] = out.position.len();
+            out.position.push(q);
+            out.volume.push(self.volume[i] * share);
+            out.surfaces.push(self.surfaces[i]);
+            plane.push(on);
+        }
+        let keep = |list: &[usize]| -> Vec<usize> {
+            list.iter()
+                .filter(|&&i| index[i] != usize::MAX)
+                .map(|&i| index[i])
+                .collect()
+        };
+        out.sets = RodSets {
+            face: keep(&self.sets.face),
+            mantle: keep(&self.sets.mantle),
+            tail: index[self.sets.tail],
+        };
+        (out, plane)
+    }
+
     /// Number of nodes.
     pub fn len(&self) -> usize {
         self.position.len()
@@ -244,6 +302,43 @@ mod tests {
             let per_layer = 1 + 3 * rings * (rings + 1);
             assert_eq!(lat.len() % per_layer, 0);
             assert_eq!(lat.sets.face.len(), per_layer);
+        }
+    }
+
+    /// The quarter keeps a quarter of the volume (to round-off), every
+    /// node of the full lattice is one of its nodes or an image of one, and
+    /// the nodes on the planes are exactly on them.
+    #[test]
+    fn the_quarter_is_a_quarter() {
+        use crate::mlpg::mirror::{X, Y, vector};
+        let cyl = Cylinder {
+            radius: 5e-3,
+            length: 10e-3,
+        };
+        for rings in 1..=6 {
+            let full = NodeLattice::cylinder(cyl, rings);
+            let (q, plane) = full.quarter();
+            let v: f64 = q.volume.iter().sum();
+            assert!(
+                (4.0 * v / cyl.volume() - 1.0).abs() < 1e-14,
+                "rings {rings}"
+            );
+            for (p, &on) in q.position.iter().zip(&plane) {
+                assert!(p[0] >= 0.0 && p[1] >= 0.0);
+                assert_eq!(on & X != 0, p[0] == 0.0);
+                assert_eq!(on & Y != 0, p[1] == 0.0);
+            }
+            let close = |a: &[f64; 3], b: &[f64; 3]| (0..3).all(|d| (a[d] - b[d]).abs() < 1e-12);
+            for p in &full.position {
+                assert!(
+                    q.position
+                        .iter()
+                        .any(|r| (0..4).any(|f| close(&vector(r, f), p))),
+                    "{p:?}"
+                );
+            }
+            assert_eq!(q.sets.mantle.len(), full.sets.mantle.len());
+            assert_eq!(q.position[q.sets.tail], [0.0, 0.0, cyl.length]);
         }
     }
 

@@ -54,7 +54,7 @@
 
 use crate::isa::{Isa, hot};
 use crate::msph::{MAX_CONDITION, invert};
-use crate::neighbors::{NeighborList, cell_list};
+use crate::neighbors::{NeighborList, cell_list_first};
 use crate::{Error, Result};
 use rayon::prelude::*;
 
@@ -150,6 +150,19 @@ impl Supports {
         group: &[u8],
         params: SupportParams,
     ) -> Result<Self> {
+        Self::compute_rows(points, group, points.len(), params)
+    }
+
+    /// The supports with only the first `rows` nodes naming their `k`
+    /// nearest (of all `points`): the others (mirror images,
+    /// `src/mlpg/mirror.rs`) are named, and get the radius of their largest
+    /// naming distance only. [`Supports::named`] has `rows` rows.
+    pub fn compute_rows(
+        points: &[[f64; 3]],
+        group: &[u8],
+        rows: usize,
+        params: SupportParams,
+    ) -> Result<Self> {
         let k = params.neighbours;
         let same = |i: usize, j: usize| group.is_empty() || group[i] == group[j];
         if k < BASIS - 1 || k >= points.len() {
@@ -196,13 +209,13 @@ impl Supports {
         }
         .max(1e-300);
         let list = loop {
-            let list = cell_list(points, search);
-            if (0..points.len()).all(|i| list.of(i).iter().filter(|&&j| same(i, j)).count() > k) {
+            let list = cell_list_first(points, rows, search);
+            if (0..rows).all(|i| list.of(i).iter().filter(|&&j| same(i, j)).count() > k) {
                 break list;
             }
             search *= 2.0;
         };
-        let rows: Vec<Vec<(f64, usize)>> = (0..points.len())
+        let named_rows: Vec<Vec<(f64, usize)>> = (0..rows)
             .into_par_iter()
             .map(|i| {
                 let mut row: Vec<(f64, usize)> = list
@@ -216,14 +229,15 @@ impl Supports {
                 row
             })
             .collect();
-        let mut radius: Vec<f64> = rows.iter().map(|r| r[k - 1].0).collect();
+        let mut radius: Vec<f64> = named_rows.iter().map(|r| r[k - 1].0).collect();
+        radius.resize(points.len(), 0.0);
         let mut named = NeighborList {
-            offsets: Vec::with_capacity(points.len() + 1),
-            indices: Vec::with_capacity(points.len() * k),
+            offsets: Vec::with_capacity(rows + 1),
+            indices: Vec::with_capacity(rows * k),
         };
-        let mut named_distance = Vec::with_capacity(points.len() * k);
+        let mut named_distance = Vec::with_capacity(rows * k);
         named.offsets.push(0);
-        for row in &rows {
+        for row in &named_rows {
             for &(d, j) in row {
                 radius[j] = radius[j].max(d);
                 named.indices.push(j);
@@ -673,8 +687,16 @@ fn norm1(m: &[[f64; BASIS]; BASIS]) -> f64 {
 /// neighbours within `reach + max r_J`, a superset of the nodes whose
 /// supports cover any point within `reach` of the node.
 /// With several bodies ([`Supports::group`]) only the node's own body's.
-pub fn candidates(points: &[[f64; 3]], supports: &Supports, reach: f64) -> NeighborList {
-    let list = cell_list(points, reach + supports.max_radius());
+///
+/// Lists only the first `rows` points (the real nodes; the others are
+/// mirror images, `src/mlpg/mirror.rs`).
+pub fn candidates_first(
+    points: &[[f64; 3]],
+    rows: usize,
+    supports: &Supports,
+    reach: f64,
+) -> NeighborList {
+    let list = cell_list_first(points, rows, reach + supports.max_radius());
     let g = &supports.group;
     if g.is_empty() {
         return list;
@@ -711,8 +733,14 @@ impl NodalShapes {
     /// any number of threads). The first failing node, in index order,
     /// names the error.
     pub fn build(points: &[[f64; 3]], supports: &Supports) -> Result<Self> {
-        let list = candidates(points, supports, 0.0);
-        let rows: Vec<Result<ShapeRow>> = (0..points.len())
+        Self::build_rows(points, supports, points.len())
+    }
+
+    /// The shape functions at the first `rows` nodes only (the real nodes;
+    /// the others, mirror images, are only covering nodes).
+    pub fn build_rows(points: &[[f64; 3]], supports: &Supports, rows: usize) -> Result<Self> {
+        let list = candidates_first(points, rows, supports, 0.0);
+        let rows: Vec<Result<ShapeRow>> = (0..rows)
             .into_par_iter()
             .map_init(ShapeRow::default, |row, i| {
                 row.evaluate(points[i], list.of(i), points, &supports.radius, true, i)?;

@@ -29,6 +29,7 @@
 
 pub mod contact;
 pub mod lattice;
+pub mod mirror;
 pub mod mls;
 pub mod nodal;
 pub mod penetration;

@@ -50,15 +50,16 @@ pub struct NodalOperator {
 }
 
 impl NodalOperator {
-    /// The transpose of `shapes` (a counting sort: rows in node order,
-    /// each in ascending `i`).
-    pub fn build(shapes: &NodalShapes) -> Self {
+    /// The transpose of `shapes` over `columns ≥ shapes.len()` nodes (more
+    /// with mirror images, `src/mlpg/mirror.rs`): a counting sort, rows in node
+    /// order, each in ascending `i`.
+    pub fn build(shapes: &NodalShapes, columns: usize) -> Self {
         let n = shapes.offsets.len().saturating_sub(1);
-        let mut offsets = vec![0usize; n + 1];
+        let mut offsets = vec![0usize; columns + 1];
         for &j in &shapes.nodes {
             offsets[j + 1] += 1;
         }
-        for j in 0..n {
+        for j in 0..columns {
             offsets[j + 1] += offsets[j];
         }
         let mut next = offsets.clone();
@@ -83,7 +84,8 @@ impl NodalOperator {
     }
 
     /// `out = Hᵀ y`, the transpose of the defect operator `H = I − Φ` with
-    /// `(Φ v)_i = Σ_J φ_J(x_i) v_J`: `out_J = y_J − Σ_i φ_J(x_i) y_i`.
+    /// `(Φ v)_i = Σ_J φ_J(x_i) v_J`: `out_J = y_J − Σ_i φ_J(x_i) y_i`
+    /// (`y_J = 0` for a column past `y`, a mirror image).
     pub fn defect_transpose(&self, y: &[[f64; 3]], out: &mut [[f64; 3]]) {
         out.par_iter_mut().enumerate().for_each(|(j, o)| {
             let mut m = [0.0; 3];
@@ -93,7 +95,8 @@ impl NodalOperator {
                     m[c] += p * yi[c];
                 }
             }
-            *o = std::array::from_fn(|c| y[j][c] - m[c]);
+            let own = y.get(j).copied().unwrap_or([0.0; 3]);
+            *o = std::array::from_fn(|c| own[c] - m[c]);
         });
     }
 
@@ -151,7 +154,7 @@ mod tests {
     fn the_forces_do_the_work_of_the_stress_power() {
         let (shapes, stress, vel, vol) = setup();
         let n = vel.len();
-        let op = NodalOperator::build(&shapes);
+        let op = NodalOperator::build(&shapes, shapes.len());
         let mut f = vec![[0.0; 3]; n];
         op.apply(&stress, &vol, &mut f);
         let mut l = vec![[[0.0; 3]; 3]; n];
@@ -194,7 +197,7 @@ mod tests {
     fn the_forces_sum_to_zero() {
         let (shapes, stress, vel, vol) = setup();
         let n = vel.len();
-        let op = NodalOperator::build(&shapes);
+        let op = NodalOperator::build(&shapes, shapes.len());
         let mut f = vec![[0.0; 3]; n];
         op.apply(&stress, &vol, &mut f);
         let largest = f.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -211,7 +214,7 @@ mod tests {
     fn the_transpose_holds_the_shapes() {
         let (shapes, _, vel, _) = setup();
         let n = vel.len();
-        let op = NodalOperator::build(&shapes);
+        let op = NodalOperator::build(&shapes, shapes.len());
         assert_eq!(op.nodes.len(), shapes.nodes.len());
         for j in 0..n {
             let row = op.offsets[j]..op.offsets[j + 1];
@@ -259,7 +262,7 @@ mod tests {
     fn the_smoothing_transpose_is_the_adjoint_of_the_defect() {
         let (shapes, _, vel, vol) = setup();
         let n = vel.len();
-        let op = NodalOperator::build(&shapes);
+        let op = NodalOperator::build(&shapes, shapes.len());
         let mass: Vec<f64> = vol.iter().map(|v| 8000.0 * v).collect();
         let y: Vec<[f64; 3]> = (0..n).map(|i| vel[(7 * i + 3) % n]).collect();
         let mut hty = vec![[0.0; 3]; n];

@@ -14,7 +14,7 @@
 
 use crate::Result;
 use crate::isa::Isa;
-use crate::mlpg::mls::{PointShapes, ShapeRow, Supports, candidates, distance};
+use crate::mlpg::mls::{PointShapes, ShapeRow, Supports, candidates_first, distance};
 use crate::mlpg::sphere::{SphereRule, TestSphere};
 use rayon::prelude::*;
 
@@ -62,9 +62,9 @@ impl TractionOperator {
         cut: &SphereRule,
     ) -> Result<Self> {
         let reach = spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
-        let list = candidates(points, supports, reach);
+        let list = candidates_first(points, spheres.len(), supports, reach);
         let radius = &supports.radius;
-        let rows: Vec<Result<Row>> = (0..points.len())
+        let rows: Vec<Result<Row>> = (0..spheres.len())
             .into_par_iter()
             .map_init(PointShapes::default, |ps, i| {
                 let cand = list.of(i);
@@ -111,8 +111,8 @@ impl TractionOperator {
         cut: &SphereRule,
     ) -> Result<Self> {
         let reach = spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
-        let list = candidates(points, supports, reach);
-        let rows: Vec<Result<Row>> = (0..points.len())
+        let list = candidates_first(points, spheres.len(), supports, reach);
+        let rows: Vec<Result<Row>> = (0..spheres.len())
             .into_par_iter()
             .map_init(
                 || (ShapeRow::default(), Vec::new(), Vec::new()),

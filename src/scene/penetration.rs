@@ -183,6 +183,7 @@ const AFTER: &[ParamSpec] = &[
         default: 1.0,
         ..super::taylor3d::WEAK_FORM
     },
+    super::taylor3d::SYMMETRY,
     row(
         "end_time",
         "s",
@@ -237,7 +238,8 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
         let k = (c.radius / spacing).round();
         (1.0 + 3.0 * k * (k + 1.0)) * ((c.length / spacing).round() + 1.0)
     };
-    let nodes = count(&projectile) + count(&plate);
+    let quarter = v("symmetry")? >= 0.5;
+    let nodes = (count(&projectile) + count(&plate)) / if quarter { 4.0 } else { 1.0 };
     if nodes > MAX_NODES as f64 {
         return Err(Error::Inconsistent(format!(
             "the run would have {nodes:.0} nodes, more than {MAX_NODES}: lower particles_radial \
@@ -261,6 +263,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     numerics.smoothing_order = v("smoothing_order")? as u32;
     numerics.shifting = v("shifting")?;
     numerics.weak_form = WeakForm::of(v("weak_form")?);
+    numerics.quarter = quarter;
     Ok((setup, (projectile_material, plate_material), numerics))
 }
 

@@ -66,6 +66,17 @@ pub(crate) const SMOOTHING_ORDER_SPEC: ParamSpec = spec(
     "MLPG velocity smoothing with H = I - Phi (Phi: the MLS approximation at the nodes): 1 = v <- v - alpha H v, 2 = v <- v - alpha M^-1 H^T M H v, its symmetric square, which spares smooth fields (README, 3-D MLPG)",
 );
 
+/// The `symmetry` row of the 3-D scenes of a normal impact: 0 the whole
+/// body, 1 the quarter model (`src/mlpg/mirror.rs`).
+pub(crate) const SYMMETRY: ParamSpec = spec(
+    "symmetry",
+    "1",
+    0.0,
+    Range::integer(0.0, 1.0),
+    "0 = the whole body; 1 = the quarter x >= 0, y >= 0 with the symmetry planes x = 0 and y = 0 by mirror images of the nodes \
+     near them (a quarter of the nodes; energies are reported for the whole body)",
+);
+
 /// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
 /// over test spheres (eq. 10), 1 the nodal Galerkin form
 /// (`src/mlpg/nodal.rs`).
@@ -118,6 +129,7 @@ const AFTER: &[ParamSpec] = &[
         "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the seed",
     ),
     WEAK_FORM,
+    SYMMETRY,
     END_TIME,
 ];
 
@@ -173,7 +185,7 @@ param_struct! {
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
         melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
         particles_radial, damping, smoothing_coefficient, smoothing_order, rebuild_strain,
-        shifting, weak_form, end_time,
+        shifting, weak_form, symmetry, end_time,
     }
 }
 
@@ -235,6 +247,7 @@ impl Taylor3dParams {
         s.smoothing_order = self.smoothing_order as u32;
         s.shifting = self.shifting;
         s.weak_form = WeakForm::of(self.weak_form);
+        s.quarter = self.symmetry >= 0.5;
         s
     }
 

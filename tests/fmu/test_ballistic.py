@@ -115,6 +115,24 @@ def test_fmu_state_rolls_back_and_moves_between_instances(tmp_path_factory):
     assert last == pytest.approx(4e-6, rel=1e-9)
 
 
+def test_the_quarter_model_through_the_fmu(tmp_path_factory):
+    """`symmetry` = 1 reaches the run: the FMU gives the CLI's quarter model
+    bit for bit (92 nodes against the whole body's 278), its state rolls
+    back and moves between instances, and its projectile is within the
+    issue's 1 % of the whole body's (measured 1298.3 against 1306.1 m/s,
+    -0.59 %, at 4 us)."""
+    quarter = {**COARSE, "end_time": 4e-6, "symmetry": 1}
+    ref = cli_pen(tmp_path_factory, quarter)
+    whole = cli_pen(tmp_path_factory, {**COARSE, "end_time": 4e-6})
+    assert ref["particles"] == 92 and whole["particles"] == 278
+    assert abs(ref["projectile_velocity"] / whole["projectile_velocity"] - 1.0) < 0.01
+    m = fmu()
+    names = [v.name for v in m.outputs]
+    r = simulate_fmu(str(m.path), start_values=quarter, output=names, stop_time=4e-6, output_interval=4e-7)
+    assert_simulated_equal_to_cli(r, ref, names)
+    assert assert_state_rolls_back_and_resumes(fmu(), init3, quarter, 5e-7, 3, ref) is None
+
+
 def test_a_solver_stop_is_an_error_with_the_clis_message_and_values(tmp_path):
     """The run that collapses a spacing: Error from doStep, the CLI's message
     in the host's log, and the outputs at the stop equal the CLI's bit for
