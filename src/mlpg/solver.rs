@@ -1213,7 +1213,12 @@ impl Mlpg3d {
         // only the real nodes' kept.
         scratch.pairs.clear();
         let damaging = self.damaging();
-        let pos = extended(images, &self.pos, &mut scratch.ext_pos, mirror::vector);
+        // No contact pass in a run of one body without damage: no copy.
+        let pos: &[[f64; 3]] = if self.group.is_empty() && !damaging {
+            &self.pos
+        } else {
+            extended(images, &self.pos, &mut scratch.ext_pos, mirror::vector)
+        };
         let group: &[u8] = if self.group.is_empty() {
             &[]
         } else {
