@@ -17,14 +17,20 @@ Each shot runs to end_time. Its status:
   stopped    its final velocity is no more than the capture speed
              m_p V / (m_p + m_plate), at which projectile and whole plate move
              together (the plate's rim is free, so a stopped projectile moves
-             on with it), or it is settled with part of it still above the
-             plate's back face (embedded, moving on with the plate and its
-             fragments): V_r = 0;
-  unsettled  faster than the capture speed, but its velocity still changed
-             by more than --settle-tol x V over the last tenth of the run: the
-             projectile is still slowing (in the plate, or pushed by its
-             fragments), so its velocity is not yet a residual velocity.
-             Left out of the fit unless --fit-unsettled is given;
+             on with it), or it is embedded: settled, with part of it still
+             above the plate's original back face, and too slow to cross that
+             face within another run of the same length (its depth above the
+             face exceeds its velocity times end_time): V_r = 0;
+  unsettled  faster than the capture speed, and not yet a residual velocity:
+             its velocity still changed by more than --settle-tol x V over the
+             last tenth of the run (still slowing, in the plate or pushed by
+             its fragments), or it is settled but still partly above the
+             plate's back face and fast enough to cross it within another run
+             of the same length (a slow perforation near the ballistic limit
+             looks settled by the first rule while the bulging plate still
+             carries it). Left out of the fit unless --fit-unsettled is given;
+             with --extend K the script runs these shots again with twice the
+             end time, up to K times;
   error      the FMU run stopped with an error (for example a named solver
              stop such as a particle spacing collapse): reported with the
              message and left out of the fit; the CSV has the outputs at the
@@ -55,7 +61,7 @@ DEFAULT_FMU = ROOT / "target" / "fmu" / "BallisticImpact.fmu"
 OUTPUTS = ["projectile_velocity", "projectile_extent", "hole_radius", "damaged_fraction",
            "pulverized_fraction", "max_damage", "energy_error", "projectile_clearance"]
 COLUMNS = ["V_mps", "status", "Vr_mps", "capture_speed_mps", "velocity_change_mps", *OUTPUTS,
-           "error", "wall_time_s"]
+           "end_time_s", "error", "wall_time_s"]
 
 
 def parse_speeds(text):
@@ -129,8 +135,10 @@ def capture_speed(p):
 
 
 def classify(row, params, settle_tol):
-    """Adds the status, V_r and the capture speed to a shot's row."""
+    """Adds the status, V_r, the capture speed and the end time to a shot's
+    row (`params`: every parameter's value, end_time included)."""
     row["capture_speed_mps"] = capture_speed(params)
+    row["end_time_s"] = params["end_time"]
     row["Vr_mps"] = ""
     if row["error"]:
         row["status"] = "error"
@@ -138,26 +146,30 @@ def classify(row, params, settle_tol):
         row["status"], row["Vr_mps"] = "stopped", 0.0
     else:
         settled = row["velocity_change_mps"] <= settle_tol * row["V_mps"]
-        if settled and row["projectile_clearance"] <= 0.0:
-            # Settled with part of it still above the plate's back face:
-            # embedded, moving on with the plate and its fragments.
+        inside = row["projectile_clearance"] <= 0.0
+        # At its present speed, would it cross the back face within another
+        # run of the same length?
+        within_reach = -row["projectile_clearance"] <= row["projectile_velocity"] * params["end_time"]
+        if settled and inside and not within_reach:
+            # Embedded, moving on with the plate and its fragments.
             row["status"], row["Vr_mps"] = "stopped", 0.0
         else:
-            row["status"] = "through" if settled else "unsettled"
+            row["status"] = "through" if settled and not inside else "unsettled"
             row["Vr_mps"] = row["projectile_velocity"]
     return row
 
 
 def print_table(rows):
     print(f"{'V (m/s)':>9} {'status':>9} {'V_r (m/s)':>10} {'v_end (m/s)':>11} {'dv last 10%':>11} "
-          f"{'hole (mm)':>9} {'pulverized':>10} {'energy err':>10} {'wall (s)':>8}")
+          f"{'clear (mm)':>10} {'end (us)':>8} {'hole (mm)':>9} {'pulverized':>10} {'energy err':>10} {'wall (s)':>8}")
     for r in rows:
         vr = f"{r['Vr_mps']:.1f}" if r["Vr_mps"] != "" else "-"
         dv = f"{r['velocity_change_mps']:.1f}" if "velocity_change_mps" in r else "-"
-        values = [r.get(n, math.nan) for n in ("projectile_velocity", "hole_radius", "pulverized_fraction",
-                                                "energy_error")]
-        print(f"{r['V_mps']:9.1f} {r['status']:>9} {vr:>10} {values[0]:11.1f} {dv:>11} {1e3 * values[1]:9.3f} "
-              f"{values[2]:10.4f} {values[3]:10.4f} {r['wall_time_s']:8.1f}")
+        values = [r.get(n, math.nan) for n in ("projectile_velocity", "projectile_clearance", "hole_radius",
+                                                "pulverized_fraction", "energy_error")]
+        print(f"{r['V_mps']:9.1f} {r['status']:>9} {vr:>10} {values[0]:11.1f} {dv:>11} {1e3 * values[1]:10.2f} "
+              f"{1e6 * r['end_time_s']:8.1f} {1e3 * values[2]:9.3f} {values[3]:10.4f} {values[4]:10.4f} "
+              f"{r['wall_time_s']:8.1f}")
 
 
 def plot(path, rows, fit, title):
@@ -292,6 +304,8 @@ def main(argv=None):
     ap.add_argument("--settle-tol", type=float, default=0.01,
                     help="a shot is settled when its velocity changed by at most this fraction of V over the last "
                          "tenth of the run (default %(default)s)")
+    ap.add_argument("--extend", type=int, default=0, metavar="K",
+                    help="run the unsettled shots again with twice the end time, up to K times (default %(default)s)")
     ap.add_argument("--fit-unsettled", action="store_true",
                     help="fit the unsettled shots too (their velocities are not residual velocities)")
     ap.add_argument("--workers", type=int, default=os.cpu_count(), help="local worker processes (default: one per CPU)")
@@ -324,6 +338,22 @@ def main(argv=None):
     rows = run_jobs(run_shot, [(args.fmu, p, end_time, step) for p in shots], args.workers, args.scheduler)
     wall = time.perf_counter() - t0
     rows = [classify(r, {**defaults, **p}, args.settle_tol) for r, p in zip(rows, shots)]
+    if args.extend < 0:
+        ap.error(f"--extend {args.extend}: need K >= 0")
+    for _ in range(args.extend):
+        again = [k for k, r in enumerate(rows) if r["status"] == "unsettled"]
+        if not again:
+            break
+        longer = [{**shots[k], "end_time": 2 * rows[k]["end_time_s"]} for k in again]
+        print("running again with twice the end time: "
+              + ", ".join(f"{p['impact_speed']:g} m/s to {p['end_time']:g} s" for p in longer), file=sys.stderr)
+        t1 = time.perf_counter()
+        redone = run_jobs(run_shot, [(args.fmu, p, p["end_time"], args.step or p["end_time"] / 100) for p in longer],
+                          args.workers, args.scheduler)
+        wall += time.perf_counter() - t1
+        for k, r, p in zip(again, redone, longer):
+            shots[k] = p
+            rows[k] = classify(r, {**defaults, **p}, args.settle_tol)
 
     print_table(rows)
     print(f"{len(rows)} shots in {wall:.1f} s -> {args.out}")
@@ -338,8 +368,12 @@ def main(argv=None):
     unsettled = [r for r in rows if r["status"] == "unsettled"]
     if unsettled:
         what = "fitted anyway (--fit-unsettled)" if args.fit_unsettled else "left out of the fit"
-        print(f"warning: {len(unsettled)} shots unsettled at end_time = {end_time:g} s (velocity still changing by "
-              f"more than {args.settle_tol:g} V over the last tenth of the run: not residual velocities), {what}: "
+        times = sorted({r["end_time_s"] for r in unsettled})
+        at = f"end_time = {times[0]:g} s" if len(times) == 1 else f"end_time = {times[0]:g} to {times[-1]:g} s"
+        print(f"warning: {len(unsettled)} shots unsettled at {at} (velocity still changing by "
+              f"more than {args.settle_tol:g} V over the last tenth of the run, or still in the plate and fast enough "
+              f"to cross its back face within another run of the same length: not residual velocities; run longer "
+              f"with --end-time or --extend), {what}: "
               + ", ".join(f"{r['V_mps']:g} m/s" for r in unsettled), file=sys.stderr)
     fitted = {"through", "stopped"} | ({"unsettled"} if args.fit_unsettled else set())
     data = [(r["V_mps"], r["Vr_mps"]) for r in rows if r["status"] in fitted]
