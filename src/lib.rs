@@ -135,10 +135,13 @@ pub mod internals {
     /// The 3-D MLPG method's parts.
     pub mod mlpg {
         pub use crate::mlpg::mls::distance;
+        pub use crate::mlpg::nodal::NodalOperator;
         pub use crate::mlpg::penetration::{Penetration, PenetrationSetup};
         pub use crate::mlpg::solver::{SMOOTHING, WeakForm};
         pub use crate::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
-        pub use crate::mlpg::step::{OMEGA_FACTOR, largest_eigenvalue, stable_step};
+        pub use crate::mlpg::step::{
+            OMEGA_FACTOR, OMEGA_FACTOR_NODAL, largest_eigenvalue, stable_step, stable_step_with,
+        };
         pub use crate::mlpg::weak::VOIGT;
         pub use crate::mlpg::{
             Body, Cylinder, Mlpg3d, NodalShapes, NodeLattice, RodSetup, SphereRule, SupportParams,

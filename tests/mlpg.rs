@@ -5,9 +5,9 @@
 //! operator behind the stable time step.
 
 use meshless_impact::internals::mlpg::{
-    ALPHA, BOUNDARY_RULE, Cylinder, DEFAULT_RULE, NodalShapes, NodeLattice, OMEGA_FACTOR,
-    SphereRule, SupportParams, Supports, TestSphere, TractionOperator, distance,
-    largest_eigenvalue, stable_step,
+    ALPHA, BOUNDARY_RULE, Cylinder, DEFAULT_RULE, NodalOperator, NodalShapes, NodeLattice,
+    OMEGA_FACTOR, OMEGA_FACTOR_NODAL, SphereRule, SupportParams, Supports, TestSphere,
+    TractionOperator, distance, largest_eigenvalue, stable_step,
 };
 use std::f64::consts::PI;
 
@@ -148,6 +148,17 @@ impl Bar {
     /// The linear operator `u ↦ −a(σ(u))`, `σ = C : sym(∇u)`, on flat
     /// vectors: its eigenvalues are ω².
     fn stiffness(&self, u: &[f64], out: &mut [f64]) {
+        self.stiffness_of(u, out, |stress, a| self.accelerations(stress, a));
+    }
+
+    /// [`Bar::stiffness`] with the accelerations of the stresses
+    /// `accelerations` (a form's forces over its inertia).
+    fn stiffness_of(
+        &self,
+        u: &[f64],
+        out: &mut [f64],
+        accelerations: impl Fn(&[[f64; 6]], &mut [[f64; 3]]),
+    ) {
         let n = self.len();
         let disp: Vec<[f64; 3]> = (0..n)
             .map(|i| [u[3 * i], u[3 * i + 1], u[3 * i + 2]])
@@ -156,7 +167,7 @@ impl Bar {
         self.shapes.velocity_gradients(&disp, &mut l);
         let stress: Vec<[f64; 6]> = l.iter().map(hooke_rate).collect();
         let mut a = vec![[0.0; 3]; n];
-        self.accelerations(&stress, &mut a);
+        accelerations(&stress, &mut a);
         for i in 0..n {
             for d in 0..3 {
                 out[3 * i + d] = -a[i][d];
@@ -365,6 +376,41 @@ fn kappa(bar: &Bar) -> f64 {
     let cp = ((lambda + 2.0 * mu) / RHO).sqrt();
     let w2 = largest_eigenvalue(3 * bar.len(), 600, |u, out| bar.stiffness(u, out));
     w2.sqrt() * bar.d_min / cp
+}
+
+/// `κ` of the nodal Galerkin form (`weak_form = 1`): the operator
+/// `u ↦ M⁻¹ Gᵀ V C G u`, G the collocated gradients, V the nodal volumes.
+fn kappa_nodal(bar: &Bar) -> f64 {
+    let (lambda, mu) = lame();
+    let cp = ((lambda + 2.0 * mu) / RHO).sqrt();
+    let n = bar.len();
+    let op = NodalOperator::build(&bar.shapes, n);
+    let volume = &bar.lattice.volume;
+    let w2 = largest_eigenvalue(3 * n, 600, |u, out| {
+        bar.stiffness_of(u, out, |stress, a| {
+            op.apply(stress, volume, a);
+            for (a, v) in a.iter_mut().zip(volume) {
+                *a = a.map(|x| x / (RHO * v));
+            }
+        })
+    });
+    w2.sqrt() * bar.d_min / cp
+}
+
+/// Measured κ of the nodal form: 1.8618 (2 rings), 1.8207 (3), 1.7921
+/// (4), 1.8045 (5), under `OMEGA_FACTOR_NODAL` = 1.95; above the sphere
+/// form's `OMEGA_FACTOR` = 1.52 even with its safety factor (1.52 / 0.9 =
+/// 1.69), so the nodal form needs its own step.
+#[test]
+fn highest_frequency_of_the_nodal_operator() {
+    for rings in [2, 3] {
+        let k = kappa_nodal(&Bar::new(rings, ALPHA));
+        println!("rings {rings}: nodal kappa {k:.4}");
+        assert!(
+            k < OMEGA_FACTOR_NODAL && k > OMEGA_FACTOR / 0.9,
+            "rings {rings}: nodal kappa {k}"
+        );
+    }
 }
 
 /// Measured κ: 1.4475 (2 rings, 399 nodes) and 1.4507 (3 rings, 1147

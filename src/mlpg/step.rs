@@ -37,10 +37,25 @@ pub fn newmark_limit(omega_max: f64, beta: f64, gamma: f64) -> Option<f64> {
     Some(1.0 / (omega_max * (0.5 * gamma - beta).sqrt()))
 }
 
+/// `κ` of the nodal Galerkin form (`weak_form = 1`, `src/mlpg/nodal.rs`):
+/// the largest measured value, 1.862 (2 rings; 1.821, 1.792 and 1.805 at
+/// 3, 4 and 5), with the margin of [`OMEGA_FACTOR`], 4.8 %. Its stiffness
+/// `Gᵀ V C G` (G the collocated gradients) is stiffer at the top of its
+/// spectrum than the seed's sphere form, by 28 %; at the sphere form's
+/// step the nodal form's highest modes grow (VALIDATION.md, "The nodal
+/// form's own stable step").
+pub const OMEGA_FACTOR_NODAL: f64 = 1.95;
+
 /// The stable step of the central differences (`β = 0`, `γ = 1/2`):
 /// `safety · 2 / ω_max` with `ω_max = OMEGA_FACTOR · c_p / d_min`.
 pub fn stable_step(wave_speed: f64, d_min: f64, safety: f64) -> f64 {
-    safety * 2.0 * d_min / (OMEGA_FACTOR * wave_speed)
+    stable_step_with(OMEGA_FACTOR, wave_speed, d_min, safety)
+}
+
+/// [`stable_step`] with the factor `kappa` of `ω_max = κ c_p / d_min`
+/// ([`OMEGA_FACTOR`] or [`OMEGA_FACTOR_NODAL`]).
+pub fn stable_step_with(kappa: f64, wave_speed: f64, d_min: f64, safety: f64) -> f64 {
+    safety * 2.0 * d_min / (kappa * wave_speed)
 }
 
 /// The largest eigenvalue (in magnitude) of the linear operator `apply` on
