@@ -35,7 +35,7 @@ use super::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
     smooth, smooth2, velocity_gradients,
 };
-use super::shift::{Candidates, Freedom, carry, leaving, shifts};
+use super::shift::{Candidates, Freedom, carry, leaving, shifts, surface_band};
 use super::team::{Chunks, Team};
 use super::{COURANT, check_derived, check_time_step};
 use crate::error::{Error, Result};
@@ -66,6 +66,11 @@ pub const SHIFT_RANGE: f64 = 0.5;
 /// Gap along the axis, relative to the initial spacing, below which an
 /// axis particle may leave the axis (src/solver/shift.rs, `leaving`).
 pub const AXIS_CROWD: f64 = 0.3;
+
+/// Distance from a surface particle, relative to the initial spacing,
+/// within which a particle does not shift outward across the surface
+/// (README, "Particle shifting").
+pub const SURFACE_BAND: f64 = 1.0;
 
 /// Distance from the axis, relative to the initial spacing, that a particle
 /// leaving it is moved to: its mirror image is then twice that away, above
@@ -810,10 +815,11 @@ impl TaylorSolver {
         result
     }
 
-    /// The directions each particle may shift in: none on the surfaces (the
-    /// face row, the mantle and the top, which carry the boundary
-    /// conditions and the rod's outline), along Z on the axis, along R on
-    /// the anvil, none on both.
+    /// The directions each particle may shift in: along the surface on the
+    /// mantle and the top (they carry the boundary conditions and the rod's
+    /// outline, which sliding keeps), none on the face row, the corners and
+    /// a surface particle on the anvil or the axis, along Z on the axis,
+    /// along R on the anvil, none on both.
     fn freedoms(&self) -> Vec<Freedom> {
         let mut free: Vec<Freedom> = self
             .contact
@@ -826,12 +832,48 @@ impl TaylorSolver {
                 (false, false) => Freedom::Both,
             })
             .collect();
-        for s in [&self.mantle, &self.top, &self.face] {
-            for &i in &s.particles {
-                free[i] = Freedom::Fixed;
+        // The surfaces slide along themselves: a particle of the mantle or
+        // the top (not a corner, nor on the anvil) moves across its normal
+        // only, so that the outline stays while crowded surface particles
+        // spread along it. The face row and the corners stay.
+        for s in [&self.mantle, &self.top] {
+            let last = s.particles.len() - 1;
+            for (k, &i) in s.particles.iter().enumerate() {
+                let n = s.normal(k, &self.pos);
+                free[i] =
+                    if k == 0 || k == last || self.contact[i] || self.on_axis[i] || n == [0.0; 2] {
+                        Freedom::Fixed
+                    } else {
+                        Freedom::Across(n)
+                    };
             }
         }
+        for &i in &self.face.particles {
+            free[i] = Freedom::Fixed;
+        }
         free
+    }
+
+    /// The particles of the surfaces (mantle, top, face row) with their
+    /// outward normals, as the traction-free condition takes them.
+    fn surface_normals(&self) -> Vec<(usize, [f64; 2])> {
+        let mut out = Vec::with_capacity(
+            self.mantle.particles.len() + self.top.particles.len() + self.face.particles.len(),
+        );
+        for (k, &i) in self.mantle.particles.iter().enumerate() {
+            out.push((i, self.mantle.normal(k, &self.pos)));
+        }
+        for (s, first) in [(&self.top, [0.0, 1.0]), (&self.face, [0.0, -1.0])] {
+            for (k, &i) in s.particles.iter().enumerate() {
+                let n = if k == 0 {
+                    first
+                } else {
+                    s.normal(k, &self.pos)
+                };
+                out.push((i, n));
+            }
+        }
+        out
     }
 
     /// Particle shifting (src/solver/shift.rs): pushes apart the pairs closer
@@ -864,9 +906,11 @@ impl TaylorSolver {
             nbr_len: &ws.nbr_len,
             stride: ws.stride,
         };
+        let outward = surface_band(c, n, self.surface_normals(), SURFACE_BAND * spacing);
         let mut d = shifts(
             c,
             &free,
+            &outward,
             spacing,
             SHIFT_RANGE * spacing,
             self.p.shifting,
@@ -923,6 +967,12 @@ impl TaylorSolver {
             self.pos[i] = [self.pos[i][0] + di[0], self.pos[i][1] + di[1]];
         }
         self.smoothing_dissipation += ke[0] - ke[1];
+        // A surface particle that slid carries the stress of its new place:
+        // the traction-free condition again, on the new normals.
+        let slid = |s: &Surface| s.particles.iter().any(|&i| d[i] != [0.0; 2]);
+        if slid(&self.mantle) || slid(&self.top) {
+            self.apply_surface_stress_bc();
+        }
         Ok(true)
     }
 

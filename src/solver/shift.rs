@@ -48,9 +48,15 @@ impl Candidates<'_> {
 /// the initial spacing), limited to `cap` in length and projected on the
 /// directions the particle is free in. Mirror images count, so a particle
 /// is pushed off the axis and the anvil by its own image as by any other.
+/// A particle with an `outward` normal (nonzero: that of the nearest surface
+/// particle, see [`surface_band`]) does not shift along it: pushed from
+/// inside, it slides along the surface instead of passing out through it
+/// between two surface particles (Lind et al. 2012 restrict shifting near a
+/// free surface the same way).
 pub(super) fn shifts(
     c: Candidates,
     free: &[Freedom],
+    outward: &[[f64; 2]],
     spacing: f64,
     range: f64,
     beta: f64,
@@ -79,6 +85,11 @@ pub(super) fn shifts(
                 let dn = d[0] * n[0] + d[1] * n[1];
                 d = [d[0] - dn * n[0], d[1] - dn * n[1]];
             }
+            let n = outward[i];
+            let dn = d[0] * n[0] + d[1] * n[1];
+            if dn > 0.0 {
+                d = [d[0] - dn * n[0], d[1] - dn * n[1]];
+            }
             let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
             if len > cap {
                 d = [d[0] * cap / len, d[1] * cap / len];
@@ -86,6 +97,42 @@ pub(super) fn shifts(
             d
         })
         .collect()
+}
+
+/// The outward normal each particle may not shift along (zero where it
+/// is free to): that of the nearest particle of a surface within `reach`,
+/// given the surface particles with their outward normals. Only real
+/// particles (index below `free.len()`) that are not surface particles
+/// themselves are marked.
+pub(super) fn surface_band(
+    c: Candidates,
+    n: usize,
+    surface: impl IntoIterator<Item = (usize, [f64; 2])>,
+    reach: f64,
+) -> Vec<[f64; 2]> {
+    let mut out = vec![[0.0; 2]; n];
+    let mut nearest = vec![reach * reach; n];
+    let mut on = vec![false; n];
+    let surface: Vec<(usize, [f64; 2])> = surface.into_iter().collect();
+    for &(s, _) in &surface {
+        on[s] = true;
+    }
+    for &(s, normal) in &surface {
+        let xs = c.pos[s];
+        for &j in c.of(s) {
+            let j = j as usize;
+            if j >= n || on[j] {
+                continue;
+            }
+            let (a, b) = (c.pos[j][0] - xs[0], c.pos[j][1] - xs[1]);
+            let r2 = a * a + b * b;
+            if r2 < nearest[j] {
+                nearest[j] = r2;
+                out[j] = normal;
+            }
+        }
+    }
+    out
 }
 
 /// Which particles of the axis column leave the axis, given their places
@@ -329,6 +376,7 @@ mod tests {
         // A lattice at the initial spacing: nobody is within the range.
         let (mut pos, nbr, len, stride) = lattice(5, 5, 1.0);
         let free = vec![Freedom::Both; pos.len()];
+        let none = vec![[0.0; 2]; pos.len()];
         let c = Candidates {
             pos: &pos,
             nbr: &nbr,
@@ -337,7 +385,7 @@ mod tests {
         };
         let (beta, range) = (0.1, 0.5);
         assert!(
-            shifts(c, &free, 1.0, range, beta, 1.0)
+            shifts(c, &free, &none, 1.0, range, beta, 1.0)
                 .iter()
                 .all(|d| *d == [0.0; 2])
         );
@@ -350,7 +398,7 @@ mod tests {
             nbr_len: &len,
             stride,
         };
-        let d = shifts(c, &free, 1.0, range, beta, 1.0);
+        let d = shifts(c, &free, &none, 1.0, range, beta, 1.0);
         let push = beta * (1.0f64 - 0.2 / 0.5).powi(2);
         assert!(
             (d[12][1] - push).abs() < 1e-15 && d[12][0] == 0.0,
@@ -368,12 +416,48 @@ mod tests {
                 .all(|(i, d)| i == 7 || i == 12 || *d == [0.0; 2])
         );
         // The cap and the freedoms hold.
-        let d = shifts(c, &free, 1.0, range, beta, 0.01);
+        let d = shifts(c, &free, &none, 1.0, range, beta, 0.01);
         assert!((d[12][1] - 0.01).abs() < 1e-15);
         let mut only_r = free.clone();
         only_r[12] = Freedom::Across([0.0, 1.0]);
         only_r[7] = Freedom::Fixed;
-        let d = shifts(c, &only_r, 1.0, range, beta, 1.0);
+        let d = shifts(c, &only_r, &none, 1.0, range, beta, 1.0);
         assert_eq!((d[12], d[7]), ([0.0; 2], [0.0; 2]));
+    }
+
+    /// A particle in the gap between two surface particles, pushed from
+    /// inside, moves out through the surface without the band and does not
+    /// with it; the particle pushing it still moves inward, and particles
+    /// beyond the reach or on the surface are not marked.
+    #[test]
+    fn the_surface_band_keeps_a_pushed_particle_from_passing_out() {
+        let (mut pos, nbr, len, stride) = lattice(5, 5, 1.0);
+        // The top row (20-24) is the surface, normal +Z, with a gap over
+        // particle 17: 21 and 23 stand 0.4 to either side of it, 22 is gone.
+        pos[21] = [1.6, 4.0];
+        pos[23] = [2.4, 4.0];
+        pos[22] = [2.0, 10.0];
+        pos[17] = [2.0, 3.8];
+        pos[12] = [2.0, 3.45];
+        let c = Candidates {
+            pos: &pos,
+            nbr: &nbr,
+            nbr_len: &len,
+            stride,
+        };
+        let free = vec![Freedom::Both; pos.len()];
+        let none = vec![[0.0; 2]; pos.len()];
+        let (beta, range) = (0.1, 0.5);
+        let d = shifts(c, &free, &none, 1.0, range, beta, 1.0);
+        assert!(d[17][1] > 0.005, "{:?}", d[17]);
+        let top = [20, 21, 22, 23, 24].map(|i| (i, [0.0, 1.0]));
+        let band = surface_band(c, pos.len(), top, 1.0);
+        assert_eq!(band[17], [0.0, 1.0]);
+        assert_eq!(band[12], [0.0, 1.0]);
+        assert_eq!(band[7], [0.0; 2]);
+        assert_eq!(band[21], [0.0; 2]);
+        let d = shifts(c, &free, &band, 1.0, range, beta, 1.0);
+        assert!(d[17][0].abs() < 1e-15 && d[17][1] == 0.0, "{:?}", d[17]);
+        assert!(d[12][1] < -0.005, "{:?}", d[12]);
     }
 }
