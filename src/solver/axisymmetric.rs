@@ -906,7 +906,7 @@ impl TaylorSolver {
             nbr_len: &ws.nbr_len,
             stride: ws.stride,
         };
-        let outward = surface_band(c, n, self.surface_normals(), SURFACE_BAND * spacing);
+        let outward = surface_band(c, n, &self.surface_normals(), SURFACE_BAND * spacing);
         let mut d = shifts(
             c,
             &free,

@@ -102,22 +102,21 @@ pub(super) fn shifts(
 /// The outward normal each particle may not shift along (zero where it
 /// is free to): that of the nearest particle of a surface within `reach`,
 /// given the surface particles with their outward normals. Only real
-/// particles (index below `free.len()`) that are not surface particles
-/// themselves are marked.
+/// particles (index below `n`) that are not surface particles themselves
+/// are marked.
 pub(super) fn surface_band(
     c: Candidates,
     n: usize,
-    surface: impl IntoIterator<Item = (usize, [f64; 2])>,
+    surface: &[(usize, [f64; 2])],
     reach: f64,
 ) -> Vec<[f64; 2]> {
     let mut out = vec![[0.0; 2]; n];
     let mut nearest = vec![reach * reach; n];
     let mut on = vec![false; n];
-    let surface: Vec<(usize, [f64; 2])> = surface.into_iter().collect();
-    for &(s, _) in &surface {
+    for &(s, _) in surface {
         on[s] = true;
     }
-    for &(s, normal) in &surface {
+    for &(s, normal) in surface {
         let xs = c.pos[s];
         for &j in c.of(s) {
             let j = j as usize;
@@ -451,7 +450,7 @@ mod tests {
         let d = shifts(c, &free, &none, 1.0, range, beta, 1.0);
         assert!(d[17][1] > 0.005, "{:?}", d[17]);
         let top = [20, 21, 22, 23, 24].map(|i| (i, [0.0, 1.0]));
-        let band = surface_band(c, pos.len(), top, 1.0);
+        let band = surface_band(c, pos.len(), &top, 1.0);
         assert_eq!(band[17], [0.0, 1.0]);
         assert_eq!(band[12], [0.0, 1.0]);
         assert_eq!(band[7], [0.0; 2]);
