@@ -221,6 +221,12 @@ impl PointState {
     pub fn ceramic(&self) -> Option<&CeramicVars> {
         self.damage.as_ref()
     }
+
+    /// Whether the point is a pulverized ceramic (its material has the
+    /// Rajendran-Grove model and the point has reached pulverization).
+    pub fn is_pulverized(&self) -> bool {
+        self.ceramic().is_some_and(|v| v.pulverized.is_some())
+    }
 }
 
 /// Per-particle state of a material's models, owned next to the material:

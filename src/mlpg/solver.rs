@@ -1254,11 +1254,9 @@ impl Mlpg3d {
         if damaging {
             let points = self.material_state.points();
             scratch.loose.clear();
-            scratch.loose.extend(
-                points
-                    .iter()
-                    .map(|p| p.ceramic().is_some_and(|v| v.pulverized.is_some())),
-            );
+            scratch
+                .loose
+                .extend(points.iter().map(|p| p.is_pulverized()));
             let loose = extended(images, &scratch.loose, &mut scratch.ext_loose, mirror::same);
             contact::loose_pairs(
                 pos,
@@ -1617,10 +1615,7 @@ impl Mlpg3d {
             // 4 across: energy error 18.8 % against 0.46 % with it fixed;
             // README, "Ballistic penetration"); the contact of pulverized
             // nodes keeps them apart.
-            let pulverized = points
-                .get(i)
-                .and_then(|p| p.ceramic())
-                .is_some_and(|v| v.pulverized.is_some());
+            let pulverized = points.get(i).is_some_and(|p| p.is_pulverized());
             *f = if pulverized {
                 Freedom::Fixed
             } else if !anvil {
@@ -1640,14 +1635,15 @@ impl Mlpg3d {
             };
         });
         let pos = extended(images, &self.pos, &mut scratch.ext_pos, mirror::vector);
+        let step_scale = self.setup.weak_form.step_scale();
         shifts(
             pos,
             &g.shapes,
             &scratch.free,
             spacing,
             SHIFT_RANGE * spacing,
-            self.setup.shifting * self.setup.weak_form.step_scale(),
-            SHIFT_CAP * spacing * self.setup.weak_form.step_scale(),
+            self.setup.shifting * step_scale,
+            SHIFT_CAP * spacing * step_scale,
             &mut scratch.shift,
         );
         // A node on a symmetry plane moves in it.

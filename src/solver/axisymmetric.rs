@@ -820,7 +820,7 @@ impl TaylorSolver {
     /// outline, which sliding keeps), none on the face row, the corners and
     /// a surface particle on the anvil or the axis, along Z on the axis,
     /// along R on the anvil, none on both.
-    fn freedoms(&self) -> Vec<Freedom> {
+    fn freedoms(&self, normals: &[(usize, [f64; 2])]) -> Vec<Freedom> {
         let mut free: Vec<Freedom> = self
             .contact
             .iter()
@@ -835,11 +835,13 @@ impl TaylorSolver {
         // The surfaces slide along themselves: a particle of the mantle or
         // the top (not a corner, nor on the anvil) moves across its normal
         // only, so that the outline stays while crowded surface particles
-        // spread along it. The face row and the corners stay.
-        for s in [&self.mantle, &self.top] {
+        // spread along it. The face row and the corners stay. The normals
+        // are those of [`Self::surface_normals`] (mantle, then top).
+        let m = self.mantle.particles.len();
+        for (s, normals) in [(&self.mantle, &normals[..m]), (&self.top, &normals[m..])] {
             let last = s.particles.len() - 1;
             for (k, &i) in s.particles.iter().enumerate() {
-                let n = s.normal(k, &self.pos);
+                let n = normals[k].1;
                 free[i] =
                     if k == 0 || k == last || self.contact[i] || self.on_axis[i] || n == [0.0; 2] {
                         Freedom::Fixed
@@ -886,7 +888,8 @@ impl TaylorSolver {
     fn shift(&mut self, ws: &mut Workspace, margin: Option<f64>) -> Result<bool> {
         let n = self.particles();
         let spacing = self.spacing();
-        let mut free = self.freedoms();
+        let normals = self.surface_normals();
+        let mut free = self.freedoms(&normals);
         if let Some(m) = margin {
             let reach = SHIFT_RANGE * spacing * (1.0 + 1e-9) + m;
             for (f, p) in free.iter_mut().zip(&ws.part) {
@@ -906,7 +909,7 @@ impl TaylorSolver {
             nbr_len: &ws.nbr_len,
             stride: ws.stride,
         };
-        let outward = surface_band(c, n, &self.surface_normals(), SURFACE_BAND * spacing);
+        let outward = surface_band(c, n, &normals, SURFACE_BAND * spacing);
         let mut d = shifts(
             c,
             &free,
