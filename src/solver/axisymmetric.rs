@@ -350,6 +350,18 @@ fn fill_images<T: Mirrored>(f: &mut [T], n: usize, images: &[Image]) {
     }
 }
 
+/// The outward normal of the top at the axis.
+const TOP_ON_AXIS: [f64; 2] = [0.0, 1.0];
+/// The outward normal of the impact face at the axis.
+const FACE_ON_AXIS: [f64; 2] = [0.0, -1.0];
+
+/// The outward normal at the `k`-th particle of a surface that starts on
+/// the axis (the top or the face): `on_axis` for the particle on the axis,
+/// where the surface is flat by symmetry, else [`Surface::normal`].
+fn normal_from_axis(s: &Surface, k: usize, pos: &[[f64; 2]], on_axis: [f64; 2]) -> [f64; 2] {
+    if k == 0 { on_axis } else { s.normal(k, pos) }
+}
+
 /// Kinetic energy of a particle of mass `m` and velocity `v`.
 #[inline]
 fn kinetic1(v: [f64; 2], m: f64) -> f64 {
@@ -865,14 +877,9 @@ impl TaylorSolver {
         for (k, &i) in self.mantle.particles.iter().enumerate() {
             out.push((i, self.mantle.normal(k, &self.pos)));
         }
-        for (s, first) in [(&self.top, [0.0, 1.0]), (&self.face, [0.0, -1.0])] {
+        for (s, on_axis) in [(&self.top, TOP_ON_AXIS), (&self.face, FACE_ON_AXIS)] {
             for (k, &i) in s.particles.iter().enumerate() {
-                let n = if k == 0 {
-                    first
-                } else {
-                    s.normal(k, &self.pos)
-                };
-                out.push((i, n));
+                out.push((i, normal_from_axis(s, k, &self.pos, on_axis)));
             }
         }
         out
@@ -1474,11 +1481,7 @@ impl TaylorSolver {
             };
         }
         for (k, &i) in self.top.particles.iter().enumerate().take(nr - 1) {
-            let n = if k == 0 {
-                [0.0, 1.0]
-            } else {
-                self.top.normal(k, &self.pos)
-            };
+            let n = normal_from_axis(&self.top, k, &self.pos, TOP_ON_AXIS);
             self.stress_bc[i] = traction_free(&self.stress_bc[i], n);
         }
         for (k, &i) in self.face.particles.iter().enumerate().take(nr - 1) {
@@ -1486,11 +1489,7 @@ impl TaylorSolver {
                 // Smooth anvil: no shear traction.
                 self.stress_bc[i][3] = 0.0;
             } else {
-                let n = if k == 0 {
-                    [0.0, -1.0]
-                } else {
-                    self.face.normal(k, &self.pos)
-                };
+                let n = normal_from_axis(&self.face, k, &self.pos, FACE_ON_AXIS);
                 self.stress_bc[i] = traction_free(&self.stress_bc[i], n);
             }
         }

@@ -82,13 +82,11 @@ pub(super) fn shifts(
                 }
             }
             if let Freedom::Across(n) = free[i] {
-                let dn = d[0] * n[0] + d[1] * n[1];
-                d = [d[0] - dn * n[0], d[1] - dn * n[1]];
+                d = without_along(d, n);
             }
             let n = outward[i];
-            let dn = d[0] * n[0] + d[1] * n[1];
-            if dn > 0.0 {
-                d = [d[0] - dn * n[0], d[1] - dn * n[1]];
+            if d[0] * n[0] + d[1] * n[1] > 0.0 {
+                d = without_along(d, n);
             }
             let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
             if len > cap {
@@ -97,6 +95,13 @@ pub(super) fn shifts(
             d
         })
         .collect()
+}
+
+/// `d` without its component along the unit vector `n`.
+#[inline]
+fn without_along(d: [f64; 2], n: [f64; 2]) -> [f64; 2] {
+    let dn = d[0] * n[0] + d[1] * n[1];
+    [d[0] - dn * n[0], d[1] - dn * n[1]]
 }
 
 /// The outward normal each particle may not shift along (zero where it
