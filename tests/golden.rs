@@ -2,7 +2,11 @@
 //! and histories must keep their exact bits while the core is reorganised
 //! (scene registry, `Model` trait, composed materials). A change of any bit
 //! fails it; the expected values were recorded from the code before the
-//! refactoring began and are never re-recorded by it.
+//! refactoring began and are never re-recorded by it. One case was
+//! re-recorded for a change of the scheme, not of the code's organisation:
+//! the large-strain case on 2026-11-27, when the density's smoothing took
+//! the velocity's order (README, "Smoothing at large strain"); the paper's
+//! case and Noh keep the bits they were first recorded with.
 //!
 //! Each case is a digest: the bits of every final observable, and an FNV-1a
 //! checksum over the bits of every recorded time and value. Every case runs
@@ -108,21 +112,21 @@ fn cases() -> Vec<Golden> {
                 LARGE[2],
             ],
             finals: &[
-                0x3fa2_95a5_293b_6f50,
-                0x3f72_bae4_bdb6_7ad2,
-                0x3f93_160e_040c_a043,
-                0x4060_b525_3a8c_8493,
+                0x3fa2_9560_999b_ff2f,
+                0x3f72_c01a_f233_f116,
+                0x3f93_12a5_d01a_fd93,
+                0x4060_b4b4_6252_c492,
                 0x0000_0000_0000_0000,
-                0x3fda_51af_ff13_ce03,
-                0x407a_d6f4_dbcc_b2b4,
-                0x405b_ea34_e4f9_91ff,
-                0x4058_556a_b4b2_2bac,
-                0x4021_8041_480d_7738,
-                0x4006_1100_025b_c641,
-                0x3f43_a868_bfeb_2241,
+                0x3fda_1bf9_4abc_c286,
+                0x407a_c58b_9efd_da1f,
+                0x405b_f6d8_fc28_0a4d,
+                0x4058_3321_21f3_d982,
+                0x4022_23d6_1524_e350,
+                0x4006_135c_875e_aac8,
+                0x3f46_44b6_b091_dc1e,
                 0x0000_0000_0000_0000,
             ],
-            history: 0x169c_229d_bf0a_8091,
+            history: 0x2e77_cdb5_89e0_b476,
             rows: 102,
         },
     ]

@@ -352,8 +352,8 @@ fn rows_pressed_on_the_anvil_close_evenly_and_stay_above_the_guard() {
 /// scheme, with particle shifting) at the default 20 particles across runs to
 /// rest, no pair closer than the spacing guard, within 2% in length of
 /// 21.42 mm and 3% in face radius of 7.15 mm (the published finite-element
-/// solutions), with the energy balanced within 5%. Measured: +1.10% and
-/// +0.17%, energy error 0.020, at rest at 84.7 us.
+/// solutions), with the energy balanced within 5%. Measured: +0.88% and
+/// −0.80%, energy error 0.021, at rest at 84.5 us.
 #[test]
 fn wilkins_bar_runs_to_rest_with_the_face_of_the_finite_element_solutions() {
     let sim = run(wilkins_scene(), &[]);
@@ -380,7 +380,7 @@ fn check_benchmark(sim: &Simulation, length: (f64, f64), radius: (f64, f64)) {
 
 /// Test 7 at 400 m/s, more than twice its speed, with the large-strain
 /// scheme runs to rest with the energy balanced within 5% (measured: at
-/// rest at 61.6 us, energy error 0.028); with the paper's scheme it stops
+/// rest at 61.0 us, energy error 0.033); with the paper's scheme it stops
 /// with a singular moment matrix at the face centre at 15.3 us.
 #[test]
 fn test7_at_400_mps_runs_to_rest_with_the_large_strain_scheme() {
@@ -429,9 +429,9 @@ fn check_rest(sim: &Simulation) {
 /// near-melt rod of the stability matrix (T0 = Tm - 50 K), run to rest with
 /// the large-strain scheme. Both flatten into a flange that stays pressed on
 /// the anvil, and end by the quiet rule (README, End condition). Measured:
-/// 600 m/s at rest at 71.5 us (rod 13.80 mm, face radius 16.7 mm, energy
-/// error 0.020); near-melt at rest at 248 us (rod 5.91 mm, energy error
-/// 0.038). With the paper's scheme 600 m/s stops at 6.5 us (20 across).
+/// 600 m/s at rest at 71.6 us (rod 13.64 mm, face radius 16.6 mm, energy
+/// error 0.0091); near-melt at rest at 252 us (rod 5.32 mm, energy error
+/// 0.0062). With the paper's scheme 600 m/s stops at 6.5 us (20 across).
 #[test]
 fn the_speed_ladder_runs_to_rest_at_10_across() {
     let cases: [&[(&str, f64)]; 2] = [
@@ -450,11 +450,11 @@ fn the_speed_ladder_runs_to_rest_at_10_across() {
     });
 }
 
-/// At 800 m/s the flange's rim folds onto the anvil: the mantle particle of
-/// the second row comes down beside the rim of the face row, and the run
-/// stops with the named `SpacingCollapse` (README, "Where the large-strain
-/// scheme stops") instead of running on with particles on top of each
-/// other. Measured at 10 across: 29.7 us, flange radius 18.5 mm.
+/// At 800 m/s, once the rod is spent, particles crowd along the anvil far
+/// out in the flange, and the run stops with the named `SpacingCollapse`
+/// (README, "Where the large-strain scheme stops") instead of running on
+/// with particles on top of each other. Measured at 10 across: 79.6 us, flange radius 27.5 mm, kinetic
+/// energy 0.86 J of 4310 J.
 #[test]
 fn test7_at_800_mps_stops_with_a_named_error_once_spent() {
     let scene = large_strain(&[("impact_speed", 800.0), ("particles_radial", 10.0)]);
@@ -474,7 +474,7 @@ fn test7_at_800_mps_stops_with_a_named_error_once_spent() {
 }
 
 /// The speed ladder at the default 20 particles across (`scripts/validate.sh`):
-/// 600 m/s runs to rest (measured: 71.9 us, energy error 0.009, about 3
+/// 600 m/s runs to rest (measured: 72.3 us, energy error 0.0099, about 3
 /// minutes on one thread).
 #[test]
 #[ignore = "slow: run by scripts/validate.sh"]
@@ -488,7 +488,7 @@ fn test7_at_600_mps_runs_to_rest_at_paper_resolution() {
 /// the default 20 particles across runs to rest within 1% in length and 3%
 /// in face diameter of the converged axisymmetric finite-element results
 /// (DynELA and Abaqus: Lf 26.54 mm, Df 11.16 mm), with the energy balanced
-/// within 5%. Measured: +0.17% and +1.43%, energy error 0.0091.
+/// within 5%. Measured: +0.03% and −0.38%, energy error 0.011.
 #[test]
 fn crmo4_bar_matches_the_converged_finite_element_results() {
     let sim = run(

@@ -140,7 +140,7 @@ const AFTER: &[ParamSpec] = &[
         "1",
         1.0,
         Range::integer(1.0, 2.0),
-        "velocity smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)",
+        "velocity and density smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)",
     ),
     spec(
         "shifting",

@@ -22,7 +22,8 @@
 //!    (3.23), or with `smoothing_order = 2` its bi-Laplacian
 //!    `v - alpha L(L v)`, `L v` = Shepard mean minus value, which damps the
 //!    particle-scale waves as (3.23) does and the resolved flow far less;
-//! 4. velocity gradients, continuity, conservative smoothing of the density;
+//! 4. velocity gradients, continuity, conservative smoothing of the density
+//!    (of the same order as the velocity's);
 //! 5. stress update by the material ([`Material::update`]: Jaumann rate, trial
 //!    deviator, radial return of its strength model, heating from plastic
 //!    work, its EOS), internal energy from stress power;
@@ -253,6 +254,9 @@ struct Workspace {
     /// The smoothing operator applied once to the velocity (the Shepard
     /// mean minus the value), for the smoothing of order 2.
     lap: Vec<[f64; 2]>,
+    /// The same for the density (its smoothing follows the velocity's
+    /// order).
+    lap_rho: Vec<[f64; 1]>,
     rho: Vec<[f64; 1]>,
     /// Neighbours in the support this step, and their MSPH derivative
     /// weights (d/dR, d/dZ) and Shepard weights, in the padded layout.
@@ -348,6 +352,31 @@ fn fill_images<T: Mirrored>(f: &mut [T], n: usize, images: &[Image]) {
     for (img, im) in out.iter_mut().zip(images) {
         *img = real[im.source as usize].mirrored(im.mirror);
     }
+}
+
+/// The smoothing operator `L f = (Shepard mean of f) − f` at the real
+/// particles, `out[..n]`, and then at their images: the first pass of the
+/// smoothing of order 2.
+fn laplacians<const K: usize>(
+    team: &Team,
+    isa: Isa,
+    rows: Rows,
+    f: &[[f64; K]],
+    out: &mut [[f64; K]],
+    n: usize,
+    images: &[Image],
+) where
+    [f64; K]: Mirrored,
+{
+    let parts = Chunks::new(&mut out[..n], MIN_LEN);
+    team.run_parts(&parts, |c, out| {
+        let i0 = c * MIN_LEN;
+        shepard_means(isa, rows, f, i0, out);
+        for (k, l) in out.iter_mut().enumerate() {
+            *l = laplacian(f[i0 + k], *l);
+        }
+    });
+    fill_images(out, n, images);
 }
 
 /// The outward normal of the top at the axis.
@@ -760,6 +789,7 @@ impl TaylorSolver {
         ws.vel_s.resize(m, [0.0; 2]);
         if self.p.smoothing_order == 2.0 {
             ws.lap.resize(m, [0.0; 2]);
+            ws.lap_rho.resize(m, [0.0]);
         }
         ws.rho.resize(m, [0.0]);
         ws.part.resize(n, PairPass::default());
@@ -1025,6 +1055,7 @@ impl TaylorSolver {
             vel,
             vel_s,
             lap,
+            lap_rho,
             rho: rho_raw,
             act,
             wr,
@@ -1169,16 +1200,7 @@ impl TaylorSolver {
         let order2 = self.p.smoothing_order == 2.0;
         if order2 {
             // Order 2: first the operator L v = (Shepard mean of v) - v.
-            let vel = &*vel;
-            let parts = Chunks::new(&mut lap[..n], MIN_LEN);
-            team.run_parts(&parts, |c, out| {
-                let i0 = c * MIN_LEN;
-                shepard_means(isa, rows, vel, i0, out);
-                for (k, l) in out.iter_mut().enumerate() {
-                    *l = laplacian(vel[i0 + k], *l);
-                }
-            });
-            fill_images(lap, n, images);
+            laplacians(team, isa, rows, vel, lap, n, images);
         }
         {
             let (vel, lap) = (&*vel, &*lap);
@@ -1240,6 +1262,11 @@ impl TaylorSolver {
             });
         }
         fill_images(rho_raw, n, images);
+        // With order 2 the density is smoothed by the same bi-Laplacian as
+        // the velocity: first L ρ, then the Shepard mean of L ρ in the loop.
+        if order2 {
+            laplacians(team, isa, rows, rho_raw, lap_rho, n, images);
+        }
 
         // 5-6. Per particle: conservative smoothing of the density, the
         // constitutive update, positions x^{n+1} = x^n + dt v^{n+1/2}, anvil
@@ -1274,11 +1301,19 @@ impl TaylorSolver {
                     let i0 = c * MIN_LEN;
                     let mut means = [[0.0]; MIN_LEN];
                     let means = &mut means[..dev.len()];
-                    shepard_means(isa, rows, rho_raw, i0, means);
+                    if order2 {
+                        shepard_means(isa, rows, lap_rho, i0, means);
+                    } else {
+                        shepard_means(isa, rows, rho_raw, i0, means);
+                    }
                     let mut t = Tally::default();
                     for k in 0..dev.len() {
                         let i = i0 + k;
-                        let [rho_new] = smooth(rho_raw[i], means[k], alpha);
+                        let [rho_new] = if order2 {
+                            smooth2(rho_raw[i], lap_rho[i], means[k], alpha)
+                        } else {
+                            smooth(rho_raw[i], means[k], alpha)
+                        };
                         let g = grads[i];
                         let d_rr = g[0];
                         let d_zz = g[3];
