@@ -91,13 +91,7 @@ fn explore_elastic_rebound() {
                 s.in_contact().iter().filter(|&&c| c).count()
             );
             if std::env::var("HELD").is_ok() {
-                let face: Vec<usize> = (0..s.particles())
-                    .filter(|&i| s.lattice().position[i][2] == 0.0)
-                    .collect();
-                println!(
-                    "  the anvil's pressure {:.3e} Pa",
-                    -face_traction(&s, &face)
-                );
+                println!("  the anvil's pressure {:.3e} Pa", -face_traction(&s));
             }
         }
     }
@@ -166,16 +160,13 @@ fn elastic_rebound_with(rings: usize, smoothing: f64, form: WeakForm) -> (Mlpg3d
     };
     let mut passing = [f64::NAN; 2];
     let mut last = (0.0, [v0; 2]);
-    let face: Vec<usize> = (0..s.particles())
-        .filter(|&i| s.lattice().position[i][2] == 0.0)
-        .collect();
     let mut traction = (0.0, -1.0);
     let mut unloaded = f64::NAN;
     let transit = ROD.length / (youngs() / RHO).sqrt();
     while !s.finished() {
         s.step().unwrap();
         let now = [mean(&s, &layers[0]), mean(&s, &layers[1])];
-        let t = face_traction(&s, &face);
+        let t = face_traction(&s);
         if unloaded.is_nan() && s.time() > transit && t >= 0.0 && traction.1 < 0.0 {
             unloaded = traction.0 + (s.time() - traction.0) * traction.1 / (traction.1 - t);
         }
@@ -200,10 +191,12 @@ fn elastic_rebound_with(rings: usize, smoothing: f64, form: WeakForm) -> (Mlpg3d
     (s, passing, unloaded)
 }
 
-/// The mean axial stress of the face nodes `face`, weighted by their
-/// masses (their shares of the face's area): the anvil's pressure on the
-/// rod as its stresses give it (Pa, negative in compression).
-fn face_traction(s: &Mlpg3d, face: &[usize]) -> f64 {
+/// The mean axial stress of the face nodes (the lattice's face set),
+/// weighted by their masses (their shares of the face's area): the anvil's
+/// pressure on the rod as its stresses give it (Pa, negative in
+/// compression).
+fn face_traction(s: &Mlpg3d) -> f64 {
+    let face = &s.lattice().sets.face;
     let (m, stress) = (s.masses(), s.stress());
     let total: f64 = face.iter().map(|&i| m[i]).sum();
     face.iter().map(|&i| m[i] * stress[i][2]).sum::<f64>() / total
