@@ -250,7 +250,7 @@ fn a_taylor3d_run_saved_mid_way_resumes_to_the_bits_of_the_whole_run() {
 fn forged_taylor3d_states_are_refused() {
     let (_, base) = saved("taylor3d", &[("particles_radial", 3.0)], 3e-6);
     type Edit = fn(&mut Value);
-    let edits: [(&str, Edit, &str); 14] = [
+    let edits: [(&str, Edit, &str); 16] = [
         (
             "scene parameter out of range",
             |s| s["scene"]["params"]["Taylor3d"]["density"] = json!(-5.0),
@@ -287,6 +287,32 @@ fn forged_taylor3d_states_are_refused() {
                     .pop();
             },
             "contact",
+        ),
+        (
+            "the anvil pulling on a node it holds",
+            |s| {
+                let held = solver(s, "Taylor3d")["contact"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .position(|c| c == &json!(true))
+                    .unwrap();
+                solver(s, "Taylor3d")["reaction"][held] = json!(-1.0);
+            },
+            "anvil reactions",
+        ),
+        (
+            "the anvil pushing on a node off it",
+            |s| {
+                let free = solver(s, "Taylor3d")["contact"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .position(|c| c == &json!(false))
+                    .unwrap();
+                solver(s, "Taylor3d")["reaction"][free] = json!(1.0);
+            },
+            "anvil reactions",
         ),
         (
             "a negative density",

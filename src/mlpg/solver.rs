@@ -15,7 +15,8 @@
 //!    (the Heaviside weak form: the sphere's inertia);
 //! 2. `v^{n+1/2} = v^{n−1/2} + dt a_i`; a node on the anvil keeps `v_z = 0`
 //!    while the anvil pushes it (`F_z ≤ 0`) and is released when its sphere
-//!    pulls it away (`F_z > 0`: the contact force would be tensile); then
+//!    pulls it away (`F_z > 0`: the contact force would be tensile), the
+//!    release timed where `F_z`, linear between the steps, crosses zero; then
 //!    the velocity smoothing `v ← v + α (Σ_J φ_J(x_i) v_J − v_i)`
 //!    ([`SMOOTHING`]), its kinetic energy booked as `smoothing_dissipation`;
 //!    in a run of several bodies, the contact impulses between them, and
@@ -315,6 +316,12 @@ pub struct Mlpg3d {
     /// by its Nanson plane, so a restored run rebuilds them as they were).
     #[serde(default)]
     built_contact: Vec<bool>,
+    /// The anvil's reaction on each node held on it at the last step's
+    /// forces, `−F_z ≥ 0` (N; zero on a free node): a release is timed by
+    /// the zero of the node's net axial force between that step and the
+    /// next ([`Mlpg3d::last_release`]).
+    #[serde(default)]
+    reaction: Vec<f64>,
     // Node fields (structure of arrays).
     pos: Vec<[f64; 3]>,
     vel: Vec<[f64; 3]>,
@@ -397,13 +404,13 @@ impl NamedPairs {
 struct Scratch {
     total: Vec<[f64; 6]>,
     force: Vec<[f64; 3]>,
-    kicked: Vec<(f64, bool)>,
+    kicked: Vec<(f64, Option<f64>)>,
     smooth: Vec<[f64; 3]>,
     /// The smoothing's defect `H v` (order 2: `Hᵀ M H v`) and, with
     /// order 2, the mass-weighted defect `M H v`.
     defect: Vec<[f64; 3]>,
     pass: Vec<[f64; 3]>,
-    moved: Vec<(f64, f64, bool, Option<f64>)>,
+    moved: Vec<(f64, f64, Option<f64>, Option<f64>)>,
     grad: Vec<[[f64; 3]; 3]>,
     /// The nodal volumes `m / ρ` (the nodal form).
     volume: Vec<f64>,
@@ -444,11 +451,11 @@ impl Scratch {
     fn fit(&mut self, n: usize) {
         self.total.resize(n, [0.0; 6]);
         self.force.resize(n, [0.0; 3]);
-        self.kicked.resize(n, (0.0, false));
+        self.kicked.resize(n, (0.0, None));
         self.smooth.resize(n, [0.0; 3]);
         self.defect.resize(n, [0.0; 3]);
         self.pass.resize(n, [0.0; 3]);
-        self.moved.resize(n, (0.0, 0.0, false, None));
+        self.moved.resize(n, (0.0, 0.0, None, None));
         self.grad.resize(n, [[0.0; 3]; 3]);
         self.volume.resize(n, 0.0);
         self.results.resize(n, Ok(Tally::default()));
@@ -581,6 +588,7 @@ impl Mlpg3d {
             temp,
             visc: vec![[0.0; 6]; n],
             built_contact: contact.clone(),
+            reaction: vec![0.0; n],
             contact,
             plane,
             supports_at: pos.clone(),
@@ -1020,7 +1028,10 @@ impl Mlpg3d {
         &self.contact
     }
 
-    /// Time of the last release of a node from the anvil (s).
+    /// Time of the last release of a node from the anvil (s): where the
+    /// node's net axial force, linear between the last step it was held
+    /// (pushed by the anvil) and the step it lets go (pulled away), crosses
+    /// zero; the node leaves the anvil in that step.
     pub fn last_release(&self) -> f64 {
         self.last_release
     }
@@ -1143,12 +1154,14 @@ impl Mlpg3d {
         let (volume, rho, mass) = (&g.op.volume, &self.rho, &self.mass);
         let plane = &self.plane;
         let kicked = &mut scratch.kicked;
+        let now = self.time;
         self.vel
             .par_iter_mut()
             .zip(self.contact.par_iter_mut())
+            .zip(self.reaction.par_iter_mut())
             .zip(kicked.par_iter_mut())
             .enumerate()
-            .for_each(|(i, ((v, touch), out))| {
+            .for_each(|(i, (((v, touch), reaction), out))| {
                 let f = force[i];
                 let inertia = if nodal { mass[i] } else { rho[i] * volume[i] };
                 // A node held on the anvil loses the speed it had toward it
@@ -1162,13 +1175,19 @@ impl Mlpg3d {
                 for d in 0..3 {
                     v[d] += dt * f[d] / inertia;
                 }
-                let mut released = false;
+                // The release is timed where the net axial force, linear
+                // between the last step's (−reaction ≤ 0) and this one's
+                // (> 0), crosses zero (the last step's length taken as this
+                // one's: they differ only at a rebuild).
+                let mut released = None;
                 if *touch {
                     if f[2] > 0.0 {
                         *touch = false;
-                        released = true;
+                        released = Some(now - dt * f[2] / (f[2] + *reaction));
+                        *reaction = 0.0;
                     } else {
                         v[2] = 0.0;
+                        *reaction = -f[2];
                     }
                 }
                 if let Some(&on) = plane.get(i) {
@@ -1337,8 +1356,8 @@ impl Mlpg3d {
         self.steps += 1;
         for (i, &(held, lost, released, through)) in moved.iter().enumerate() {
             self.contact_dissipation += held + lost;
-            if released {
-                self.last_release = self.time;
+            if let Some(t) = released {
+                self.last_release = self.last_release.max(t);
             }
             if let Some(z) = through {
                 return Err(Error::ThroughBoundary {
@@ -1751,6 +1770,7 @@ impl Mlpg3d {
             + b(&self.reference)
             + b(&self.built_reference)
             + b(&self.built_contact)
+            + b(&self.reaction)
             + b(&l.position)
             + b(&l.volume)
             + b(&l.surfaces)
@@ -2164,6 +2184,18 @@ impl Mlpg3d {
         }
         if self.contact.len() != n || self.built_contact.len() != n {
             return Err(format!("its contact flags are not {n}"));
+        }
+        // The anvil holds only the nodes on it, and pushes.
+        if self.reaction.len() != n
+            || !self
+                .reaction
+                .iter()
+                .zip(&self.contact)
+                .all(|(&r, &c)| r.is_finite() && r >= 0.0 && (c || r == 0.0))
+        {
+            return Err(format!(
+                "its anvil reactions are not {n} finite values, at least zero, and zero off the anvil"
+            ));
         }
         // The quarter model's nodes stay on their side of the planes, those
         // on a plane on it, with no velocity across it.
