@@ -745,7 +745,8 @@ fn build3d(scene: &Scene) -> Mlpg3d {
 /// Exploration: where a jump of the energy error comes from. The scene
 /// file `MI_SCENE_FILE` (default the Wilkins bar in 3-D) with `MI_SET`
 /// overrides is run while the energy error stays below `MI_JUMP` (default
-/// 0.02); at the first step past it, the five nodes whose stress work
+/// 0.02); at the first step past it, the eight nodes of lowest density
+/// (with their surfaces and place) and the five nodes whose stress work
 /// `V Δp` and plastic strain changed most in that step are printed with
 /// their place, surfaces, contact, density ratio and nearest neighbour.
 #[test]
@@ -781,6 +782,17 @@ fn explore_energy_jump() {
                 .map(|i| ((p[i] - p0[i]).abs() + 1e9 * (e[i] - e0[i]).abs(), i))
                 .collect();
             by.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut low: Vec<(f64, usize)> = (0..p.len()).map(|i| (rho[i] / rho0, i)).collect();
+            low.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for &(ratio, i) in low.iter().take(8) {
+                println!(
+                    "  lowest density: node {i}, rho/rho0 {ratio:.3}, {:?}, r {:.3} mm z {:.3} mm (impact z {:.3})",
+                    s.lattice().surfaces[i],
+                    (x[i][0].powi(2) + x[i][1].powi(2)).sqrt() * 1e3,
+                    x[i][2] * 1e3,
+                    s.lattice().position[i][2] * 1e3,
+                );
+            }
             for &(_, i) in by.iter().take(5) {
                 let nearest = (0..x.len())
                     .filter(|&j| j != i)
