@@ -24,6 +24,18 @@ fn solver<'a>(state: &'a mut Value, kind: &str) -> &'a mut Value {
     &mut state["solver"][kind]
 }
 
+/// Sets the anvil's reaction of the first `taylor3d` node whose contact
+/// flag is `held` to `value`.
+fn set_reaction(state: &mut Value, held: bool, value: f64) {
+    let node = solver(state, "Taylor3d")["contact"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|c| c == &json!(held))
+        .unwrap();
+    solver(state, "Taylor3d")["reaction"][node] = json!(value);
+}
+
 /// Asserts that the edited state is refused with `InvalidState`, and
 /// returns the message.
 fn refused(state: &Value) -> String {
@@ -290,28 +302,12 @@ fn forged_taylor3d_states_are_refused() {
         ),
         (
             "the anvil pulling on a node it holds",
-            |s| {
-                let held = solver(s, "Taylor3d")["contact"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .position(|c| c == &json!(true))
-                    .unwrap();
-                solver(s, "Taylor3d")["reaction"][held] = json!(-1.0);
-            },
+            |s| set_reaction(s, true, -1.0),
             "anvil reactions",
         ),
         (
             "the anvil pushing on a node off it",
-            |s| {
-                let free = solver(s, "Taylor3d")["contact"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .position(|c| c == &json!(false))
-                    .unwrap();
-                solver(s, "Taylor3d")["reaction"][free] = json!(1.0);
-            },
+            |s| set_reaction(s, false, 1.0),
             "anvil reactions",
         ),
         (
