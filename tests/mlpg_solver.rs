@@ -702,7 +702,7 @@ fn explore_wilkins3d_face() {
                 println!(
                     "   node {i}: z {:.3} mm r {:.3} mm (at impact z {:.3}), v {:?}, {:?}, contact {}, p {:.2} GPa, eps {:.2}",
                     x[i][2] * 1e3,
-                    (x[i][0].powi(2) + x[i][1].powi(2)).sqrt() * 1e3,
+                    radius_mm(x[i]),
                     s.lattice().position[i][2] * 1e3,
                     v[i].map(|a| (a * 10.0).round() / 10.0),
                     surf[i],
@@ -729,6 +729,11 @@ fn wilkins_or_env_scene() -> Scene {
         }
     }
     scene
+}
+
+/// The distance of `x` from the rod's axis, in mm (the explorations' prints).
+fn radius_mm(x: [f64; 3]) -> f64 {
+    x[0].hypot(x[1]) * 1e3
 }
 
 /// The 3-D solver of a `taylor3d` scene, with the scene's material choice.
@@ -788,7 +793,7 @@ fn explore_energy_jump() {
                 println!(
                     "  lowest density: node {i}, rho/rho0 {ratio:.3}, {:?}, r {:.3} mm z {:.3} mm (impact z {:.3})",
                     s.lattice().surfaces[i],
-                    (x[i][0].powi(2) + x[i][1].powi(2)).sqrt() * 1e3,
+                    radius_mm(x[i]),
                     x[i][2] * 1e3,
                     s.lattice().position[i][2] * 1e3,
                 );
@@ -809,7 +814,7 @@ fn explore_energy_jump() {
                     .sqrt();
                 println!(
                     "  node {i}: r {:.3} mm z {:.3} mm (impact z {:.3}), {:?}, contact {}, p {:.2} -> {:.2} GPa, eps {:.3} -> {:.3}, rho/rho0 {:.3}, nearest {:.1} um, moved {:.2} um",
-                    (x[i][0].powi(2) + x[i][1].powi(2)).sqrt() * 1e3,
+                    radius_mm(x[i]),
                     x[i][2] * 1e3,
                     s.lattice().position[i][2] * 1e3,
                     s.lattice().surfaces[i],
