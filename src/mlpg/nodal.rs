@@ -34,6 +34,30 @@ use super::mls::NodalShapes;
 use super::weak::VOIGT;
 use rayon::prelude::*;
 
+/// The transpose of the rows of `shapes` over `columns ≥ shapes.len()`
+/// nodes, by a counting sort: column `J` is `offsets[J]..offsets[J + 1]`
+/// of the entries `(q, i)`, `q` the entry of row `i` that names `J`, in
+/// ascending `i`.
+pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<(usize, usize)>) {
+    let mut offsets = vec![0usize; columns + 1];
+    for &j in &shapes.nodes {
+        offsets[j + 1] += 1;
+    }
+    for j in 0..columns {
+        offsets[j + 1] += offsets[j];
+    }
+    let mut next = offsets.clone();
+    let mut entries = vec![(0, 0); shapes.nodes.len()];
+    for i in 0..shapes.len() {
+        for q in shapes.row(i) {
+            let j = shapes.nodes[q];
+            entries[next[j]] = (q, i);
+            next[j] += 1;
+        }
+    }
+    (offsets, entries)
+}
+
 /// The transpose of the nodal shape functions and their gradients: for
 /// each node `J`, the nodes `i` (ascending) with `φ_J(x_i)` and
 /// `∇φ_J(x_i)`.
@@ -54,32 +78,12 @@ impl NodalOperator {
     /// with mirror images, `src/mlpg/mirror.rs`): a counting sort, rows in node
     /// order, each in ascending `i`.
     pub fn build(shapes: &NodalShapes, columns: usize) -> Self {
-        let n = shapes.offsets.len().saturating_sub(1);
-        let mut offsets = vec![0usize; columns + 1];
-        for &j in &shapes.nodes {
-            offsets[j + 1] += 1;
-        }
-        for j in 0..columns {
-            offsets[j + 1] += offsets[j];
-        }
-        let mut next = offsets.clone();
-        let mut nodes = vec![0usize; shapes.nodes.len()];
-        let mut grad = vec![[0.0; 3]; shapes.nodes.len()];
-        let mut phi = vec![0.0; shapes.nodes.len()];
-        for i in 0..n {
-            for q in shapes.row(i) {
-                let j = shapes.nodes[q];
-                nodes[next[j]] = i;
-                grad[next[j]] = shapes.grad[q];
-                phi[next[j]] = shapes.phi[q];
-                next[j] += 1;
-            }
-        }
+        let (offsets, entries) = transpose(shapes, columns);
         NodalOperator {
             offsets,
-            nodes,
-            grad,
-            phi,
+            nodes: entries.iter().map(|&(_, i)| i).collect(),
+            grad: entries.iter().map(|&(q, _)| shapes.grad[q]).collect(),
+            phi: entries.iter().map(|&(q, _)| shapes.phi[q]).collect(),
         }
     }
 

@@ -57,6 +57,7 @@
 //! (eq. 12) to its distance from the tangent planes of the boundary nodes
 //! it names.
 
+use super::conform::{CONFORM_TOLERANCE, conform};
 use super::contact;
 use super::lattice::{Cylinder, NodeLattice, Surfaces};
 use super::mirror::{self, Mirror};
@@ -65,7 +66,7 @@ use super::nodal::NodalOperator;
 use super::profile::{Phase, PhaseTimes};
 use super::shift::{Freedom, carry, shifts};
 use super::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii};
-use super::step::{OMEGA_FACTOR, OMEGA_FACTOR_NODAL, stable_step_with};
+use super::step::{OMEGA_FACTOR, OMEGA_FACTOR_CONFORMING, OMEGA_FACTOR_NODAL, stable_step_with};
 use super::weak::TractionOperator;
 use crate::error::{Error, Result};
 use crate::isa::Isa;
@@ -174,6 +175,12 @@ pub struct RodSetup {
     /// (`src/mlpg/mirror.rs`); false (the default): the whole body.
     #[serde(default)]
     pub quarter: bool,
+    /// With the nodal form: gradients corrected to meet the integration
+    /// constraint at the surfaces (`src/mlpg/conform.rs`), so that a
+    /// uniform stress leaves every node off the surfaces in equilibrium.
+    /// The whole body only.
+    #[serde(default)]
+    pub conforming: bool,
 }
 
 /// The weak form of the nodal forces.
@@ -193,7 +200,8 @@ pub enum WeakForm {
 }
 
 impl WeakForm {
-    /// The form of a scene's `weak_form` value: 0 the sphere, 1 nodal.
+    /// The form of a scene's `weak_form` value: 0 the sphere, 1 and 2 nodal
+    /// (2 with [`RodSetup::conforming`]).
     pub fn of(value: f64) -> Self {
         if value >= 0.5 {
             WeakForm::Nodal
@@ -223,6 +231,25 @@ impl WeakForm {
 }
 
 impl RodSetup {
+    /// `κ` of the highest frequency of the forces chosen, `ω_max = κ c_p /
+    /// d_min`: the weak form's ([`WeakForm::omega_factor`]), or
+    /// [`OMEGA_FACTOR_CONFORMING`] with conforming gradients.
+    pub fn omega_factor(&self) -> f64 {
+        if self.conforming {
+            OMEGA_FACTOR_CONFORMING
+        } else {
+            self.weak_form.omega_factor()
+        }
+    }
+
+    /// The ratio of this setup's stable step to the seed's form's,
+    /// `OMEGA_FACTOR / κ`: the factor on the per-step rates (the
+    /// smoothing's α, the shifting's β and cap), so that they act at the
+    /// same rate per unit time whatever the step.
+    pub fn step_scale(&self) -> f64 {
+        OMEGA_FACTOR / self.omega_factor()
+    }
+
     /// A rod with the default numerical choices ([`DAMPING`], [`SAFETY`],
     /// [`REBUILD_STRAIN`]).
     pub fn new(cylinder: Cylinder, rings: usize, impact_speed: f64, end_time: f64) -> Self {
@@ -240,6 +267,7 @@ impl RodSetup {
             base: 0.0,
             weak_form: WeakForm::Sphere,
             quarter: false,
+            conforming: false,
         }
     }
 }
@@ -520,6 +548,12 @@ impl Mlpg3d {
             })
         };
         let density = density_of(&material)?;
+        if setup.conforming && (setup.quarter || setup.weak_form != WeakForm::Nodal) {
+            return Err(Error::Inconsistent(
+                "conforming gradients (weak_form = 2) need the nodal form on the whole body (symmetry = 0)"
+                    .into(),
+            ));
+        }
         let mut lattice = NodeLattice::cylinder(setup.cylinder, setup.rings);
         let mut plane = Vec::new();
         if setup.quarter {
@@ -628,7 +662,7 @@ impl Mlpg3d {
         s.d_min0 = s.nearest_distance();
         let cp = s.wave_speed();
         check_derived("wave speed", cp, " m/s")?;
-        s.damping_time = 2.0 * setup.damping * s.d_min0 / (setup.weak_form.omega_factor() * cp);
+        s.damping_time = 2.0 * setup.damping * s.d_min0 / (setup.omega_factor() * cp);
         s.dt = s.stable_dt(cp, s.d_min0);
         check_derived("time step", s.dt, " s")?;
         s.dt0 = s.dt;
@@ -640,7 +674,7 @@ impl Mlpg3d {
     /// damping: `(2 / ω_max)(√(1 + ζ²) − ζ)`.
     fn stable_dt(&self, c: f64, d: f64) -> f64 {
         let z = self.setup.damping;
-        let kappa = self.setup.weak_form.omega_factor();
+        let kappa = self.setup.omega_factor();
         stable_step_with(kappa, c, d, self.setup.safety) * ((1.0 + z * z).sqrt() - z)
     }
 
@@ -744,6 +778,11 @@ impl Mlpg3d {
         let mut buf = Vec::new();
         let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
         g.shapes = NodalShapes::build_rows(pts, sup, n).map_err(at_time)?;
+        if self.setup.conforming {
+            let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.rho[i]).collect();
+            let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
+            conform(&mut g.shapes, pts, &volume, &inner, CONFORM_TOLERANCE);
+        }
         self.profile.lap(Phase::Shapes, &mut clock);
         match self.setup.weak_form {
             WeakForm::Sphere => {
@@ -1197,7 +1236,7 @@ impl Mlpg3d {
             });
         self.profile.lap(Phase::Kick, &mut clock);
         // Velocity smoothing toward the MLS approximation at the node.
-        let alpha = self.setup.smoothing * self.setup.weak_form.step_scale();
+        let alpha = self.setup.smoothing * self.setup.step_scale();
         if alpha > 0.0 {
             let shapes = &g.shapes;
             let vel = &self.vel;
@@ -1654,7 +1693,7 @@ impl Mlpg3d {
             };
         });
         let pos = extended(images, &self.pos, &mut scratch.ext_pos, mirror::vector);
-        let step_scale = self.setup.weak_form.step_scale();
+        let step_scale = self.setup.step_scale();
         shifts(
             pos,
             &g.shapes,

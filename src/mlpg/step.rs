@@ -46,6 +46,18 @@ pub fn newmark_limit(omega_max: f64, beta: f64, gamma: f64) -> Option<f64> {
 /// form's own stable step").
 pub const OMEGA_FACTOR_NODAL: f64 = 1.95;
 
+/// `κ` of the nodal form with conforming gradients (`weak_form = 2`,
+/// `src/mlpg/conform.rs`): twice [`OMEGA_FACTOR_NODAL`], half its step. On
+/// the undeformed rod the corrected operator is no stiffer (κ 1.850,
+/// 1.816, 1.788 at 2, 3 and 4 rings, against 1.862, 1.821, 1.792), but its
+/// highest frequency grows with the deformation where the layers over the
+/// face are squashed: on the Wilkins bar at 8 across, `ω_max Δt / 2` at
+/// the nodal form's step reaches 1.14 at 30 µs (0.44 for the plain
+/// gradients), and the run stops with `EnergyDrift` at 27-32 µs. At half
+/// the step it comes to rest, and at a third the length and face radius
+/// are the same to four digits (VALIDATION.md, "Conforming gradients").
+pub const OMEGA_FACTOR_CONFORMING: f64 = 2.0 * OMEGA_FACTOR_NODAL;
+
 /// The stable step of the central differences (`β = 0`, `γ = 1/2`):
 /// `safety · 2 / ω_max` with `ω_max = OMEGA_FACTOR · c_p / d_min`.
 pub fn stable_step(wave_speed: f64, d_min: f64, safety: f64) -> f64 {

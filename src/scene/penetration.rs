@@ -263,6 +263,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     numerics.smoothing_order = v("smoothing_order")? as u32;
     numerics.shifting = v("shifting")?;
     numerics.weak_form = WeakForm::of(v("weak_form")?);
+    numerics.conforming = v("weak_form")? >= 1.5;
     numerics.quarter = quarter;
     Ok((setup, (projectile_material, plate_material), numerics))
 }

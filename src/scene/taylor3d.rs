@@ -79,14 +79,16 @@ pub(crate) const SYMMETRY: ParamSpec = spec(
 
 /// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
 /// over test spheres (eq. 10), 1 the nodal Galerkin form
-/// (`src/mlpg/nodal.rs`).
+/// (`src/mlpg/nodal.rs`), 2 the nodal form with gradients that conform to
+/// the nodal quadrature at the surfaces (`src/mlpg/conform.rs`).
 pub(crate) const WEAK_FORM: ParamSpec = spec(
     "weak_form",
     "1",
     0.0,
-    Range::integer(0.0, 1.0),
+    Range::integer(0.0, 2.0),
     "forces of the MLPG solver: 0 = the seed's local weak form over test spheres (eq. 10), 1 = nodal Galerkin form, \
-     the adjoint of the collocated gradients, which conserves momentum and energy (README, 3-D MLPG)",
+     the adjoint of the collocated gradients, which conserves momentum and energy, 2 = the nodal form with gradients \
+     corrected so that a uniform stress leaves the nodes off the surfaces in equilibrium (whole body only; README, 3-D MLPG)",
 );
 
 /// The numerical parameters and the end time: the rows after the material
@@ -247,6 +249,7 @@ impl Taylor3dParams {
         s.smoothing_order = self.smoothing_order as u32;
         s.shifting = self.shifting;
         s.weak_form = WeakForm::of(self.weak_form);
+        s.conforming = self.weak_form >= 1.5;
         s.quarter = self.symmetry >= 0.5;
         s
     }
