@@ -33,11 +33,14 @@ use super::mls::NodalShapes;
 use super::nodal::transpose;
 use rayon::prelude::*;
 
-/// The solver's stop of the conjugate gradients: the largest inner `|a_J|`
-/// below this fraction of the largest `|a_J|` over all nodes (measured on
-/// the Wilkins bar at 6 and 8 across: 72-150 iterations, the inner
-/// residual then 1e-8 of a face node's load).
+/// Where the solver stops the conjugate gradients: when the largest inner
+/// `|a_J|` is below this fraction of the largest `|a_J|` over all nodes
+/// (on the Wilkins bar at 6 and 8 across: 72-155 iterations per rebuild).
 pub const CONFORM_TOLERANCE: f64 = 1e-8;
+
+/// The most conjugate-gradient iterations; past them the correction is
+/// the partial one reached ([`Conformed::after`] says how far).
+pub const CONFORM_ITERATIONS: usize = 2000;
 
 /// What the correction did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -303,7 +306,7 @@ pub fn conform(
     let mut e = vec![[0.0; 3]; shapes.nodes.len()];
     let mut ap = vec![[0.0; 3]; n];
     let mut iterations = 0;
-    while inner_max(&r) > goal && iterations < 2000 {
+    while inner_max(&r) > goal && iterations < CONFORM_ITERATIONS {
         sys.entries(&p, &mut e);
         sys.gather(&e, 2, &mut ap);
         let pap = dot(&p, &ap);
