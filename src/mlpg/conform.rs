@@ -127,7 +127,7 @@ struct System<'a> {
     inner: &'a [bool],
     scale: Vec<f64>,
     minv: Vec<[[f64; 4]; 4]>,
-    columns: Columns,
+    columns: &'a Columns,
 }
 
 impl System<'_> {
@@ -232,6 +232,8 @@ pub fn conform(
             invert4(m)
         })
         .collect();
+    // The sparsity is the same before and after: one transpose serves both.
+    let columns = Columns::of(shapes, n);
     let sys = System {
         shapes,
         points,
@@ -239,7 +241,7 @@ pub fn conform(
         inner,
         scale,
         minv,
-        columns: Columns::of(shapes, n),
+        columns: &columns,
     };
     // a_J over every node, for the scale of the stop.
     let mut a = vec![[0.0; 3]; n];
@@ -343,7 +345,7 @@ pub fn conform(
     }
     // The constraint after, measured afresh.
     let mut after = 0.0f64;
-    let cols = Columns::of(shapes, n);
+    let cols = &columns;
     for j in (0..n).filter(|&j| inner[j]) {
         let mut s = [0.0; 3];
         for k in cols.offsets[j]..cols.offsets[j + 1] {
