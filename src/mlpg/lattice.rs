@@ -109,6 +109,23 @@ impl NodeLattice {
     /// The ring lattice of `cylinder` with `rings ≥ 1` rings across the
     /// radius (the radial spacing is `R0 / rings`).
     pub fn cylinder(cylinder: Cylinder, rings: usize) -> Self {
+        Self::cylinder_with(cylinder, rings, false)
+    }
+
+    /// The ring lattice, with the odd layers turned by half a node's angle
+    /// on every ring when `staggered` (ring `k` of an odd layer at the
+    /// angles `2π (l + 1/2) / (6 k)`): the nodes of neighbouring layers
+    /// then interleave instead of standing on the same radial lines, so
+    /// that layers pressed together over the impact face, whose rings
+    /// have spread to several times their spacing around the
+    /// circumference, still fill the gaps between each other's nodes
+    /// (README, "3-D MLPG mixed method": the staggered lattice). Each
+    /// layer keeps its six-fold symmetry and its mirror symmetry in the
+    /// planes `x = 0` and `y = 0`; the volumes and surfaces are the same.
+    /// The mantle generator of [`NodeLattice::sets`] then zig-zags by half
+    /// a node's angle from layer to layer (its nodes' radii are what the
+    /// rod observables read).
+    pub fn cylinder_with(cylinder: Cylinder, rings: usize, staggered: bool) -> Self {
         let rings = rings.max(1);
         let (r0, l0) = (cylinder.radius, cylinder.length);
         let dr = r0 / rings as f64;
@@ -137,8 +154,9 @@ impl NodeLattice {
             for k in 0..=rings {
                 let r = if k == rings { r0 } else { k as f64 * dr };
                 let count = nodes_on_ring(k);
+                let turn = if staggered && j % 2 == 1 { 0.5 } else { 0.0 };
                 for l in 0..count {
-                    let theta = 2.0 * PI * l as f64 / count as f64;
+                    let theta = 2.0 * PI * (l as f64 + turn) / count as f64;
                     let i = lattice.position.len();
                     let mut s = 0;
                     if j == 0 {
@@ -278,8 +296,8 @@ mod tests {
             radius: 3.8e-3,
             length: 38e-3,
         };
-        for rings in 1..=12 {
-            let lat = NodeLattice::cylinder(cyl, rings);
+        for (rings, staggered) in (1..=12).flat_map(|r| [(r, false), (r, true)]) {
+            let lat = NodeLattice::cylinder_with(cyl, rings, staggered);
             // Compensated (Neumaier) sum: the error left is the lattice's.
             let (mut total, mut comp) = (0.0f64, 0.0f64);
             for &v in &lat.volume {
@@ -302,12 +320,26 @@ mod tests {
             let per_layer = 1 + 3 * rings * (rings + 1);
             assert_eq!(lat.len() % per_layer, 0);
             assert_eq!(lat.sets.face.len(), per_layer);
+            // Staggered: a ring node of layer 1 stands half a node's angle
+            // from the nodes of its ring in layer 0, otherwise above one.
+            for (i, p) in lat.position[per_layer..2 * per_layer].iter().enumerate() {
+                let below = lat.position[i];
+                let r = below[0].hypot(below[1]);
+                if r == 0.0 {
+                    continue;
+                }
+                let k = (r / lat.radial_spacing).round();
+                let turned = (p[1].atan2(p[0]) - below[1].atan2(below[0])).rem_euclid(2.0 * PI);
+                let want = if staggered { PI / (6.0 * k) } else { 0.0 };
+                assert!((turned - want).abs() < 1e-12, "rings {rings}, node {i}");
+            }
         }
     }
 
     /// The quarter keeps a quarter of the volume (to round-off), every
-    /// node of the full lattice is one of its nodes or an image of one, and
-    /// the nodes on the planes are exactly on them.
+    /// node of the full lattice is one of its nodes or an image of one (the
+    /// staggered lattice too: it keeps the mirror symmetry), and the nodes
+    /// on the planes are exactly on them.
     #[test]
     fn the_quarter_is_a_quarter() {
         use crate::mlpg::mirror::{X, Y, vector};
@@ -315,8 +347,8 @@ mod tests {
             radius: 5e-3,
             length: 10e-3,
         };
-        for rings in 1..=6 {
-            let full = NodeLattice::cylinder(cyl, rings);
+        for (rings, staggered) in (1..=6).flat_map(|r| [(r, false), (r, true)]) {
+            let full = NodeLattice::cylinder_with(cyl, rings, staggered);
             let (q, plane) = full.quarter();
             let v: f64 = q.volume.iter().sum();
             assert!(

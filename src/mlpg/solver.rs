@@ -181,6 +181,11 @@ pub struct RodSetup {
     /// The whole body only.
     #[serde(default)]
     pub conforming: bool,
+    /// The rod's lattice with its odd layers turned by half a node's angle
+    /// ([`NodeLattice::cylinder_with`]); false (the default): the layers
+    /// stand on the same radial lines.
+    #[serde(default)]
+    pub staggered: bool,
 }
 
 /// The weak form of the nodal forces.
@@ -268,6 +273,7 @@ impl RodSetup {
             weak_form: WeakForm::Sphere,
             quarter: false,
             conforming: false,
+            staggered: false,
         }
     }
 }
@@ -344,6 +350,11 @@ pub struct Mlpg3d {
     /// by its Nanson plane, so a restored run rebuilds them as they were).
     #[serde(default)]
     built_contact: Vec<bool>,
+    /// `rho` at the last build of the operator (conforming gradients weigh
+    /// the constraint by the nodal volumes `m / ρ` of the build, so a
+    /// restored run rebuilds them as they were).
+    #[serde(default)]
+    built_rho: Vec<f64>,
     /// The anvil's reaction on each node held on it at the last step's
     /// forces, `−F_z ≥ 0` (N; zero on a free node): a release is timed by
     /// the zero of the node's net axial force between that step and the
@@ -554,7 +565,7 @@ impl Mlpg3d {
                     .into(),
             ));
         }
-        let mut lattice = NodeLattice::cylinder(setup.cylinder, setup.rings);
+        let mut lattice = NodeLattice::cylinder_with(setup.cylinder, setup.rings, setup.staggered);
         let mut plane = Vec::new();
         if setup.quarter {
             (lattice, plane) = lattice.quarter();
@@ -615,6 +626,7 @@ impl Mlpg3d {
             material_state: MaterialState::default(),
             vel,
             mass,
+            built_rho: rho.clone(),
             rho,
             dev: vec![[0.0; 6]; n],
             pressure: vec![0.0; n],
@@ -779,7 +791,7 @@ impl Mlpg3d {
         let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
         g.shapes = NodalShapes::build_rows(pts, sup, n).map_err(at_time)?;
         if self.setup.conforming {
-            let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.rho[i]).collect();
+            let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
             let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
             conform(&mut g.shapes, pts, &volume, &inner, CONFORM_TOLERANCE);
         }
@@ -1455,12 +1467,14 @@ impl Mlpg3d {
             self.built_at.clone_from(&self.pos);
             self.built_reference.clone_from(&self.reference);
             self.built_contact.clone_from(&self.contact);
+            self.built_rho.clone_from(&self.rho);
             self.build_geometry(true)?;
             clock = std::time::Instant::now();
         } else if pairs.strain > self.setup.rebuild_strain {
             self.built_at.clone_from(&self.pos);
             self.built_reference.clone_from(&self.reference);
             self.built_contact.clone_from(&self.contact);
+            self.built_rho.clone_from(&self.rho);
             self.build_geometry(false)?;
             clock = std::time::Instant::now();
         }
@@ -1809,6 +1823,7 @@ impl Mlpg3d {
             + b(&self.reference)
             + b(&self.built_reference)
             + b(&self.built_contact)
+            + b(&self.built_rho)
             + b(&self.reaction)
             + b(&l.position)
             + b(&l.volume)
@@ -2212,6 +2227,7 @@ impl Mlpg3d {
         // Each with the least physical value.
         let scalars = [
             ("densities", &self.rho, f64::MIN_POSITIVE),
+            ("densities at the build", &self.built_rho, f64::MIN_POSITIVE),
             ("pressures", &self.pressure, f64::NEG_INFINITY),
             ("plastic strains", &self.eps_p, 0.0),
             ("temperatures", &self.temp, f64::MIN_POSITIVE),

@@ -184,6 +184,7 @@ const AFTER: &[ParamSpec] = &[
         ..super::taylor3d::WEAK_FORM
     },
     super::taylor3d::SYMMETRY,
+    super::taylor3d::LATTICE,
     row(
         "end_time",
         "s",
@@ -265,6 +266,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     numerics.weak_form = WeakForm::of(v("weak_form")?);
     numerics.conforming = v("weak_form")? >= 1.5;
     numerics.quarter = quarter;
+    numerics.staggered = v("lattice")? >= 0.5;
     Ok((setup, (projectile_material, plate_material), numerics))
 }
 

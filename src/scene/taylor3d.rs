@@ -91,6 +91,18 @@ pub(crate) const WEAK_FORM: ParamSpec = spec(
      corrected so that a uniform stress leaves the nodes off the surfaces in equilibrium (whole body only; README, 3-D MLPG)",
 );
 
+/// The `lattice` row of the 3-D scenes: 0 the ring lattice with every
+/// layer's nodes on the same radial lines, 1 the staggered lattice (odd
+/// layers turned by half a node's angle, `NodeLattice::cylinder_with`).
+pub(crate) const LATTICE: ParamSpec = spec(
+    "lattice",
+    "1",
+    0.0,
+    Range::integer(0.0, 1.0),
+    "node lattice of the rod: 0 = rings with the nodes of every layer on the same radial lines, 1 = staggered, the odd \
+     layers turned by half a node's angle so that layers pressed together interleave (README, 3-D MLPG)",
+);
+
 /// The numerical parameters and the end time: the rows after the material
 /// block.
 const AFTER: &[ParamSpec] = &[
@@ -132,6 +144,7 @@ const AFTER: &[ParamSpec] = &[
     ),
     WEAK_FORM,
     SYMMETRY,
+    LATTICE,
     END_TIME,
 ];
 
@@ -187,7 +200,7 @@ param_struct! {
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
         melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
         particles_radial, damping, smoothing_coefficient, smoothing_order, rebuild_strain,
-        shifting, weak_form, symmetry, end_time,
+        shifting, weak_form, symmetry, lattice, end_time,
     }
 }
 
@@ -251,6 +264,7 @@ impl Taylor3dParams {
         s.weak_form = WeakForm::of(self.weak_form);
         s.conforming = self.weak_form >= 1.5;
         s.quarter = self.symmetry >= 0.5;
+        s.staggered = self.lattice >= 0.5;
         s
     }
 
