@@ -10,7 +10,7 @@
 # FMU state; about a minute and 4 GB), whose figures are in BENCHMARKS.md;
 # the seed's penetration case at the default 6 nodes across (about 90 s),
 # its residual velocity within 10 % of the seed's; and the Wilkins copper bar
-# in 3-D as its scene file sets it at 8 and 11 nodes across (about 18 minutes
+# in 3-D as its scene file sets it at 8 and 11 nodes across (about 9 minutes
 # on two cores), within 2 % in length and 5 % in face radius of the converged
 # references.
 set -euo pipefail

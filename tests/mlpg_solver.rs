@@ -481,18 +481,23 @@ fn explore_taylor3d_stop() {
 
 /// Exploration: the phase profile of `taylor3d` run to its end
 /// (`PARTICLES_RADIAL`, default 6), printed with the CPU time per
-/// node-step (BENCHMARKS.md, "3-D MLPG speed").
+/// node-step (BENCHMARKS.md, "3-D MLPG speed"); with `MI_SCENE_FILE` or
+/// `MI_SET` set, of that scene instead (as `explore_energy_jump`).
 #[test]
 #[ignore = "exploration"]
 fn explore_taylor3d_profile() {
     let across: f64 = std::env::var("PARTICLES_RADIAL")
         .map(|s| s.parse().unwrap())
         .unwrap_or(6.0);
-    let p = Taylor3dParams {
-        particles_radial: across,
-        ..Taylor3dParams::default()
+    let mut s = if std::env::var("MI_SCENE_FILE").is_ok() || std::env::var("MI_SET").is_ok() {
+        build3d(&wilkins_or_env_scene())
+    } else {
+        let p = Taylor3dParams {
+            particles_radial: across,
+            ..Taylor3dParams::default()
+        };
+        p.build().unwrap()
     };
-    let mut s = p.build().unwrap();
     let t0 = std::time::Instant::now();
     while !s.finished() {
         s.step().unwrap();
@@ -735,7 +740,7 @@ fn staggered_wilkins_bar(particles_radial: f64) -> (f64, f64) {
 }
 
 /// The Wilkins bar as its scene file sets it ([`staggered_wilkins_bar`]
-/// at 6 nodes across, 4732 nodes, about 35 s on one thread): measured
+/// at 6 nodes across, 4732 nodes, about 22 s on one thread): measured
 /// 21.66 mm (+1.1 %), 7.22 mm (+1.0 %), spread 1.34 %, energy error
 /// 0.18 %. On the aligned lattice the same choices give 21.65 mm and
 /// 7.41 mm with a spread of 2.4 %, and stop with `EnergyDrift` at 28.3 µs
@@ -755,12 +760,12 @@ fn the_wilkins_bar_in_3d_meets_its_references_on_the_staggered_lattice() {
 }
 
 /// Refinement of [`staggered_wilkins_bar`] (`scripts/validate.sh`): at 8
-/// and 11 nodes across (12 168 and 33 762 nodes; about 2 and 16 minutes on
+/// and 11 nodes across (12 168 and 33 762 nodes; about 1 and 7 minutes on
 /// two cores) the bar stays within the references' bounds, and its length
 /// moves toward 21.42 mm as the spacing shrinks (measured 21.66, 21.57,
 /// 21.52 mm at 6, 8, 11 across; face radius 7.22, 7.28, 7.35 mm).
 #[test]
-#[ignore = "heavy: about 18 minutes on two cores; scripts/validate.sh"]
+#[ignore = "heavy: about 9 minutes on two cores; scripts/validate.sh"]
 fn the_staggered_wilkins_bar_under_refinement() {
     let (l8, _) = staggered_wilkins_bar(8.0);
     let (l11, _) = staggered_wilkins_bar(11.0);
