@@ -183,6 +183,7 @@ impl<'a> System<'a> {
             columns,
         }
     }
+
     /// `λ_i = M_i⁻¹ Σ_J p_J μ_J` over the inner nodes of row `i`.
     fn lambda(&self, i: usize, mu: &[[f64; 3]]) -> [[f64; 3]; 4] {
         let s = self.shapes;
