@@ -605,6 +605,13 @@ fn to_rest(s: &mut Mlpg3d) {
     assert!(s.at_rest(), "at rest at {} s", s.time());
 }
 
+/// The run of `scene`, stepped [`to_rest`].
+fn rested(scene: &Scene) -> Mlpg3d {
+    let mut s = build3d(scene);
+    to_rest(&mut s);
+    s
+}
+
 /// The Wilkins copper bar in 3-D with the plain nodal form on the aligned
 /// lattice and the order-1 smoothing (the scene file's choices before the
 /// staggered lattice; 6 nodes across the radius, 4732 nodes, with node
@@ -623,8 +630,7 @@ fn the_wilkins_bar_in_3d_comes_to_rest_as_close_as_the_axisymmetric_one() {
         ("lattice", 0.0),
     ]);
     assert_eq!(scene.get("particles_radial").unwrap(), 6.0);
-    let mut s = build3d(&scene);
-    to_rest(&mut s);
+    let s = rested(&scene);
     let rod = s.rod();
     let length = rod.rod_length / 21.42e-3 - 1.0;
     let radius = rod.mushroom_radius / 7.15e-3 - 1.0;
@@ -661,8 +667,7 @@ fn conforming_gradients_bring_the_wilkins_bar_to_the_axisymmetric_solver() {
         ("lattice", 0.0),
     ]);
     assert_eq!(scene.get("particles_radial").unwrap(), 6.0);
-    let mut s = build3d(&scene);
-    to_rest(&mut s);
+    let s = rested(&scene);
     let rod = s.rod();
     let dir = env!("CARGO_MANIFEST_DIR");
     let mut axi = Scene::from_file(format!("{dir}/scenes/wilkins_copper_bilinear.toml")).unwrap();
@@ -722,8 +727,7 @@ fn staggered_wilkins_bar(particles_radial: f64) -> (f64, f64) {
         ("smoothing_order", 2.0),
         ("lattice", 1.0),
     ]);
-    let mut s = build3d(&scene);
-    to_rest(&mut s);
+    let s = rested(&scene);
     let rod = s.rod();
     let dl = rod.rod_length / 21.42e-3 - 1.0;
     let dr = rod.mushroom_radius / 7.15e-3 - 1.0;
