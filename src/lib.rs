@@ -95,6 +95,7 @@ pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
 pub use scene::{Scene, SceneKind, builtin_names};
 pub use sim::{Progress, Simulation};
+pub use solver::axisymmetric::ENERGY_ERROR_BOUND;
 pub use uniaxial::{Layer, PlateImpact};
 
 /// Material models and their composition into a [`Material`](materials::Material):

@@ -398,7 +398,7 @@ fn run(a: RunArgs) -> Result<(), Stop> {
     // Every output is written, even when the run stopped early or another
     // output failed; the failures are reported together at the end.
     let mut failures = Vec::new();
-    if let Err(e) = status {
+    if let Err(e) = &status {
         failures.push(e.to_string());
     }
     if let Err(e) = write_vtk(&sim, &mut vtk_written) {
@@ -425,6 +425,7 @@ fn run(a: RunArgs) -> Result<(), Stop> {
             sim.steps(),
             sim.time(),
             wall,
+            status.as_ref().err(),
         );
         if let Err(e) = write_json(path, &json) {
             failures.push(format!("--json: {e}"));
@@ -847,7 +848,10 @@ fn write_csv_records(out: &Path, header: &[&str], records: &[Vec<String>]) -> Re
 }
 
 /// Final values of a run as a JSON object: every observable by name, plus
-/// `particles`, `steps`, `end_time` and `wall_time_s`.
+/// `particles`, `steps`, `end_time`, `wall_time_s`, and `outcome`:
+/// `"finished"`, or the name of the error that stopped the run, whose
+/// message is then `error` (the values are those of the state at the stop,
+/// outside the solver's domain of validity).
 fn final_json(
     specs: &[ObservableSpec],
     values: &[f64],
@@ -855,6 +859,7 @@ fn final_json(
     steps: u64,
     end_time: f64,
     wall_time_s: f64,
+    stopped: Option<&Error>,
 ) -> serde_json::Value {
     let mut m = serde_json::Map::new();
     for (s, v) in specs.iter().zip(values) {
@@ -869,6 +874,13 @@ fn final_json(
     m.insert("steps".into(), steps.into());
     m.insert("end_time".into(), serde_json::json!(end_time));
     m.insert("wall_time_s".into(), serde_json::json!(wall_time_s));
+    m.insert(
+        "outcome".into(),
+        stopped.map_or("finished", Error::name).into(),
+    );
+    if let Some(e) = stopped {
+        m.insert("error".into(), e.to_string().into());
+    }
     serde_json::Value::Object(m)
 }
 

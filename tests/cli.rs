@@ -107,6 +107,8 @@ fn json_has_every_observable_and_run_facts() {
     for k in ["particles", "steps", "end_time", "wall_time_s"] {
         assert!(v.get(k).is_some(), "missing {k}");
     }
+    assert_eq!(v["outcome"], "finished");
+    assert!(v.get("error").is_none());
     assert!(v["end_time"].as_f64().unwrap() >= 3e-6);
     let hist = std::fs::read_to_string(&csv).unwrap();
     assert!(hist.starts_with("time,rod_length,mushroom_radius"));
@@ -376,6 +378,45 @@ fn an_output_failing_at_the_end_is_named_and_the_others_are_written() {
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("final length |error|"), "{table}");
     assert!(table.contains("table not written"), "{table}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A run that leaves the solver's domain of validity exits 1 with the named
+/// error, and still writes its outputs; the JSON says how it ended, so that
+/// a script reading it alone cannot take the state at the stop for a result.
+/// The case: test 7 at 6 across without the paper's velocity smoothing
+/// (`smoothing_coefficient = 0`), whose energy balance drifts past the
+/// guard's 10 % at about 6.6 µs (the report's stability matrix).
+#[test]
+fn a_stopped_run_names_its_stop_in_the_json() {
+    let dir = scratch("stopped");
+    let (json, csv) = (dir.join("out.json"), dir.join("hist.csv"));
+    let out = bin()
+        .args(["run", "-q", "--set", "particles_radial=6"])
+        .args(["--set", "smoothing_coefficient=0", "--json"])
+        .arg(&json)
+        .arg("--csv")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert_error(&out, &["energy error", "exceeds the bound 0.1"]);
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["outcome"], "EnergyDrift");
+    let message = v["error"].as_str().unwrap();
+    assert!(stderr(&out).contains(message), "{message}");
+    let e = v["energy_error"].as_f64().unwrap();
+    assert!(
+        e > meshless_impact::ENERGY_ERROR_BOUND && e.is_finite(),
+        "{e}"
+    );
+    // The history ends at the stop.
+    let hist = std::fs::read_to_string(&csv).unwrap();
+    let last = hist.lines().last().unwrap().split(',').next().unwrap();
+    assert_eq!(
+        last.parse::<f64>().unwrap(),
+        v["end_time"].as_f64().unwrap()
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

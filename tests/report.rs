@@ -192,6 +192,24 @@ fn quick_report_regenerates_and_meets_its_claims() {
     }
     assert!(index.contains("taylor_error_vs_time_solvers.svg"));
 
+    // The large-strain benchmarks, the Wilkins bar in 3-D among them: each
+    // at rest with its energy error below 5 % (the large-deformation
+    // issue's bound for every run).
+    let benches = read_csv(&dir.join("benchmarks.csv"));
+    let scenes: Vec<&str> = benches.iter().map(|r| r["scene"].as_str()).collect();
+    assert_eq!(
+        scenes,
+        [
+            "wilkins_copper.toml",
+            "crmo4_dynela.toml",
+            "wilkins_copper_3d.toml"
+        ]
+    );
+    for r in &benches {
+        assert_eq!(r["outcome"], "finished", "{r:?}");
+        assert!(num(r, "energy_error") < 0.05, "{r:?}");
+    }
+
     // The seed's penetration case at 4 across: pictures at 4, 8, 12 and
     // 20 µs; the pulverized zone only grows (pulverization is final); the
     // projectile slows and leaves within 20 % of the seed's 1240 m/s

@@ -75,7 +75,8 @@ use crate::material::{Loading, Material, MaterialState, Point};
 use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
 use crate::rod::{RodObservables, radius};
 use crate::solver::axisymmetric::{
-    QUIET_FRACTION, QUIET_TRANSITS, SHIFT_CAP, SHIFT_RANGE, SPACING_COLLAPSE_BOUND,
+    ENERGY_ERROR_BOUND, QUIET_FRACTION, QUIET_TRANSITS, SHIFT_CAP, SHIFT_RANGE,
+    SPACING_COLLAPSE_BOUND,
 };
 use crate::solver::{check_derived, check_time_step};
 use rayon::prelude::*;
@@ -119,9 +120,6 @@ pub const SMOOTHING: f64 = 0.1;
 /// Default order of the velocity smoothing ([`RodSetup::smoothing_order`]):
 /// 1, the relaxation toward the MLS approximation.
 pub const SMOOTHING_ORDER: u32 = 1;
-
-/// Energy error past which a run stops with [`Error::EnergyDrift`].
-pub const ENERGY_ERROR_BOUND: f64 = 0.5;
 
 /// A rod on the ring lattice at the instant of impact, and the solver's
 /// numerical choices.
