@@ -46,8 +46,9 @@ def main():
     c = read_lines(sys.argv[1])
     rust = json.load(open(sys.argv[2]))
     checked = 0
+    assert rust["outcome"] == "finished", rust.get("error")
     for name, value in rust.items():
-        if name in ("wall_time_s", "particles", "end_time"):
+        if name in ("wall_time_s", "particles", "end_time", "outcome"):
             continue
         assert name in c, f"{name} missing from the C output"
         want = float(value) if not isinstance(value, bool) else float(value)
