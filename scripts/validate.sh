@@ -13,10 +13,24 @@
 # in 3-D as its scene file sets it at 8 and 11 nodes across (about 9 minutes
 # on two cores), within 2 % in length and 5 % in face radius of the converged
 # references.
-set -euo pipefail
+# Every step runs even when an earlier one fails (test 7 in 3-D at 11 across
+# fails on its Df, as VALIDATION.md says); the failed steps are listed at the
+# end and the exit status is 1 if any failed.
+set -uo pipefail
 cd "$(dirname "$0")/.."
-cargo test --release --test taylor -- --ignored --nocapture
-cargo test --release --test taylor3d -- --ignored --nocapture
-cargo test --release --test penetration the_seed_case_at_the_default_resolution -- --ignored --nocapture
-cargo test --release --test boundary -- --ignored --nocapture
-cargo test --release --test mlpg_solver the_staggered_wilkins_bar_under_refinement -- --ignored --nocapture
+failed=()
+step() {
+  echo "== $*"
+  "$@" || failed+=("$*")
+}
+step cargo test --release --test taylor -- --ignored --nocapture
+step cargo test --release --test taylor3d -- --ignored --nocapture
+step cargo test --release --test penetration the_seed_case_at_the_default_resolution -- --ignored --nocapture
+step cargo test --release --test boundary -- --ignored --nocapture
+step cargo test --release --test mlpg_solver the_staggered_wilkins_bar_under_refinement -- --ignored --nocapture
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "== failed:"
+  printf '  %s\n' "${failed[@]}"
+  exit 1
+fi
+echo "== validation passed"
