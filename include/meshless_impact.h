@@ -40,7 +40,9 @@
  * Result of every fallible `mi_*` function. `MI_OK` (0) is success; every
  * other value names one kind of failure, and `mi_sim_last_error` gives the
  * message of the last failure on a handle. The values are part of the stable
- * ABI: they are never renumbered.
+ * ABI: they are never renumbered. The codes 20 to 29 are the stops of a run
+ * (solver stops and `MI_CANCELLED`), and no other code lies there: the list
+ * at `mi_sim_run` is made of that block.
  */
 typedef enum {
     /**
@@ -115,6 +117,12 @@ typedef enum {
      * or the scene has no material to choose.
      */
     MI_UNKNOWN_MATERIAL = 15,
+    /**
+     * The run's estimated peak memory exceeds the memory budget (8 GiB, or
+     * the environment variable `MI_MEMORY_BUDGET`): refused before it
+     * allocates; the message gives the estimate and the budget.
+     */
+    MI_MEMORY_BUDGET = 16,
     /**
      * The run stopped: an MSPH moment matrix was singular (too few or
      * collinear neighbours).
@@ -292,8 +300,30 @@ const char *mi_result_name(int32_t code);
 const char *mi_result_description(int32_t code);
 
 /**
- * Creates a handle for a built-in scene with default parameters: `"taylor"`
- * (House et al. test 7), `"noh"`, or `"table1-1"` ... `"table1-12"`.
+ * Creates a handle for a built-in scene with default parameters. The
+ * built-in scenes (the kinds of scene of the registry, each followed by its
+ * named variants):
+ *
+ * - `"taylor"`: Taylor impact, House et al. test 7 (4340 steel, 181 m/s)
+ *   - `"table1-1"`: House et al. (1995) test 1: L0 = 11.39 mm, D0 = 7.595 mm, V = 285 m/s
+ *   - `"table1-2"`: House et al. (1995) test 2: L0 = 15.19 mm, D0 = 7.595 mm, V = 234 m/s
+ *   - `"table1-3"`: House et al. (1995) test 3: L0 = 15.19 mm, D0 = 7.595 mm, V = 275 m/s
+ *   - `"table1-4"`: House et al. (1995) test 4: L0 = 15.19 mm, D0 = 7.595 mm, V = 302 m/s
+ *   - `"table1-5"`: House et al. (1995) test 5: L0 = 25.29 mm, D0 = 7.595 mm, V = 170 m/s
+ *   - `"table1-6"`: House et al. (1995) test 6: L0 = 25.29 mm, D0 = 7.595 mm, V = 215 m/s
+ *   - `"table1-7"`: House et al. (1995) test 7: L0 = 37.97 mm, D0 = 7.595 mm, V = 181 m/s
+ *   - `"table1-8"`: House et al. (1995) test 8: L0 = 37.97 mm, D0 = 7.595 mm, V = 183 m/s
+ *   - `"table1-9"`: House et al. (1995) test 9: L0 = 37.97 mm, D0 = 7.595 mm, V = 224 m/s
+ *   - `"table1-10"`: House et al. (1995) test 10: L0 = 37.97 mm, D0 = 7.595 mm, V = 234 m/s
+ *   - `"table1-11"`: House et al. (1995) test 11: L0 = 37.97 mm, D0 = 7.595 mm, V = 270 m/s
+ *   - `"table1-12"`: House et al. (1995) test 12: L0 = 56.96 mm, D0 = 7.595 mm, V = 242 m/s
+ * - `"noh"`: Cylindrical Noh problem (gamma = 5/3)
+ * - `"taylor3d"`: Taylor impact in 3-D by MLPG, House et al. test 7 (4340 steel, 181 m/s)
+ *   - `"taylor3d-aisi310"`: The seed's 3-D Taylor impact (AISI 310, bilinear, 300 m/s): L0 = 12.7
+ *     mm, D0 = 7.62 mm (assumed; the seed misprints them), to 50 us
+ * - `"penetration"`: Ballistic penetration in 3-D by MLPG: tungsten rod (10 x 10 mm, 1500 m/s)
+ *   through a 5 mm AD85 plate
+ *
  * On `MI_OK`, `*out` receives a new handle that the caller must release with
  * `mi_sim_free`; on failure `*out` is left unchanged (`MI_NULL_POINTER`,
  * `MI_INVALID_UTF8`, `MI_UNKNOWN_SCENE`).
@@ -307,9 +337,11 @@ mi_result mi_sim_new(const char *scene, mi_sim **out);
 /**
  * Creates a handle from a TOML scene text (`scene = "taylor"`, an optional
  * `[parameters]` table and an optional `[reference]` table, as the files in
- * `scenes/`). Codes as `mi_sim_new`, plus `MI_SCENE_FILE`, `MI_PARSE_VALUE`,
- * `MI_UNKNOWN_PARAMETER`, `MI_OUT_OF_RANGE` and `MI_INCONSISTENT`. For the
- * message of a failure, create a handle and use `mi_sim_load_toml`.
+ * `scenes/`); `scene =` names a kind of scene, the first level of the list
+ * at `mi_sim_new`. Codes as `mi_sim_new`, plus `MI_SCENE_FILE`,
+ * `MI_PARSE_VALUE`, `MI_UNKNOWN_PARAMETER`, `MI_OUT_OF_RANGE` and
+ * `MI_INCONSISTENT`. For the message of a failure, create a handle and use
+ * `mi_sim_load_toml`.
  *
  * # Safety
  * As `mi_sim_new`.
@@ -452,10 +484,20 @@ mi_result mi_sim_advance_to(mi_sim *sim, double time);
 
 /**
  * Runs to the end condition (the rod at rest, or the scene's `end_time`).
- * Returns `MI_OK`, a solver stop (`MI_SINGULAR_MOMENT_MATRIX`,
- * `MI_NON_FINITE`, `MI_THROUGH_BOUNDARY`, `MI_TIME_STEP_COLLAPSE`,
- * `MI_ENERGY_DRIFT`) or `MI_CANCELLED`. After a stop the observables,
- * history and fields still read the state at the stop.
+ * Returns `MI_OK`, or the code of the stop that ended the run (a solver
+ * stop, or `MI_CANCELLED` from the progress callback):
+ *
+ * - `MI_SINGULAR_MOMENT_MATRIX` (20): singular MSPH moment matrix
+ * - `MI_NON_FINITE` (21): a field became NaN or infinite
+ * - `MI_THROUGH_BOUNDARY` (22): a particle passed through the anvil or the axis
+ * - `MI_TIME_STEP_COLLAPSE` (23): the time step collapsed
+ * - `MI_ENERGY_DRIFT` (24): the energy error passed its bound
+ * - `MI_CANCELLED` (25): cancelled by the progress callback
+ * - `MI_SPACING_COLLAPSE` (26): the particle spacing collapsed
+ * - `MI_COMPRESSION_LIMIT` (27): a compression reached the limit of the equation of state
+ *
+ * After a stop the observables, history and fields still read the state at
+ * the stop.
  *
  * # Safety
  * `sim` must be NULL or a live handle.
@@ -612,7 +654,10 @@ mi_result mi_sim_field(mi_sim *sim, const char *name, double *buf, size_t len, s
 /**
  * Copies the complete state of the run (solver, history, scene) as bytes,
  * by the buffer convention, for hosts that save and roll back. The bytes are
- * only meant for `mi_sim_state_load` of the same library version.
+ * only meant for `mi_sim_state_load` of the same library version. Every
+ * state saved loads back, stopped or not; a run stopped on a non-finite
+ * field has none to save, and returns its stop (`MI_NON_FINITE`, or
+ * `MI_ENERGY_DRIFT` when its energy overflowed).
  *
  * # Safety
  * `sim` must be NULL or a live handle; `buf` NULL or valid for `len` bytes;

@@ -184,6 +184,24 @@ pub enum Error {
         /// The singular compression.
         limit: f64,
     },
+    /// A run whose estimated peak memory exceeds the memory budget: refused
+    /// before it allocates (`MI_MEMORY_BUDGET` sets the budget).
+    #[error(
+        "the run would have {nodes:.0} nodes and need about {} of memory ({:.1} kB a node, BENCHMARKS.md), \
+         over the memory budget of {}: lower particles_radial or the bodies' sizes, or raise the budget \
+         with the environment variable MI_MEMORY_BUDGET (bytes, or with a suffix K, M, G, T: 32G)",
+        gib(*.estimate), .per_node / 1000.0, gib(*.budget)
+    )]
+    MemoryBudget {
+        /// Nodes (particles) of the run.
+        nodes: f64,
+        /// Estimated peak memory (bytes).
+        estimate: f64,
+        /// The budget (bytes).
+        budget: f64,
+        /// Peak bytes per node of the solver, measured.
+        per_node: f64,
+    },
     /// The caller cancelled the run from a progress callback.
     #[error("run cancelled by the caller at t = {time:.4e} s")]
     Cancelled {
@@ -222,6 +240,7 @@ impl Error {
             Error::EnergyDrift { .. } => "EnergyDrift",
             Error::SpacingCollapse { .. } => "SpacingCollapse",
             Error::CompressionLimit { .. } => "CompressionLimit",
+            Error::MemoryBudget { .. } => "MemoryBudget",
             Error::Cancelled { .. } => "Cancelled",
             Error::InvalidState(_) => "InvalidState",
             Error::Io { .. } => "Io",
@@ -239,6 +258,11 @@ impl Error {
 
 /// Result alias of the core.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// Bytes in GiB, one decimal (`8.0 GiB`).
+fn gib(bytes: f64) -> String {
+    format!("{:.1} GiB", bytes / (1024.0 * 1024.0 * 1024.0))
+}
 
 /// A number as a person reads it: plain decimals for everyday magnitudes,
 /// and the exponent form for very small or very large ones (`1.6e-298`

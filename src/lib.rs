@@ -32,7 +32,9 @@
 //!   ([`Simulation::rod_profile`]) read at a height ([`profile_radius`]) and
 //!   compared with another ([`profile_deviation`]), as the 3-D Taylor run
 //!   with its axisymmetric twin ([`axisymmetric_twin`]).
-//! - Errors: [`Error`] (with [`MomentMethod`]) and [`Result`].
+//! - Errors: [`Error`] (with [`MomentMethod`]) and [`Result`]; the memory
+//!   budget a run is checked against before it allocates
+//!   ([`memory_budget`], [`MEMORY_BUDGET_VAR`], [`DEFAULT_MEMORY_BUDGET`]).
 //! - The interface every solver implements: [`Model`], [`ModelState`].
 //! - Plate impact in uniaxial strain: [`PlateImpact`] of [`Layer`]s.
 //! - [`materials`]: the models a [`materials::Material`] is composed of
@@ -59,6 +61,7 @@
 // Index loops over fixed-size arrays read more clearly in numerical kernels.
 #![allow(clippy::needless_range_loop)]
 
+mod budget;
 // The C ABI and the FMI glue are the only places with unsafe code.
 #[allow(unsafe_code)]
 mod capi;
@@ -80,6 +83,7 @@ mod sim;
 mod solver;
 mod uniaxial;
 
+pub use budget::{DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_VAR, MemoryPerNode, memory_budget};
 pub use error::{Error, MomentMethod, Result};
 pub use isa::Isa;
 pub use model::{Model, ModelState};

@@ -399,9 +399,7 @@ impl Simulation {
         let t = self.time();
         let values = self.observables();
         self.history.push(t, &values);
-        while self.next_record <= t {
-            self.next_record += self.record_interval;
-        }
+        self.next_record = next_record_after(self.next_record, self.record_interval, t);
     }
 
     /// Takes one step. After an error the run is stopped and every further
@@ -440,9 +438,24 @@ impl Simulation {
         }
     }
 
+    /// Whether the run's state can be saved: not after a stop that left
+    /// numbers that are not finite in its fields (a `NonFinite` stop, or an
+    /// energy balance that overflowed), which no state can hold and
+    /// [`Simulation::deserialize_state`] would refuse. The error is that
+    /// stop. Every other state, stopped or not, saves and loads back.
+    pub fn check_savable(&self) -> Result<()> {
+        match &self.error {
+            Some(e @ Error::NonFinite { .. }) => Err(e.clone()),
+            Some(e @ Error::EnergyDrift { error, .. }) if !error.is_finite() => Err(e.clone()),
+            _ => Ok(()),
+        }
+    }
+
     /// The complete state of the run (solver, history, scene) as bytes, for
     /// hosts that roll back (FMI `fmi3SerializeFMUState`). A stopped run's
-    /// error is not part of the state.
+    /// error is not part of the state. Check [`Simulation::check_savable`]
+    /// first: the state of a run stopped on a non-finite field holds no
+    /// numbers, and does not load back.
     pub fn serialize_state(&self) -> Vec<u8> {
         serde_json::to_vec(self).expect("the state holds only finite numbers")
     }
@@ -515,6 +528,30 @@ impl Simulation {
             Some(e) => Err(e.clone()),
             None => Ok(()),
         }
+    }
+}
+
+/// The first record time after `t` on the grid `next + k * interval`. A step
+/// that crossed a few record times advances one interval at a time (the
+/// bits the runs were recorded with); a step that crossed more (a record
+/// interval far below the step) jumps there at once, so no input makes this
+/// loop for long; and the result is always above `t`.
+fn next_record_after(next: f64, interval: f64, t: f64) -> f64 {
+    const STEPWISE: usize = 64;
+    let mut n = next;
+    for _ in 0..STEPWISE {
+        if n > t {
+            return n;
+        }
+        n += interval;
+    }
+    if n <= t {
+        n += (((t - n) / interval).floor() + 1.0) * interval;
+    }
+    if n > t && n.is_finite() {
+        n
+    } else {
+        t.next_up()
     }
 }
 
@@ -686,5 +723,27 @@ mod tests {
             }
         }
         assert!(sim.observable("max_plastic_strain").unwrap() > 0.0);
+    }
+
+    /// The next record time is the first grid point past `t`: the bits of
+    /// one addition per interval when a step crossed a few, and at once,
+    /// still past `t`, when it crossed 10^290 of them (the penetration
+    /// scene's `end_time = 1e-300` looped for ever here).
+    #[test]
+    fn the_next_record_is_found_in_bounded_work() {
+        let mut stepwise = 0.0f64;
+        while stepwise <= 1.3e-6 {
+            stepwise += 1e-7 / 3.0;
+        }
+        assert_eq!(next_record_after(0.0, 1e-7 / 3.0, 1.3e-6), stepwise);
+        for (next, interval, t) in [
+            (0.0, 2.5e-302, 1e-7),
+            (0.0, 1e-12, 1.0),
+            (1.0, 1e-30, 1.0),
+            (0.0, 5e-324, 3e-7),
+        ] {
+            let n = next_record_after(next, interval, t);
+            assert!(n > t && n.is_finite(), "{next} {interval} {t}: {n}");
+        }
     }
 }

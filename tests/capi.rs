@@ -9,7 +9,9 @@ use std::ffi::{CStr, CString, c_void};
 use std::ptr::{null, null_mut};
 
 /// The committed header is exactly what cbindgen generates from `src/capi/`
-/// with `cbindgen.toml` now.
+/// with `cbindgen.toml` now, with the lists that come from the library's
+/// tables filled in (`expand_header`: the built-in scenes at `mi_sim_new`,
+/// the stop codes at `mi_sim_run`), as `cargo xtask header` writes it.
 #[test]
 fn header_matches_cbindgen() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -21,7 +23,7 @@ fn header_matches_cbindgen() {
         .unwrap();
     let mut generated = Vec::new();
     bindings.write(&mut generated);
-    let generated = String::from_utf8(generated).unwrap();
+    let generated = expand_header(&String::from_utf8(generated).unwrap());
     let committed =
         std::fs::read_to_string(root.join("include/meshless_impact.h")).unwrap_or_default();
     if generated != committed {
@@ -43,6 +45,28 @@ fn header_matches_cbindgen() {
     }
     assert!(committed.contains("#define MI_VERSION "));
     assert!(committed.contains("extern \"C\" {"));
+    // The generated lists are there, whole: every built-in scene and every
+    // code of the stop block, and no placeholder is left.
+    assert!(!committed.contains("@SCENES@") && !committed.contains("@STOPS@"));
+    for name in meshless_impact::builtin_names() {
+        assert!(
+            committed.contains(&format!(" * - `\"{name}\"`"))
+                || committed.contains(&format!(" *   - `\"{name}\"`")),
+            "scene {name}"
+        );
+    }
+    for code in 20..30 {
+        // SAFETY: mi_result_name returns a static NUL-terminated string.
+        let name = unsafe { CStr::from_ptr(mi_result_name(code)) }
+            .to_str()
+            .unwrap();
+        if name != "MI_UNKNOWN_RESULT" {
+            assert!(
+                committed.contains(&format!(" * - `{name}` ({code}):")),
+                "{name}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -75,6 +99,7 @@ fn result_codes_are_fixed() {
         (MI_BUFFER_TOO_SMALL, 13, "MI_BUFFER_TOO_SMALL"),
         (MI_WRONG_ORDER, 14, "MI_WRONG_ORDER"),
         (MI_UNKNOWN_MATERIAL, 15, "MI_UNKNOWN_MATERIAL"),
+        (MI_MEMORY_BUDGET, 16, "MI_MEMORY_BUDGET"),
         (MI_SINGULAR_MOMENT_MATRIX, 20, "MI_SINGULAR_MOMENT_MATRIX"),
         (MI_NON_FINITE, 21, "MI_NON_FINITE"),
         (MI_THROUGH_BOUNDARY, 22, "MI_THROUGH_BOUNDARY"),
@@ -93,7 +118,7 @@ fn result_codes_are_fixed() {
         let d = unsafe { CStr::from_ptr(mi_result_description(value)) };
         assert!(!d.to_bytes().is_empty());
     }
-    let n = unsafe { CStr::from_ptr(mi_result_name(16)) };
+    let n = unsafe { CStr::from_ptr(mi_result_name(17)) };
     assert_eq!(n.to_str().unwrap(), "MI_UNKNOWN_RESULT");
 }
 
@@ -755,6 +780,11 @@ fn every_error_code_is_produced() {
         mi_sim_set_progress(s.0, Some(no), null_mut());
         check(s.run(), MI_CANCELLED, &s.error(), "cancelled");
 
+        // 6.3 million nodes: refused before anything is allocated.
+        let s = new_sim("taylor3d");
+        assert_eq!(s.set("particles_radial", 60.0), MI_OK);
+        check(s.run(), MI_MEMORY_BUDGET, &s.error(), "memory budget");
+
         let s = new_sim("taylor");
         check(
             mi_sim_debug_panic(s.0),
@@ -1038,4 +1068,30 @@ fn material_choice_lists_only_its_parameters_and_round_trips_a_state() {
             "{e}"
         );
     }
+}
+
+/// Issue 48, failure 7: a run that stopped in its first step (before its
+/// step count left 0) took the next `mi_sim_set_param` and the next step
+/// with `MI_OK`. Its stop is sticky from the first step: parameters are
+/// fixed and every later step returns the same code. The case: a lattice
+/// of 4 across with h equal to the spacing, whose moment matrix is
+/// singular at the first step.
+#[test]
+fn a_stop_in_the_first_step_is_sticky() {
+    use mi_result::*;
+    let s = new_sim("taylor");
+    assert_eq!(s.set("particles_radial", 4.0), MI_OK);
+    assert_eq!(s.set("smoothing_ratio", 1.0), MI_OK);
+    // SAFETY: live handle.
+    let step = || unsafe { mi_sim_step(s.0) };
+    assert_eq!(step(), MI_SINGULAR_MOMENT_MATRIX, "{}", s.error());
+    assert_eq!(mi_sim_steps_of(&s), 0);
+    assert_eq!(
+        s.set("smoothing_ratio", 1.5),
+        MI_WRONG_ORDER,
+        "{}",
+        s.error()
+    );
+    assert_eq!(step(), MI_SINGULAR_MOMENT_MATRIX);
+    assert_eq!(s.run(), MI_SINGULAR_MOMENT_MATRIX);
 }

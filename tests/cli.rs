@@ -542,3 +542,89 @@ fn material_choice_on_the_command_line() {
     let out = bin().args(&run).output().unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
 }
+
+/// Issue 48, failure 1: `penetration` with `end_time = 1e-300` ran its
+/// record loop about 10^295 times (the interval was `end_time / 40`). The
+/// end time's range starts at 1 ns, as the rod scenes' does, and the
+/// shortest end time allowed finishes in one step.
+#[test]
+fn a_penetration_end_time_of_1e_300_is_refused_and_1_ns_finishes() {
+    let base = ["run", "penetration", "-q", "--set", "particles_radial=3"];
+    let out = bin()
+        .args(base)
+        .args(["--set", "plate_diameter=0.02", "--set", "end_time=1e-300"])
+        .output()
+        .unwrap();
+    assert_error(&out, &["`end_time` = 1e-300", "out of range"]);
+    let out = bin()
+        .args(base)
+        .args(["--set", "plate_diameter=0.02", "--set", "end_time=1e-9"])
+        .args(["--json", "/dev/stdout"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["outcome"], "finished");
+    assert_eq!(v["steps"], 1);
+    assert!(v["energy_error"].as_f64().unwrap().is_finite(), "{v}");
+}
+
+/// Issue 48, failure 2: `taylor3d` at 60 nodes across (6.3 million nodes)
+/// aborted on allocation. The memory budget refuses it before anything is
+/// allocated, naming the node count, the estimate and the budget; the
+/// environment variable raises the budget, and a budget that is not a size
+/// is refused by name.
+#[test]
+fn a_run_over_the_memory_budget_is_refused_before_it_allocates() {
+    let args = ["run", "taylor3d", "-q", "--set", "particles_radial=60"];
+    let out = bin()
+        .env_remove("MI_MEMORY_BUDGET")
+        .args(args)
+        .output()
+        .unwrap();
+    assert_error(
+        &out,
+        &[
+            "6277011 nodes",
+            "memory budget of 8.0 GiB",
+            "MI_MEMORY_BUDGET",
+        ],
+    );
+    let out = bin()
+        .env("MI_MEMORY_BUDGET", "64G")
+        .args(args)
+        .output()
+        .unwrap();
+    assert_error(&out, &["6277011 nodes", "memory budget of 64.0 GiB"]);
+    let out = bin()
+        .env("MI_MEMORY_BUDGET", "lots")
+        .args(["run", "-q"])
+        .output()
+        .unwrap();
+    assert_error(&out, &["MI_MEMORY_BUDGET", "lots"]);
+}
+
+/// Issue 48, failure 4: `impact_speed = 5e-324` made the impact energy 0
+/// and the energy error NaN, written as `"finished"` with
+/// `"energy_error": null`. The speed's range starts at 1 cm/s, as the rod
+/// scenes' does; the slowest shot allowed has a finite energy error.
+#[test]
+fn a_subnormal_impact_speed_is_refused_and_the_slowest_has_a_finite_energy_error() {
+    let base = ["run", "penetration", "-q", "--set", "particles_radial=3"];
+    let out = bin()
+        .args(base)
+        .args(["--set", "impact_speed=5e-324"])
+        .output()
+        .unwrap();
+    assert_error(&out, &["`impact_speed` = 5e-324", "out of range"]);
+    let out = bin()
+        .args(base)
+        .args(["--set", "impact_speed=0.01", "--set", "end_time=3e-7"])
+        .args(["--json", "/dev/stdout"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["outcome"], "finished");
+    assert!(v["energy_error"].as_f64().unwrap().is_finite(), "{v}");
+}

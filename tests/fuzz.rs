@@ -27,7 +27,7 @@ const CASE_LIMIT: Duration = Duration::from_secs(30);
 const STEPS: usize = 4;
 
 /// Error names of the library (`Error::name`), the documented table.
-const NAMES: [&str; 16] = [
+const NAMES: [&str; 17] = [
     "OutOfRange",
     "UnknownParameter",
     "UnknownScene",
@@ -41,14 +41,15 @@ const NAMES: [&str; 16] = [
     "EnergyDrift",
     "SpacingCollapse",
     "CompressionLimit",
+    "MemoryBudget",
     "Cancelled",
     "InvalidState",
     "Io",
 ];
 
 /// Result codes of the C ABI (`mi_result`), the documented table.
-const CODES: [i32; 23] = [
-    0, 1, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 20, 21, 22, 23, 24, 25, 26, 27, 30,
+const CODES: [i32; 24] = [
+    0, 1, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 16, 20, 21, 22, 23, 24, 25, 26, 27, 30,
 ];
 
 /// xorshift64*: a small, seeded, reproducible generator.

@@ -369,3 +369,33 @@ fn forged_taylor3d_states_are_refused() {
     // The unedited state loads.
     Simulation::deserialize_state(&serde_json::to_vec(&base).unwrap()).unwrap();
 }
+
+/// Issue 48, failure 9: a scene file's `[reference]` table took `nan` and
+/// `±inf` (printed as "NaN%", and the library then refused its own state).
+#[test]
+fn a_reference_that_is_not_a_number_is_refused() {
+    for bad in ["nan", "inf", "-inf"] {
+        let text = format!("scene = \"taylor\"\n[reference]\nrod_length = {bad}\n");
+        let e = Scene::from_toml_str(&text).unwrap_err();
+        assert!(e.to_string().contains("[reference] rod_length"), "{e}");
+    }
+    let ok = Scene::from_toml_str("scene = \"taylor\"\n[reference]\nrod_length = 0.02\n").unwrap();
+    assert_eq!(ok.reference["rod_length"], 0.02);
+}
+
+/// Issue 48, failure 8: the state saved after a stop loads back (here
+/// `EnergyDrift`: test 7 at 6 across without the velocity smoothing); a
+/// run stopped on a non-finite field has no state to save
+/// (`Simulation::check_savable`, `MI_NON_FINITE` from `mi_sim_state_save`).
+#[test]
+fn a_state_saved_after_a_stop_loads_back() {
+    let mut scene = Scene::builtin("taylor").unwrap();
+    scene.set("particles_radial", 6.0).unwrap();
+    scene.set("smoothing_coefficient", 0.0).unwrap();
+    let mut sim = Simulation::new(scene).unwrap();
+    let e = sim.run().unwrap_err();
+    assert_eq!(e.name(), "EnergyDrift", "{e}");
+    sim.check_savable().unwrap();
+    let back = Simulation::deserialize_state(&sim.serialize_state()).unwrap();
+    assert_eq!(back.time(), sim.time());
+}

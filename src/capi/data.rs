@@ -399,7 +399,10 @@ pub unsafe extern "C" fn mi_sim_field(
 
 /// Copies the complete state of the run (solver, history, scene) as bytes,
 /// by the buffer convention, for hosts that save and roll back. The bytes are
-/// only meant for `mi_sim_state_load` of the same library version.
+/// only meant for `mi_sim_state_load` of the same library version. Every
+/// state saved loads back, stopped or not; a run stopped on a non-finite
+/// field has none to save, and returns its stop (`MI_NON_FINITE`, or
+/// `MI_ENERGY_DRIFT` when its energy overflowed).
 ///
 /// # Safety
 /// `sim` must be NULL or a live handle; `buf` NULL or valid for `len` bytes;
@@ -413,7 +416,9 @@ pub unsafe extern "C" fn mi_sim_state_save(
 ) -> mi_result {
     with_sim(sim, |s| {
         check_buf(buf, len, "buf")?;
-        let bytes = s.sim()?.serialize_state();
+        let sim = s.sim()?;
+        sim.check_savable()?;
+        let bytes = sim.serialize_state();
         // SAFETY: forwarded contract on `buf`, `len`, `needed`.
         unsafe { copy_out(&bytes, buf, len, needed, "buf") }
     })

@@ -7,7 +7,9 @@ use std::ffi::c_char;
 /// Result of every fallible `mi_*` function. `MI_OK` (0) is success; every
 /// other value names one kind of failure, and `mi_sim_last_error` gives the
 /// message of the last failure on a handle. The values are part of the stable
-/// ABI: they are never renumbered.
+/// ABI: they are never renumbered. The codes 20 to 29 are the stops of a run
+/// (solver stops and `MI_CANCELLED`), and no other code lies there: the list
+/// at `mi_sim_run` is made of that block.
 #[allow(non_camel_case_types)]
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -52,6 +54,10 @@ pub enum mi_result {
     /// `preset` of `mi_sim_set_material`, or of a TOML `[material]` table),
     /// or the scene has no material to choose.
     MI_UNKNOWN_MATERIAL = 15,
+    /// The run's estimated peak memory exceeds the memory budget (8 GiB, or
+    /// the environment variable `MI_MEMORY_BUDGET`): refused before it
+    /// allocates; the message gives the estimate and the budget.
+    MI_MEMORY_BUDGET = 16,
     /// The run stopped: an MSPH moment matrix was singular (too few or
     /// collinear neighbours).
     MI_SINGULAR_MOMENT_MATRIX = 20,
@@ -152,6 +158,11 @@ pub(crate) const RESULTS: &[(mi_result, &str, &str)] = &[
         "unknown material model or preset\0",
     ),
     (
+        mi_result::MI_MEMORY_BUDGET,
+        "MI_MEMORY_BUDGET\0",
+        "the run's estimated memory exceeds the memory budget\0",
+    ),
+    (
         mi_result::MI_SINGULAR_MOMENT_MATRIX,
         "MI_SINGULAR_MOMENT_MATRIX\0",
         "singular MSPH moment matrix\0",
@@ -233,6 +244,7 @@ pub(crate) fn code_of(e: &Error) -> mi_result {
         Error::EnergyDrift { .. } => MI_ENERGY_DRIFT,
         Error::SpacingCollapse { .. } => MI_SPACING_COLLAPSE,
         Error::CompressionLimit { .. } => MI_COMPRESSION_LIMIT,
+        Error::MemoryBudget { .. } => MI_MEMORY_BUDGET,
         Error::Cancelled { .. } => MI_CANCELLED,
         Error::InvalidState(_) => MI_INVALID_STATE,
         Error::Io { .. } => MI_IO,
@@ -277,6 +289,6 @@ mod tests {
             assert!(name.ends_with('\0') && desc.ends_with('\0'));
             assert_eq!(format!("{code:?}\0"), *name);
         }
-        assert_eq!(RESULTS.len(), 25);
+        assert_eq!(RESULTS.len(), 26);
     }
 }

@@ -137,9 +137,14 @@ impl mi_sim {
         self.stopped = None;
     }
 
-    /// Whether the run has started (a step was taken, or it was stopped).
+    /// Whether the run has started (a step was taken, or it was stopped:
+    /// also by a stop in its first step, before the step count left 0).
     fn started(&self) -> bool {
-        self.stopped.is_some() || self.sim.as_ref().is_some_and(|s| s.steps() > 0)
+        self.stopped.is_some()
+            || self
+                .sim
+                .as_ref()
+                .is_some_and(|s| s.steps() > 0 || s.error().is_some())
     }
 
     /// Whether the run has ended: end condition, solver stop or cancel.
@@ -223,8 +228,12 @@ fn create(out: *mut *mut mi_sim, make: impl FnOnce() -> Result<Scene, Fail>) -> 
     })
 }
 
-/// Creates a handle for a built-in scene with default parameters: `"taylor"`
-/// (House et al. test 7), `"noh"`, or `"table1-1"` ... `"table1-12"`.
+/// Creates a handle for a built-in scene with default parameters. The
+/// built-in scenes (the kinds of scene of the registry, each followed by its
+/// named variants):
+///
+/// @SCENES@
+///
 /// On `MI_OK`, `*out` receives a new handle that the caller must release with
 /// `mi_sim_free`; on failure `*out` is left unchanged (`MI_NULL_POINTER`,
 /// `MI_INVALID_UTF8`, `MI_UNKNOWN_SCENE`).
@@ -243,9 +252,11 @@ pub unsafe extern "C" fn mi_sim_new(scene: *const c_char, out: *mut *mut mi_sim)
 
 /// Creates a handle from a TOML scene text (`scene = "taylor"`, an optional
 /// `[parameters]` table and an optional `[reference]` table, as the files in
-/// `scenes/`). Codes as `mi_sim_new`, plus `MI_SCENE_FILE`, `MI_PARSE_VALUE`,
-/// `MI_UNKNOWN_PARAMETER`, `MI_OUT_OF_RANGE` and `MI_INCONSISTENT`. For the
-/// message of a failure, create a handle and use `mi_sim_load_toml`.
+/// `scenes/`); `scene =` names a kind of scene, the first level of the list
+/// at `mi_sim_new`. Codes as `mi_sim_new`, plus `MI_SCENE_FILE`,
+/// `MI_PARSE_VALUE`, `MI_UNKNOWN_PARAMETER`, `MI_OUT_OF_RANGE` and
+/// `MI_INCONSISTENT`. For the message of a failure, create a handle and use
+/// `mi_sim_load_toml`.
 ///
 /// # Safety
 /// As `mi_sim_new`.
@@ -568,10 +579,13 @@ pub unsafe extern "C" fn mi_sim_advance_to(sim: *mut mi_sim, time: f64) -> mi_re
 }
 
 /// Runs to the end condition (the rod at rest, or the scene's `end_time`).
-/// Returns `MI_OK`, a solver stop (`MI_SINGULAR_MOMENT_MATRIX`,
-/// `MI_NON_FINITE`, `MI_THROUGH_BOUNDARY`, `MI_TIME_STEP_COLLAPSE`,
-/// `MI_ENERGY_DRIFT`) or `MI_CANCELLED`. After a stop the observables,
-/// history and fields still read the state at the stop.
+/// Returns `MI_OK`, or the code of the stop that ended the run (a solver
+/// stop, or `MI_CANCELLED` from the progress callback):
+///
+/// @STOPS@
+///
+/// After a stop the observables, history and fields still read the state at
+/// the stop.
 ///
 /// # Safety
 /// `sim` must be NULL or a live handle.

@@ -3,8 +3,10 @@
 //! unsafe code.
 //!
 //! cbindgen generates `include/meshless_impact.h` from this module
-//! (`cargo xtask header`, settings in `cbindgen.toml`); `tests/capi.rs` fails
-//! when the committed header differs from what cbindgen generates now.
+//! (`cargo xtask header`, settings in `cbindgen.toml`), and [`expand_header`]
+//! fills in the lists that come from the library's tables (the built-in
+//! scenes, the stop codes) where a doc comment holds a placeholder line;
+//! `tests/capi.rs` fails when the committed header differs from that output.
 //!
 //! Rules every entry point follows:
 //!
@@ -35,8 +37,11 @@ mod data;
 // Internals.
 mod panic;
 mod ptr;
+// The generated lists of the header's comments (not part of the ABI).
+mod doc_lists;
 
 pub use data::*;
+pub use doc_lists::expand_header;
 pub use error::{mi_result, mi_result_description, mi_result_name};
 pub use handle::*;
 

@@ -756,6 +756,9 @@ pub(crate) unsafe fn get_fmu_state(
             if state.is_null() {
                 return inst.fail(&format!("{function}: FMUState is NULL"));
             }
+            if let Some(Err(e)) = inst.sim.as_ref().map(|s| s.check_savable()) {
+                return inst.fail(&format!("{function}: the run has no state to save: {e}"));
+            }
             let saved = inst.save();
             // SAFETY: `state` is writable; a non-null `*state` is a
             // `Box<Saved>` this FMU handed out and has not freed.

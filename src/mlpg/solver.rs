@@ -78,7 +78,7 @@ use crate::solver::axisymmetric::{
     ENERGY_ERROR_BOUND, QUIET_FRACTION, QUIET_TRANSITS, SHIFT_CAP, SHIFT_RANGE,
     SPACING_COLLAPSE_BOUND,
 };
-use crate::solver::{check_derived, check_time_step};
+use crate::solver::{above, below, check_derived, check_time_step};
 use rayon::prelude::*;
 
 /// Default damping ratio ζ at the highest frequency `ω_max` of the
@@ -858,6 +858,14 @@ impl Mlpg3d {
             }
             let widest = sup.radius[..n].iter().copied().fold(0.0, f64::max);
             let dk = sup.named_distance.iter().copied().fold(0.0, f64::max);
+            if !(widest + dk).is_finite() {
+                // Only positions that overflow get here: never grow for ever.
+                return Err(Error::NonFinite {
+                    field: "support radius",
+                    particle: sup.radius.iter().position(|r| !r.is_finite()).unwrap_or(0),
+                    time: self.time,
+                });
+            }
             if widest + dk < layer {
                 break (sup, m, dk);
             }
@@ -1452,7 +1460,7 @@ impl Mlpg3d {
         let d_min = pairs.nearest;
         let ratio = d_min / self.d_min0;
         self.min_spacing = self.min_spacing.min(ratio);
-        if ratio < SPACING_COLLAPSE_BOUND {
+        if below(ratio, SPACING_COLLAPSE_BOUND) {
             return Err(Error::SpacingCollapse {
                 ratio,
                 bound: SPACING_COLLAPSE_BOUND,
@@ -1620,7 +1628,7 @@ impl Mlpg3d {
             });
         }
         let e = self.energy_error_with(t.kinetic);
-        if e > ENERGY_ERROR_BOUND {
+        if above(e, ENERGY_ERROR_BOUND) {
             return Err(Error::EnergyDrift {
                 error: e,
                 bound: ENERGY_ERROR_BOUND,

@@ -497,7 +497,17 @@ impl Scene {
         for (spec, v) in self.param_specs().iter().zip(&self.values) {
             spec.check(*v)?;
         }
-        (self.kind.row().check)(self)
+        // A reference is a measured or exact value: a number.
+        if let Some((name, &value)) = self.reference.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(Error::OutOfRange {
+                name: format!("[reference] {name}"),
+                value,
+                range: "a finite number".into(),
+            });
+        }
+        let row = self.kind.row();
+        (row.check)(self)?;
+        crate::budget::check_memory((row.nodes)(self), row.memory)
     }
 }
 

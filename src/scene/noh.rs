@@ -5,6 +5,7 @@
 use super::Scene;
 use super::params::{Range, param_table};
 use super::registry::{SceneRow, no_variants, restore};
+use crate::budget::MemoryPerNode;
 use crate::observe::NOH_OBSERVABLES;
 use crate::solver::radial::NohSolver;
 use std::collections::BTreeMap;
@@ -24,6 +25,10 @@ pub static ROW: SceneRow = SceneRow {
     },
     variants: no_variants,
     check: |s| NohParams::from_values(s.values()).check_consistency(),
+    nodes: |s| NohParams::from_values(s.values()).particles_radial,
+    // Measured 0.67 kB a particle at 20 000 (BENCHMARKS.md, "Memory per
+    // node").
+    memory: MemoryPerNode { bytes: 1000.0 },
     build: |s: &Scene| {
         Ok(Box::new(NohSolver::new(NohParams::from_values(
             s.values(),

@@ -4,6 +4,7 @@
 
 use super::params::ParamSpec;
 use super::{Scene, SceneKind};
+use crate::budget::MemoryPerNode;
 use crate::error::{Error, Result};
 use crate::material::choice::MaterialChoice;
 use crate::model::Model;
@@ -56,6 +57,12 @@ pub struct SceneRow {
     /// Cross-parameter checks of a scene of this kind (each value is
     /// already in its range).
     pub check: fn(&Scene) -> Result<()>,
+    /// The nodes (particles) a run of a valid scene of this kind will have,
+    /// from its parameters alone (before anything is allocated).
+    pub nodes: fn(&Scene) -> f64,
+    /// The peak memory per node of this kind's solver: with `nodes`, what
+    /// the memory budget checks ([`crate::budget`]).
+    pub memory: MemoryPerNode,
     /// Builds the initial state of a run of a valid scene of this kind.
     pub build: fn(&Scene) -> Result<Box<dyn Model>>,
     /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked

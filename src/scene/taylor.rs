@@ -14,6 +14,7 @@
 use super::Scene;
 use super::params::{ParamSpec, Range, choice_tables, param_struct};
 use super::registry::{FmuIdentity, MaterialSlot, SceneRow, restore};
+use crate::budget::MemoryPerNode;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::observe::TAYLOR_OBSERVABLES;
 use crate::solver::axisymmetric::TaylorSolver;
@@ -63,6 +64,10 @@ pub static ROW: SceneRow = SceneRow {
         material_choice(s).check_consistency(Prefix::None, |n| s.get(n))?;
         TaylorParams::of(s).check_consistency()
     },
+    nodes: |s| TaylorParams::of(s).nodes(),
+    // Measured 2.0 kB a node at 60 across (BENCHMARKS.md, "Memory per
+    // node"); the neighbour lists grow as the rod spreads.
+    memory: MemoryPerNode { bytes: 4000.0 },
     build: |s: &Scene| {
         let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
         Ok(Box::new(TaylorSolver::with_material(
@@ -205,12 +210,24 @@ impl TaylorParams {
         p
     }
 
+    /// Particles along the axis: the length over the radial spacing, plus
+    /// one.
+    pub(crate) fn axial_particles(&self) -> f64 {
+        let spacing = 0.5 * self.initial_diameter / (self.particles_radial - 1.0);
+        (self.initial_length / spacing).round() + 1.0
+    }
+
+    /// Particles of the axisymmetric lattice (across times along).
+    pub(crate) fn nodes(&self) -> f64 {
+        self.particles_radial * self.axial_particles()
+    }
+
     /// Checks the geometric constraint that single ranges cannot express
     /// (the material's are [`MaterialChoice::check_consistency`]).
     pub fn check_consistency(&self) -> crate::Result<()> {
         use crate::Error::Inconsistent;
         let n = self.particles_radial;
-        let axial = (self.initial_length / (0.5 * self.initial_diameter / (n - 1.0))).round() + 1.0;
+        let axial = self.axial_particles();
         if !(2.0..=100_000.0).contains(&axial) {
             return Err(Inconsistent(format!(
                 "initial_length / spacing gives {axial} particles along the axis; allowed [2, 100000] \

@@ -12,6 +12,7 @@ use super::Scene;
 use super::params::{ParamSpec, Range, choice_tables, param_struct};
 use super::registry::{MaterialSlot, SceneRow, restore};
 use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
+use crate::budget::MemoryPerNode;
 use crate::material::Material;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::Cylinder;
@@ -37,6 +38,18 @@ pub static ROW: SceneRow = SceneRow {
         material_choice(s).check_consistency(Prefix::None, |n| s.get(n))?;
         Taylor3dParams::of(s).check_consistency()
     },
+    nodes: |s| {
+        let p = Taylor3dParams::of(s);
+        let radius = 0.5 * p.initial_diameter;
+        let spacing = radius / (p.particles_radial - 1.0);
+        let nodes = ring_lattice_nodes(radius, p.initial_length, spacing);
+        if p.symmetry >= 0.5 {
+            nodes / 4.0
+        } else {
+            nodes
+        }
+    },
+    memory: RING_LATTICE_MEMORY,
     build: |s: &Scene| {
         let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
         Ok(Box::new(Taylor3dParams::of(s).build_with(material)?))
@@ -49,6 +62,18 @@ pub static ROW: SceneRow = SceneRow {
                       with Johnson-Cook thermo-viscoplasticity; defaults are House et al. (1995) test 7 on 4340 steel",
     }),
 };
+
+/// The peak memory per node of the 3-D MLPG solver: measured up to
+/// 14.9 kB a node over whole runs (BENCHMARKS.md, "Memory per node").
+pub(crate) const RING_LATTICE_MEMORY: MemoryPerNode = MemoryPerNode { bytes: 20_000.0 };
+
+/// Nodes of the ring lattice of a cylinder ([`crate::mlpg::lattice`]) of
+/// `radius` and `length` at the radial `spacing`: `1 + 3 k (k + 1)` a layer
+/// for `k` rings, one layer a spacing.
+pub(crate) fn ring_lattice_nodes(radius: f64, length: f64, spacing: f64) -> f64 {
+    let k = (radius / spacing).round();
+    (1.0 + 3.0 * k * (k + 1.0)) * ((length / spacing).round() + 1.0)
+}
 
 /// The material models of a `taylor3d` scene.
 fn material_choice(s: &Scene) -> MaterialChoice {

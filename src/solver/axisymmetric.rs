@@ -38,7 +38,7 @@ use super::pairs::{
 };
 use super::shift::{Candidates, Freedom, carry, leaving, shifts, surface_band};
 use super::team::{Chunks, Team};
-use super::{COURANT, check_derived, check_time_step};
+use super::{COURANT, above, below, check_derived, check_time_step};
 use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::kernel::SUPPORT;
@@ -1176,7 +1176,7 @@ impl TaylorSolver {
         let d0 = self.spacing();
         let ratio = a.min_d2.sqrt() / d0;
         self.min_spacing = self.min_spacing.min(ratio);
-        if ratio < SPACING_COLLAPSE_BOUND {
+        if below(ratio, SPACING_COLLAPSE_BOUND) {
             return Err(Error::SpacingCollapse {
                 ratio,
                 bound: SPACING_COLLAPSE_BOUND,
@@ -1475,7 +1475,7 @@ impl TaylorSolver {
         self.internal_energy += booked;
 
         let e = self.energy_error_with(t.kinetic);
-        if e > ENERGY_ERROR_BOUND {
+        if above(e, ENERGY_ERROR_BOUND) {
             return Err(Error::EnergyDrift {
                 error: e,
                 bound: ENERGY_ERROR_BOUND,

@@ -63,9 +63,20 @@ pub(crate) fn check_derived(name: &str, value: f64, unit: &str) -> crate::Result
     }
 }
 
+/// Whether `value` is above `bound`, or NaN: a guard written with it stops
+/// on a NaN (a plain `value > bound` lets NaN through).
+pub(crate) fn above(value: f64, bound: f64) -> bool {
+    value.is_nan() || value > bound
+}
+
+/// Whether `value` is below `bound`, or NaN: see [`above`].
+pub(crate) fn below(value: f64, bound: f64) -> bool {
+    value.is_nan() || value < bound
+}
+
 /// Stops a run whose stable step fell below [`MIN_DT_FRACTION`] of the first.
 pub(crate) fn check_time_step(dt: f64, dt0: f64, time: f64) -> crate::Result<()> {
-    if dt < MIN_DT_FRACTION * dt0 {
+    if below(dt, MIN_DT_FRACTION * dt0) {
         Err(crate::Error::TimeStepCollapse {
             dt,
             time,

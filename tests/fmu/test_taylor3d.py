@@ -117,3 +117,14 @@ def test_bad_values_and_foreign_states_are_refused_with_their_names():
         mine = m.md.coSimulation.modelIdentifier
         assert any(f"not a serialized {mine} FMU state" in x for x in messages("logStatusError")), MESSAGES
         t.freeInstance()
+
+
+@pytest.mark.parametrize("make", [slave3, slave2])
+def test_a_rod_over_the_memory_budget_is_refused_at_initialization(make):
+    """Issue 48, failure 2: `initial_diameter = 1e-4` (a rod of 4.8 million
+    nodes at the default 6 across) killed the fmpy host process on
+    allocation. The memory budget refuses it at initialization with Error
+    and a message that gives the node count and the budget."""
+    from test_fmu import assert_initialization_refused
+    assert_initialization_refused(fmu("" if make is slave3 else "_fmi2"), make,
+                                  {"initial_diameter": 1e-4}, "memory budget")
