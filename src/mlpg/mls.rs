@@ -678,13 +678,13 @@ fn add_outer(a: &mut [[f64; BASIS]; BASIS], p: &[f64; BASIS], w: f64) {
 
 /// The first search radius of the k nearest for a set whose box is thin in
 /// some direction (a long rod, a flat plate, a line): the radius whose
-/// d-dimensional box holds `fill` of the set, for the largest d (3, 2 or
-/// 1) at which the set is still d-dimensional at that scale (the radius is
-/// within its d-th largest extent). A long rod 3.38 m by 7.6 mm started
-/// from its length's share, 0.14 m or 190 spacings, and listed 17 000
-/// candidates a node (13 GB at 400 000 nodes); it starts at 3 spacings now.
-/// Only the cost depends on the start: any radius that holds the k nearest
-/// names the same ones.
+/// d-dimensional box holds `fill` of the set, for the largest dimension d of
+/// three, two or one at which the set is still d-dimensional at that scale
+/// (the radius is within its d-th largest extent). A long rod 3.38 m by
+/// 7.6 mm started from its length's share, 0.14 m or 190 spacings, and
+/// listed about 17 000 candidates a node (13.7 GB at 400 000 nodes); it
+/// starts at 3 spacings now. Only the cost depends on the start: any radius
+/// that holds the k nearest names the same ones.
 fn thin_start(extents: [f64; 3], fill: f64) -> f64 {
     let mut e = extents;
     e.sort_unstable_by(|a, b| b.total_cmp(a));
