@@ -47,9 +47,11 @@ static bool cancel_after_5(void *user_data, double time, double end_time, uint64
 
 /* A saved state with the `component` of particle `particle`'s velocity set to
  * `value` (the state is JSON; the text surgery is for this test only), loaded
- * into a new handle and stepped once: the solver's own checks stop it. */
-static void patched_state(int particle, int component, const char *value, mi_result want,
-                          const char *needle, const char *what) {
+ * into a new handle and stepped once: the solver's own checks stop it. With
+ * `load` = MI_INVALID_STATE the load itself is refused (a velocity beyond
+ * the physical bound of a restored state). */
+static void patched_state(int particle, int component, const char *value, mi_result load,
+                          mi_result want, const char *needle, const char *what) {
     mi_sim *sim = make("taylor", 5), *copy = NULL;
     size_t n = 0, head;
     uint8_t *bytes, *patched;
@@ -75,8 +77,12 @@ static void patched_state(int particle, int component, const char *value, mi_res
     memcpy(patched + head + strlen(value), end, n - (size_t)(end - (char *)bytes));
     n = head + strlen(value) + (n - (size_t)(end - (char *)bytes));
     check(NULL, mi_sim_new("taylor", &copy), "mi_sim_new");
-    check(copy, mi_sim_state_load(copy, patched, n), "mi_sim_state_load");
-    expect(copy, mi_sim_step(copy), want, needle, what);
+    if (load == MI_OK) {
+        check(copy, mi_sim_state_load(copy, patched, n), "mi_sim_state_load");
+        expect(copy, mi_sim_step(copy), want, needle, what);
+    } else {
+        expect(copy, mi_sim_state_load(copy, patched, n), load, needle, what);
+    }
     free(bytes);
     free(patched);
     mi_sim_free(copy);
@@ -167,8 +173,29 @@ int main(void) {
     check(s, mi_sim_set_param(s, "eos_s", 10.0), "eos_s");
     check(s, mi_sim_set_param(s, "impact_speed", 2000.0), "impact_speed");
     run_and_free(s, "Mie-Gr", MI_COMPRESSION_LIMIT, "run(MG, eos_c0 500, 2000 m/s)");
-    patched_state(6, 1, "-1e6", MI_THROUGH_BOUNDARY, "anvil", "step(v_Z = -1e6)");
-    patched_state(11, 0, "1e308", MI_NON_FINITE, "non-finite", "step(v_R = 1e308)");
+    patched_state(6, 1, "-5e4", MI_OK, MI_THROUGH_BOUNDARY, "anvil", "step(v_Z = -5e4)");
+    patched_state(11, 0, "1e308", MI_INVALID_STATE, MI_INVALID_STATE, "faster than",
+                  "state_load(v_R = 1e308)");
+
+    /* Soft, heavy bodies at 10 km/s: a temperature overflows within 1 us; such
+     * a run has no state to save (issue 48). */
+    s = make("penetration", 3);
+    check(s, mi_sim_set_param(s, "impact_speed", 1e4), "impact_speed");
+    check(s, mi_sim_set_param(s, "end_time", 1e-6), "end_time");
+    check(s, mi_sim_set_param(s, "projectile_density", 1e5), "projectile_density");
+    check(s, mi_sim_set_param(s, "plate_density", 1e5), "plate_density");
+    check(s, mi_sim_set_param(s, "projectile_shear_modulus", 1e6), "projectile_shear_modulus");
+    check(s, mi_sim_set_param(s, "projectile_bulk_modulus", 1e6), "projectile_bulk_modulus");
+    check(s, mi_sim_set_param(s, "plate_shear_modulus", 1e6), "plate_shear_modulus");
+    check(s, mi_sim_set_param(s, "projectile_yield_stress", 0.0), "projectile_yield_stress");
+    expect(s, mi_sim_run(s), MI_NON_FINITE, "non-finite", "run(soft, heavy, 10 km/s)");
+    expect(s, mi_sim_state_save(s, NULL, 0, &n), MI_NON_FINITE, "non-finite",
+           "state_save after a non-finite stop");
+    mi_sim_free(s);
+
+    /* 6.3 million nodes: refused by the memory budget before allocating. */
+    s = make("taylor3d", 60);
+    run_and_free(s, "memory budget", MI_MEMORY_BUDGET, "run(taylor3d, 60 across)");
 
     /* Cancel from the progress callback. */
     s = make("taylor", 5);

@@ -564,7 +564,19 @@ fn coarse_state_at_1us() -> serde_json::Value {
 }
 
 /// A saved state whose `vel[particle][component]` is replaced by `value`,
-/// loaded into a fresh handle: the solver's own checks then stop the next step.
+/// loaded into a fresh handle: the code and message of the load.
+fn patched_load_code(particle: usize, component: usize, value: f64) -> (mi_result, String) {
+    let mut json = coarse_state_at_1us();
+    json["solver"]["Taylor"]["vel"][particle][component] = value.into();
+    let bytes = serde_json::to_vec(&json).unwrap();
+    let t = new_sim("taylor");
+    // SAFETY: live handle; a buffer of the right length.
+    let r = unsafe { mi_sim_state_load(t.0, bytes.as_ptr(), bytes.len()) };
+    (r, t.error())
+}
+
+/// [`patched_load_code`] loaded, then stepped: the solver's own checks
+/// stop the step.
 fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_result, String) {
     let mut json = coarse_state_at_1us();
     // SAFETY: live handle; buffers of the right length.
@@ -574,7 +586,9 @@ fn patched_state_code(particle: usize, component: usize, value: f64) -> (mi_resu
         let t = new_sim("taylor");
         assert_eq!(
             mi_sim_state_load(t.0, bytes.as_ptr(), bytes.len()),
-            mi_result::MI_OK
+            mi_result::MI_OK,
+            "{}",
+            t.error()
         );
         let r = mi_sim_step(t.0);
         (r, t.error())
@@ -767,10 +781,39 @@ fn every_error_code_is_produced() {
             assert_eq!(s.set(k, v), MI_OK, "{k}");
         }
         check(s.run(), MI_COMPRESSION_LIMIT, &s.error(), "Mie-Gr");
-        let (r, m) = patched_state_code(6, 1, -1e6);
+        // 50 km/s toward the anvil: within the bound of a restored state
+        // (ten times impact plus wave speed), through the anvil in a step.
+        let (r, m) = patched_state_code(6, 1, -5e4);
         check(r, MI_THROUGH_BOUNDARY, &m, "through the anvil");
-        let (r, m) = patched_state_code(11, 0, 1e308);
-        check(r, MI_NON_FINITE, &m, "non-finite");
+        // Soft, heavy bodies at 10 km/s: a temperature overflows within
+        // 1 us (issue 48's extreme physics).
+        let s = new_sim("penetration");
+        for (k, v) in [
+            ("particles_radial", 3.0),
+            ("impact_speed", 1e4),
+            ("end_time", 1e-6),
+            ("projectile_density", 1e5),
+            ("plate_density", 1e5),
+            ("projectile_shear_modulus", 1e6),
+            ("projectile_bulk_modulus", 1e6),
+            ("plate_shear_modulus", 1e6),
+            ("projectile_yield_stress", 0.0),
+        ] {
+            assert_eq!(s.set(k, v), MI_OK, "{k}");
+        }
+        check(s.run(), MI_NON_FINITE, &s.error(), "non-finite");
+        // Such a run has no state to save: its stop is returned.
+        let mut n = 0usize;
+        check(
+            mi_sim_state_save(s.0, null_mut(), 0, &mut n),
+            MI_NON_FINITE,
+            &s.error(),
+            "non-finite",
+        );
+        // A forged velocity of 1e308 (once MI_NON_FINITE at the next step)
+        // is refused on loading.
+        let (r, m) = patched_load_code(11, 0, 1e308);
+        check(r, MI_INVALID_STATE, &m, "faster than");
 
         unsafe extern "C" fn no(_: *mut c_void, _: f64, _: f64, _: u64) -> bool {
             false

@@ -604,6 +604,44 @@ fn a_run_over_the_memory_budget_is_refused_before_it_allocates() {
     assert_error(&out, &["MI_MEMORY_BUDGET", "lots"]);
 }
 
+/// Issue 48, failure 3: soft, heavy bodies at 10 km/s took a first step of
+/// 478 µs (the wave speed alone, 3 m/s), and the projectile passed 4.76 m
+/// beyond the plate without touching it, reported "finished". The first
+/// step now has the bound of every later one, the nodes' speed included:
+/// the projectile meets the plate (contact dissipates energy, and it
+/// slows) within the first microsecond. The run then stops by name (a
+/// temperature overflows: `NonFinite`), never "finished" past the plate.
+#[test]
+fn a_fast_soft_projectile_meets_the_plate() {
+    let out = bin()
+        .args(["run", "penetration", "-q", "--set", "particles_radial=3"])
+        .args(["--set", "impact_speed=1e4", "--set", "end_time=1e-6"])
+        .args([
+            "--set",
+            "projectile_density=1e5",
+            "--set",
+            "plate_density=1e5",
+        ])
+        .args(["--set", "projectile_shear_modulus=1e6"])
+        .args(["--set", "projectile_bulk_modulus=1e6"])
+        .args(["--set", "plate_shear_modulus=1e6"])
+        .args([
+            "--set",
+            "projectile_yield_stress=0",
+            "--json",
+            "/dev/stdout",
+        ])
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["steps"].as_u64().unwrap() > 3, "{v}");
+    assert!(v["contact_dissipation"].as_f64().unwrap() > 0.0, "{v}");
+    assert!(v["projectile_velocity"].as_f64().unwrap() < 9000.0, "{v}");
+    assert!(v["end_time"].as_f64().unwrap() < 1e-6, "{v}");
+    assert_eq!(v["outcome"], "NonFinite", "{v}");
+    assert_error(&out, &["non-finite"]);
+}
+
 /// Issue 48, failure 4: `impact_speed = 5e-324` made the impact energy 0
 /// and the energy error NaN, written as `"finished"` with
 /// `"energy_error": null`. The speed's range starts at 1 cm/s, as the rod

@@ -370,6 +370,64 @@ fn forged_taylor3d_states_are_refused() {
     Simulation::deserialize_state(&serde_json::to_vec(&base).unwrap()).unwrap();
 }
 
+/// The `Mlpg3d` run inside a saved 3-D state: `taylor3d`'s solver, or the
+/// run of a `penetration`.
+fn run3d(state: &mut Value) -> &mut Value {
+    let solver = state["solver"].as_object_mut().unwrap();
+    let (_, s) = solver.iter_mut().next().unwrap();
+    if s.get("run").is_some() {
+        &mut s["run"]
+    } else {
+        s
+    }
+}
+
+/// Issue 48, failures 5 and 6: forged states with finite but absurd values
+/// loaded. A support position of ±1e300 in the quarter model hung the next
+/// step (the search of the supports grew its layer for ever); a velocity
+/// or a crack of 1e300 made the observables infinite with success. Each is
+/// refused by the physical bounds of a restored run (no node ten times
+/// faster than impact plus wave speed, none further out than the bodies
+/// could have gone, no crack larger than the bodies), and an unedited
+/// state of the same runs still loads.
+#[test]
+fn forged_states_with_absurd_finite_values_are_refused() {
+    let quarter = [("particles_radial", 3.0), ("symmetry", 1.0)];
+    let (_, pen) = saved("penetration", &quarter, 3e-7);
+    let (_, rod3d) = saved("taylor3d", &[("particles_radial", 3.0)], 1e-6);
+    let (_, rod) = saved("taylor", &[("particles_radial", 5.0)], 2e-6);
+    for base in [&pen, &rod3d, &rod] {
+        let bytes = serde_json::to_vec(base).unwrap();
+        Simulation::deserialize_state(&bytes).unwrap();
+    }
+    for huge in [1e300, -1e300] {
+        for field in ["supports_at", "pos", "built_at", "reference"] {
+            let mut s = pen.clone();
+            run3d(&mut s)[field][5][2] = json!(huge);
+            let e = refused(&s);
+            assert!(e.contains("not physical"), "{field}: {e}");
+        }
+        let mut s = pen.clone();
+        run3d(&mut s)["vel"][7][2] = json!(huge);
+        assert!(refused(&s).contains("faster than"));
+        let mut s = rod3d.clone();
+        run3d(&mut s)["vel"][0][2] = json!(huge);
+        assert!(refused(&s).contains("faster than"));
+        let mut s = rod.clone();
+        solver(&mut s, "Taylor")["vel"][3][1] = json!(huge);
+        assert!(refused(&s).contains("faster than"));
+        let mut s = rod.clone();
+        solver(&mut s, "Taylor")["pos"][3][0] = json!(huge);
+        assert!(refused(&s).contains("not physical"));
+    }
+    let mut s = pen.clone();
+    // The damage variables: one entry a node, `null` where none yet.
+    let points = run3d(&mut s)["material_state"].as_array_mut().unwrap();
+    let cracked = points.iter_mut().find(|p| !p.is_null()).unwrap();
+    cracked["crack_size"] = json!(1e300);
+    assert!(refused(&s).contains("crack"));
+}
+
 /// Issue 48, failure 9: a scene file's `[reference]` table took `nan` and
 /// `±inf` (printed as "NaN%", and the library then refused its own state).
 #[test]

@@ -289,6 +289,24 @@ impl MaterialState {
     }
 }
 
+impl MaterialState {
+    /// Refuses a crack larger than `extent`, the bodies' size: no running
+    /// model grows one (a forged state's 1e300 would make every
+    /// observable infinite).
+    pub fn check_cracks(&self, extent: f64) -> std::result::Result<(), String> {
+        match self.points.iter().position(|p| {
+            p.damage
+                .is_some_and(|v| v.crack_size.is_nan() || v.crack_size > extent)
+        }) {
+            Some(i) => Err(format!(
+                "its crack at particle {i} is larger than the bodies ({} m)",
+                crate::error::number(extent)
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Whether the variables of a ceramic point are finite and physical.
 fn physical(v: &CeramicVars) -> bool {
     v.elastic_strain.iter().all(|x| x.is_finite())

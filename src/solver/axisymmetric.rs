@@ -646,7 +646,17 @@ impl TaylorSolver {
                 self.min_spacing,
                 self.quiet_since.unwrap_or(0.0),
             ],
-        )
+        )?;
+        // Finite is not enough: a velocity of 1e300 overflows the energies.
+        let fastest = |v: &[f64; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
+        let bounds = super::RestoreBounds::new(
+            &fresh.pos,
+            fresh.vel.iter().map(fastest).fold(0.0, f64::max) + fresh.wave_speed(),
+            self.time,
+        );
+        bounds.speeds("velocities", &self.vel)?;
+        bounds.places("positions", &self.pos)?;
+        self.material_state.check_cracks(bounds.extent)
     }
 
     /// Particles across the radius and along the axis.

@@ -119,6 +119,65 @@ pub(crate) fn check_restored_clock(
     Ok(())
 }
 
+/// How fast a restored node may move, in units of the fastest speed at the
+/// start (the nodes' speed plus the wave speed): a running solver never comes
+/// near ten.
+pub(crate) const RESTORED_SPEED_FACTOR: f64 = 10.0;
+
+/// The physical bounds of a restored run, from a new run of its parameters:
+/// no node faster than [`RESTORED_SPEED_FACTOR`] times the fastest speed at
+/// the start, none further from the origin than the bodies' extent plus that
+/// speed times the run's time. A forged state of finite but absurd values
+/// (a velocity of 1e300, a node a light-year away) is refused by them.
+pub(crate) struct RestoreBounds {
+    /// Largest coordinate of the bodies at the start (m).
+    pub extent: f64,
+    speed: f64,
+    reach: f64,
+}
+
+impl RestoreBounds {
+    /// The bounds of a run whose nodes start at `start` with speeds up to
+    /// `fastest` (m/s, node speed plus wave speed), restored at `time`.
+    pub fn new<const D: usize>(start: &[[f64; D]], fastest: f64, time: f64) -> Self {
+        let extent = start.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let speed = RESTORED_SPEED_FACTOR * fastest;
+        RestoreBounds {
+            extent,
+            speed,
+            reach: extent + speed * time,
+        }
+    }
+
+    /// Refuses a node faster than the bound.
+    pub fn speeds<const D: usize>(&self, what: &str, v: &[[f64; D]]) -> Result<(), String> {
+        match v
+            .iter()
+            .position(|v| above(v.iter().map(|x| x * x).sum::<f64>().sqrt(), self.speed))
+        {
+            Some(i) => Err(format!(
+                "its {what} are not physical: node {i} is faster than {} m/s",
+                crate::error::number(self.speed)
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// Refuses a place further out than the bodies can have gone.
+    pub fn places<const D: usize>(&self, what: &str, x: &[[f64; D]]) -> Result<(), String> {
+        match x
+            .iter()
+            .position(|x| x.iter().any(|c| above(c.abs(), self.reach)))
+        {
+            Some(i) => Err(format!(
+                "its {what} are not physical: node {i} is further than {} m out",
+                crate::error::number(self.reach)
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Index and field of the first non-finite value, if any.
 pub(crate) fn first_non_finite(fields: &[(&'static str, &[f64])]) -> Option<(&'static str, usize)> {
     fields

@@ -13,7 +13,7 @@
 //! `guard` swallows in `Instantiate` and `FreeInstance`), a non-finite value
 //! read back with OK, and OK where the standard requires Error.
 
-use super::{Rng, bounded, edit_leaf};
+use super::{Entry, Rng, bounded, count, edit_leaf};
 use meshless_impact::ParamSpec;
 use meshless_impact::internals::fmi::{self, VarKind, VarType, fmi2, fmi3};
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
@@ -29,20 +29,78 @@ const FATAL: c_int = 4;
 /// Calls a case makes at most after instantiation.
 const CALLS: usize = 24;
 
-/// `particles_radial` values a case sets: cheap lattices, and values out of
-/// range. (Large in-range lattices take seconds to build: not fuzzed here.)
-const RADIAL: [i32; 9] = [3, 4, 4, 5, 6, i32::MIN, 0, 201, i32::MAX];
-
 /// The interval a case draws a parameter's value from (with the hostile
-/// values around it): its range, but the rod's length and diameter within
-/// a factor of 4 of the default. (A rod of 1e5 spacings builds and steps for
-/// seconds: not fuzzed here, as the large lattices; tests/fuzz.rs's
-/// parameter cases build them.)
+/// values around it): its range, but lengths (in m) within a factor of 2 of
+/// the default. (A rod of 1e5 spacings, or a wide plate, builds and steps
+/// for seconds: not fuzzed here, as the large lattices; tests/fuzz.rs's
+/// parameter cases build them under its cost guard.)
 fn draw_range(p: &ParamSpec) -> (f64, f64) {
-    match p.name {
-        "initial_length" | "initial_diameter" => (p.default / 4.0, p.default * 4.0),
-        _ => (p.range.min, p.range.max),
+    if p.unit == "m" {
+        (p.default / 2.0, p.default * 2.0)
+    } else {
+        (p.range.min, p.range.max)
     }
+}
+
+/// One FMU of the registry, as the fuzzer drives it: what it measured of
+/// its scene at start-up.
+#[derive(Clone)]
+pub struct Info {
+    /// The FMU.
+    pub fmu: fmi::Fmu,
+    /// Its variables.
+    vars: Vec<fmi::Variable>,
+    /// The coarse `particles_radial` of its scene (tests/fuzz.rs's
+    /// `coarse_radial`), and the default.
+    radial: i32,
+    default_radial: i32,
+    /// Whether a coarse run to its end is cheap (steps of any size).
+    to_end: bool,
+    /// The longest step a case takes on a coarse run: about 0.2 s of work.
+    h: f64,
+    /// A serialized FMU state of a coarse run after three steps.
+    reference: Option<Bytes>,
+}
+
+impl Info {
+    /// The value reference of a variable.
+    fn vr(&self, name: &str) -> u32 {
+        self.vars.iter().find(|v| v.name == name).unwrap().vr
+    }
+
+    /// `particles_radial` values a case sets: cheap lattices, and values
+    /// out of range. (Large in-range lattices take seconds to build: not
+    /// fuzzed here.)
+    fn radial_values(&self) -> [i32; 9] {
+        let r = self.radial;
+        let spec = self
+            .fmu
+            .kind()
+            .param_specs()
+            .iter()
+            .find(|p| p.name == "particles_radial")
+            .unwrap();
+        [
+            r,
+            r,
+            r + 1,
+            r + 1,
+            i32::MIN,
+            0,
+            spec.range.min as i32 - 1,
+            spec.range.max as i32 + 1,
+            i32::MAX,
+        ]
+    }
+}
+
+/// The calls of the FMU case running (for the report of a hang).
+static TRACE: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// The calls the FMU case made so far, as the last one that returned left
+/// them: after a hang, the call that hangs is the next one.
+pub fn trace() -> Vec<String> {
+    TRACE.lock().unwrap().clone()
 }
 
 /// Panics anywhere in the process since the hook was installed.
@@ -119,23 +177,26 @@ struct Model {
 }
 
 impl Model {
-    fn new() -> Self {
+    fn new(info: &Info) -> Self {
         Model {
             st: Some(St::Instantiated),
             start: 0.0,
             stop: None,
             time: 0.0,
-            radial: Some(20),
+            radial: Some(info.default_radial),
             tuned: false,
         }
     }
     fn is(&self, states: &[St]) -> bool {
         self.st.is_some_and(|s| states.contains(&s))
     }
-    /// A cheap run: a coarse lattice of the default rod, to whose end
-    /// (tens of milliseconds) steps of any size are affordable.
-    fn cheap(&self) -> bool {
-        self.st.is_some() && self.radial.is_some_and(|n| n <= 8) && !self.tuned
+    /// A cheap run: a coarse lattice of the default body, to whose end
+    /// (measured: seconds at most) steps of any size are affordable.
+    fn cheap(&self, info: &Info) -> bool {
+        info.to_end
+            && self.st.is_some()
+            && self.radial.is_some_and(|n| n <= info.radial)
+            && !self.tuned
     }
 }
 
@@ -157,7 +218,7 @@ trait Fmu: Sized {
     const FMI2: bool;
     /// Instantiates; the flag says whether the FMU must accept the arguments
     /// (`Some(true)`), must refuse them (`Some(false)`) or may do either.
-    fn new(rng: &mut Rng, log: *const Mutex<Log>) -> (Self, Option<bool>);
+    fn new(rng: &mut Rng, log: *const Mutex<Log>, fmu: fmi::Fmu) -> (Self, Option<bool>, bool);
     fn ptr(&self) -> *mut c_void;
     /// FMI 2 `fmi2SetupExperiment` (`None` for FMI 3).
     unsafe fn setup(&mut self, start: f64, stop: Option<f64>) -> Option<c_int>;
@@ -314,8 +375,8 @@ impl Fmu for Fmi3 {
     const FMI2: bool = false;
     type Bool = u8;
 
-    fn new(rng: &mut Rng, log: *const Mutex<Log>) -> (Self, Option<bool>) {
-        let good = CString::new(fmi::Fmu::named("TaylorImpact").unwrap().token()).unwrap();
+    fn new(rng: &mut Rng, log: *const Mutex<Log>, fmu: fmi::Fmu) -> (Self, Option<bool>, bool) {
+        let good = CString::new(fmu.token()).unwrap();
         let bad = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
         let (token, expect) = match rng.below(10) {
             0 => (bad.as_ptr(), Some(false)),
@@ -345,7 +406,7 @@ impl Fmu for Fmi3 {
                 null_mut(),
             )
         };
-        (Fmi3(p), expect)
+        (Fmi3(p), expect, token.is_null())
     }
     fn ptr(&self) -> *mut c_void {
         self.0
@@ -478,8 +539,8 @@ impl Fmu for Fmi2 {
     const FMI2: bool = true;
     type Bool = c_int;
 
-    fn new(rng: &mut Rng, _log: *const Mutex<Log>) -> (Self, Option<bool>) {
-        let good = CString::new(fmi::Fmu::named("TaylorImpact").unwrap().token()).unwrap();
+    fn new(rng: &mut Rng, _log: *const Mutex<Log>, fmu: fmi::Fmu) -> (Self, Option<bool>, bool) {
+        let good = CString::new(fmu.token()).unwrap();
         let bad = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
         let (guid, mut expect) = match rng.below(10) {
             0 => (bad.as_ptr(), Some(false)),
@@ -518,7 +579,7 @@ impl Fmu for Fmi2 {
                 rng.below(2) as c_int,
             )
         };
-        (Fmi2(p), expect)
+        (Fmi2(p), expect, guid.is_null())
     }
     fn ptr(&self) -> *mut c_void {
         self.0
@@ -632,29 +693,33 @@ impl Fmu for Fmi2 {
     }
 }
 
-/// A serialized FMU state of a coarse FMI 3 run after three steps, made
-/// once, for cases that deserialize before they serialize anything.
-pub fn reference_state() -> Bytes {
+/// A serialized FMU state of a coarse FMI 3 run of `info`'s FMU after
+/// three steps, made once, for cases that deserialize before they serialize
+/// anything.
+fn reference_state(info: &Info) -> Bytes {
     let log = Mutex::new(Log::default());
     let mut rng = Rng(2);
     let mut f = loop {
-        match Fmi3::new(&mut rng, &log) {
-            (f, Some(true)) => break f,
+        match Fmi3::new(&mut rng, &log, info.fmu) {
+            (f, Some(true), _) => break f,
             // SAFETY: NULL or a live instance, freed once.
-            (f, _) => unsafe { f.free() },
+            (f, _, _) => unsafe { f.free() },
         }
     };
-    let pr = vr("particles_radial");
-    let mut m = Model::new();
+    let pr = info.vr("particles_radial");
+    let mut m = Model::new(info);
     let mut s = null_mut();
     let mut size = 0;
     // SAFETY: a live instance; valid arrays and outputs; the state freed once.
     let data = unsafe {
-        assert_eq!(f.set(VarType::Int32, &pr, 1, Some(&[4.0]), 1), OK);
+        assert_eq!(
+            f.set(VarType::Int32, &pr, 1, Some(&[info.radial as f64]), 1),
+            OK
+        );
         assert_eq!(f.enter_init(0.0, None), OK);
         assert_eq!(f.exit_init(), OK);
         for _ in 0..3 {
-            let (code, t, _) = f.do_step(m.time, 1e-6, false);
+            let (code, t, _) = f.do_step(m.time, info.h.min(1e-6), false);
             assert_eq!(code, OK);
             m.time = t;
         }
@@ -667,19 +732,8 @@ pub fn reference_state() -> Bytes {
         data
     };
     m.st = Some(St::Step);
-    m.radial = Some(4);
+    m.radial = Some(info.radial);
     Bytes { data, model: m }
-}
-
-/// The value reference of a variable.
-fn vr(name: &str) -> u32 {
-    fmi::Fmu::named("TaylorImpact")
-        .unwrap()
-        .variables()
-        .iter()
-        .find(|v| v.name == name)
-        .unwrap()
-        .vr
 }
 
 /// Mangles serialized bytes: a byte changed, a cut, a leaf of the typed
@@ -688,14 +742,13 @@ fn vr(name: &str) -> u32 {
 /// header. The typed edits decode the state ([`fmi::Fmu::state_to_json`]),
 /// edit its JSON form and encode it again; an edit that the state's types
 /// cannot hold changes a byte instead. Returns what was done.
-fn corrupt(rng: &mut Rng, data: &mut Vec<u8>, sims: &[serde_json::Value]) -> String {
+fn corrupt(rng: &mut Rng, data: &mut Vec<u8>, sims: &[serde_json::Value], fmu: fmi::Fmu) -> String {
     let header = data
         .iter()
         .enumerate()
         .filter(|(_, b)| **b == b'\n')
         .nth(1)
         .map_or(0, |(k, _)| k + 1);
-    let fmu = fmi::Fmu::named("TaylorImpact").unwrap();
     let json = fmu.state_to_json(data).ok();
     let edit = match (rng.below(6), json) {
         (0, _) | (_, None) if !data.is_empty() => {
@@ -760,6 +813,8 @@ struct Case<F: Fmu> {
     bytes: Vec<Bytes>,
     log: *const Mutex<Log>,
     calls: Vec<String>,
+    /// The FMU.
+    info: Info,
 }
 
 impl<F: Fmu> Case<F> {
@@ -781,6 +836,7 @@ impl<F: Fmu> Case<F> {
     ) {
         let live = !self.fmu.ptr().is_null();
         self.calls.push(format!("{what} -> {code}"));
+        *TRACE.lock().unwrap() = self.calls.clone();
         let calls = &self.calls[self.calls.len().saturating_sub(12)..];
         assert!((0..=4).contains(&code), "undocumented status: {calls:?}");
         assert_ne!(code, FATAL, "Fatal (a caught panic): {calls:?}");
@@ -947,8 +1003,8 @@ impl<F: Fmu> Case<F> {
 
     /// A list of value references: the variables of the table, and some
     /// that are not.
-    fn refs(rng: &mut Rng) -> Vec<u32> {
-        let n = fmi::Fmu::named("TaylorImpact").unwrap().variables().len() as u32;
+    fn refs(&self, rng: &mut Rng) -> Vec<u32> {
+        let n = self.info.vars.len() as u32;
         (0..rng.below(4))
             .map(|_| match rng.below(8) {
                 0 => *rng.pick(&[n, n + 1, 999, u32::MAX]),
@@ -958,7 +1014,7 @@ impl<F: Fmu> Case<F> {
     }
 
     fn set(&mut self, rng: &mut Rng, logged: usize) {
-        let vars = fmi::Fmu::named("TaylorImpact").unwrap().variables();
+        let vars = self.info.vars.clone();
         let ty = *rng.pick(&[
             VarType::Float64,
             VarType::Float64,
@@ -966,9 +1022,9 @@ impl<F: Fmu> Case<F> {
             VarType::Int32,
             VarType::Boolean,
         ]);
-        let mut vrs = Self::refs(rng);
+        let mut vrs = self.refs(rng);
         if ty == VarType::Int32 && rng.below(2) == 0 {
-            vrs = vec![vr("particles_radial")];
+            vrs = vec![self.info.vr("particles_radial")];
         } else if rng.below(2) == 0 {
             // Only parameters of this type: the sets that may work.
             vrs.retain(|&r| {
@@ -984,7 +1040,22 @@ impl<F: Fmu> Case<F> {
         };
         let values: Vec<f64> = (0..nvr.max(n))
             .map(|k| match vrs.get(k).and_then(|&r| vars.get(r as usize)) {
-                Some(v) if v.ty == VarType::Int32 => *rng.pick(&RADIAL) as f64,
+                Some(v) if v.name == "particles_radial" => {
+                    *rng.pick(&self.info.radial_values()) as f64
+                }
+                Some(fmi::Variable {
+                    kind: VarKind::Parameter(p),
+                    ty: VarType::Int32,
+                    ..
+                }) => *rng.pick(&[
+                    p.range.min,
+                    p.range.max,
+                    p.default,
+                    p.range.min - 1.0,
+                    p.range.max + 1.0,
+                    i32::MIN as f64,
+                    i32::MAX as f64,
+                ]),
                 Some(fmi::Variable {
                     kind: VarKind::Parameter(p),
                     ..
@@ -1035,7 +1106,7 @@ impl<F: Fmu> Case<F> {
         if ty == VarType::Float64 && nvr > 0 {
             self.m.tuned = true;
         }
-        let pr = vr("particles_radial");
+        let pr = self.info.vr("particles_radial");
         if let Some(k) = vrs.iter().rposition(|&r| r == pr) {
             self.m.radial = if code == OK {
                 Some(values[k] as i32)
@@ -1046,14 +1117,14 @@ impl<F: Fmu> Case<F> {
     }
 
     fn get(&mut self, rng: &mut Rng, logged: usize) {
-        let vars = fmi::Fmu::named("TaylorImpact").unwrap().variables();
+        let vars = self.info.vars.clone();
         let ty = *rng.pick(&[
             VarType::Float64,
             VarType::Float64,
             VarType::Int32,
             VarType::Boolean,
         ]);
-        let mut vrs = Self::refs(rng);
+        let mut vrs = self.refs(rng);
         if rng.below(2) == 0 {
             // Only variables of this type: the reads that must work.
             vrs.retain(|&r| {
@@ -1107,7 +1178,7 @@ impl<F: Fmu> Case<F> {
             if r == fmi::VR_TIME {
                 assert_eq!(x, self.m.time, "{what}");
             }
-            if r == vr("particles_radial")
+            if r == self.info.vr("particles_radial")
                 && let Some(n) = self.m.radial
             {
                 assert_eq!(x, n as f64, "{what}");
@@ -1124,20 +1195,29 @@ impl<F: Fmu> Case<F> {
         };
         let h = match rng.below(8) {
             // Any size: to the end of the run, or far past it.
-            0 if self.m.cheap() => {
+            0 if self.m.cheap(&self.info) => {
                 let any = rng.number(0.0, 1e-3);
                 *rng.pick(&[any, any, 1.0, 1e300, f64::MAX])
             }
             1 => rng.number(-1e-6, 1e-6),
-            _ => 1e-7 + 2e-6 * rng.unit(),
+            _ => (1e-7 + 2e-6 * rng.unit()).min(self.info.h),
         };
         // With a stiff or light material the time step is tiny and a
         // microsecond takes long: short steps there (and when the lattice
-        // is not known).
-        let h = if self.m.cheap() || h.is_nan() || h <= 1e-8 {
-            h
+        // is not known), and no longer than the measured budget of the
+        // coarse run.
+        let cap = if self.m.st.is_some()
+            && self.m.radial.is_some_and(|n| n <= self.info.radial + 1)
+            && !self.m.tuned
+        {
+            self.info.h
         } else {
             1e-8
+        };
+        let h = if self.m.cheap(&self.info) || h.is_nan() || h <= cap {
+            h
+        } else {
+            cap
         };
         let null_out = !F::FMI2 && rng.below(16) == 0;
         let (code, last, terminate) = unsafe { self.fmu.do_step(current, h, null_out) };
@@ -1291,7 +1371,7 @@ impl<F: Fmu> Case<F> {
         let mut data = b.data;
         let mut model = b.model;
         let edit = if rng.below(2) == 0 {
-            corrupt(rng, &mut data, sims)
+            corrupt(rng, &mut data, sims, self.info.fmu)
         } else {
             String::new()
         };
@@ -1337,7 +1417,7 @@ impl<F: Fmu> Case<F> {
     fn reset(&mut self, rng: &mut Rng, logged: usize) {
         let code = unsafe { self.fmu.reset() };
         self.check("reset".into(), code, false, true, logged);
-        self.m = Model::new();
+        self.m = Model::new(&self.info);
         self.cheapen(rng);
     }
 
@@ -1345,8 +1425,8 @@ impl<F: Fmu> Case<F> {
     /// thin rod takes minutes per microsecond).
     fn cheapen(&mut self, rng: &mut Rng) {
         let logged = self.errors_logged();
-        let n = 3 + rng.below(4) as i32;
-        let pr = vr("particles_radial");
+        let n = self.info.radial + rng.below(2) as i32;
+        let pr = self.info.vr("particles_radial");
         let code = unsafe { self.fmu.set(VarType::Int32, &pr, 1, Some(&[n as f64]), 1) };
         self.check(
             format!("set particles_radial {n}"),
@@ -1359,23 +1439,32 @@ impl<F: Fmu> Case<F> {
     }
 }
 
-/// One FMU case of standard `F` from `seed`.
-fn run<F: Fmu>(seed: u64, sims: &[serde_json::Value], reference: Bytes) {
+/// One FMU case of standard `F` from `seed`, on the FMU `pool.fmus[k]`.
+fn run<F: Fmu>(seed: u64, pool: &Pool, k: usize) {
     let mut rng = Rng(seed | 1);
     let panics = PANICS.load(Ordering::SeqCst);
     let log = Box::new(Mutex::new(Log::default()));
-    let (fmu, expect) = F::new(&mut rng, &*log);
+    let (fmu, expect, no_token) = F::new(&mut rng, &*log, pool.fmus[k].fmu);
     if let Some(e) = expect {
         assert_eq!(!fmu.ptr().is_null(), e, "instantiation accepted: {}", !e);
     }
+    // Without a token, an instance is of the first FMU of the registry.
+    let info = if no_token {
+        pool.fmus[0].clone()
+    } else {
+        pool.fmus[k].clone()
+    };
+    let reference = info.reference.clone().expect("made by Pool::new");
     let mut case = Case {
         fmu,
-        m: Model::new(),
-        slots: [(null_mut(), Model::new()); 3],
+        m: Model::new(&info),
+        slots: [(null_mut(), Model::new(&info)); 3],
         bytes: vec![reference],
         log: &*log,
         calls: Vec::new(),
+        info,
     };
+    let sims = &pool.sims;
     if case.fmu.ptr().is_null() {
         // Every function refuses a NULL instance.
         case.m.st = None;
@@ -1411,24 +1500,76 @@ fn run<F: Fmu>(seed: u64, sims: &[serde_json::Value], reference: Bytes) {
 
 /// Shared inputs of the FMU cases.
 pub struct Pool {
-    /// Saved simulations (Taylor and Noh) to forge FMU states from.
+    /// Saved simulations of every built-in scene to forge FMU states from.
     pub sims: Vec<serde_json::Value>,
-    /// A serialized FMU state.
-    pub reference: Bytes,
+    /// Every FMU of the registry ([`fmi::Fmu::all`]), in its order.
+    pub fmus: Vec<Info>,
 }
 
-/// A random FMI 3.0 (`fmi2 == false`) or FMI 2.0 call order; returns its
-/// name.
+impl Pool {
+    /// The FMUs of the registry, each with what tests/fuzz.rs measured of
+    /// the built-in scene of its kind, and its reference state.
+    pub fn new(entries: &[Entry]) -> Pool {
+        let fmus = fmi::Fmu::all()
+            .into_iter()
+            .map(|fmu| {
+                let kind = fmu.kind();
+                // The built-in scene of the FMU's row (its material choice
+                // costs about the same).
+                let e = entries
+                    .iter()
+                    .find(|e| e.name == kind.name())
+                    .expect("every FMU's row is a built-in scene");
+                let default_radial = kind
+                    .param_specs()
+                    .iter()
+                    .find(|p| p.name == "particles_radial")
+                    .expect("an FMU's scene has particles_radial")
+                    .default as i32;
+                let steps_per_second = 1.0 / e.step_secs;
+                let mut info = Info {
+                    fmu,
+                    vars: fmu.variables(),
+                    radial: e.radial as i32,
+                    default_radial,
+                    to_end: e.to_end,
+                    h: (e.dt * 0.1 * steps_per_second).clamp(e.dt, 2.1e-6),
+                    reference: None,
+                };
+                info.reference = Some(reference_state(&info));
+                info
+            })
+            .collect();
+        Pool {
+            sims: entries.iter().map(|e| e.state.clone()).collect(),
+            fmus,
+        }
+    }
+}
+
+/// A random FMI 3.0 (`fmi2 == false`) or FMI 2.0 call order on a random
+/// FMU of the registry; returns its name.
 pub fn fuzz(rng: &mut Rng, pool: &Arc<Pool>, fmi2: bool) -> String {
     let seed = rng.next();
+    let k = rng.below(pool.fmus.len());
+    let id = pool.fmus[k].fmu.identity().model_identifier;
     let standard = if fmi2 { Fmi2::NAME } else { Fmi3::NAME };
-    let what = format!("{standard} call order, seed {seed}");
+    count(
+        id,
+        if fmi2 {
+            "FMI 2.0 call order"
+        } else {
+            "FMI 3.0 call order"
+        },
+    );
+    let what = format!("{standard} call order on {id}, seed {seed}");
     let pool = Arc::clone(pool);
+    TRACE.lock().unwrap().clear();
     bounded(&what, move || {
         if fmi2 {
-            run::<Fmi2>(seed, &pool.sims, pool.reference.clone())
+            run::<Fmi2>(seed, &pool, k)
         } else {
-            run::<Fmi3>(seed, &pool.sims, pool.reference.clone())
+            run::<Fmi3>(seed, &pool, k)
         }
     });
     what
