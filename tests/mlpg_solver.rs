@@ -531,11 +531,17 @@ fn coarse_wilkins(beta: f64) -> Mlpg3d {
 }
 
 /// Node shifting on the coarse Wilkins bar: without it the second layer is
-/// pressed onto the face and the run stops with `SpacingCollapse` (at
-/// 34.2 µs); with `shifting = 0.1` no pair closes below the guard, the bar
-/// comes to rest with no named stop, every node on the anvil stays on its
-/// plane (z = 0 exactly, after every step), none passes below it, and the
-/// energy balance holds within 5 %.
+/// pressed onto the face and the run stops with `SpacingCollapse`; with
+/// `shifting = 0.1` no pair closes below the guard, the bar runs past the
+/// time of that collapse and comes to rest with no named stop, every node
+/// on the anvil stays on its plane (z = 0 exactly, after every step), none
+/// passes below it, and the energy balance holds within 5 %. The plain
+/// run's collapse time is sensitive: 34.2 µs when the first step took the
+/// wave speed alone, 49.8 µs since it takes the nodes' speed too (a first
+/// step 4 % shorter; issue 48); the shifted bar rests at 74.6 and 73.0 µs
+/// (`run --scene-file scenes/wilkins_copper_3d.toml --set
+/// particles_radial=3 --set shifting=0 --set weak_form=0 --set
+/// smoothing_order=1 --set lattice=0`, and `shifting=0.1`).
 #[test]
 fn shifting_keeps_the_pairs_apart_that_collapse_without_it() {
     let mut plain = coarse_wilkins(0.0);
@@ -556,7 +562,11 @@ fn shifting_keeps_the_pairs_apart_that_collapse_without_it() {
         }
     }
     assert!(s.at_rest(), "at rest at {} s", s.time());
-    assert!(s.time() > 2.0 * collapse);
+    assert!(
+        s.time() > collapse,
+        "at rest at {} s, collapsed at {collapse} s",
+        s.time()
+    );
     assert!(s.min_spacing_ratio() > 0.1);
     let e = s.energies();
     assert!(e.error < 0.05, "energy error {}", e.error);

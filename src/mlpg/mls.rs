@@ -165,6 +165,15 @@ impl Supports {
     ) -> Result<Self> {
         let k = params.neighbours;
         let same = |i: usize, j: usize| group.is_empty() || group[i] == group[j];
+        // A place that is not a number is never within a radius: the search
+        // below would double it for ever.
+        if let Some(particle) = points.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+            return Err(Error::NonFinite {
+                field: "position",
+                particle,
+                time: f64::NAN,
+            });
+        }
         if k < BASIS - 1 || k >= points.len() {
             return Err(Error::OutOfRange {
                 name: "support neighbours".into(),
@@ -214,6 +223,20 @@ impl Supports {
                 break list;
             }
             search *= 2.0;
+            // Every body holds more than k nodes (checked above), so a
+            // radius past the box finds them, unless a place is not a
+            // number or overflows: then stop rather than double for ever.
+            if !search.is_finite() {
+                let particle = points
+                    .iter()
+                    .position(|p| !p.iter().all(|x| x.is_finite()))
+                    .unwrap_or(0);
+                return Err(Error::NonFinite {
+                    field: "position",
+                    particle,
+                    time: f64::NAN,
+                });
+            }
         };
         let named_rows: Vec<Vec<(f64, usize)>> = (0..rows)
             .into_par_iter()
@@ -868,6 +891,19 @@ pub(crate) mod tests {
             let e = 1e-6;
             let fd = (quartic_spline(s + e).0 - quartic_spline(s - e).0) / (2.0 * e);
             assert!((quartic_spline(s).1 * s - fd).abs() < 1e-8, "{s}");
+        }
+    }
+
+    /// A place that is not a number stops the search of the supports with
+    /// `NonFinite`, naming the node, instead of doubling the radius for ever
+    /// (issue 48: a forged place of 1e300 hung a step).
+    #[test]
+    fn a_place_that_is_not_a_number_stops_the_support_search() {
+        let mut pts = jittered_cube(5, 1e-3, 0.1, 3);
+        pts[17][1] = f64::NAN;
+        match Supports::compute(&pts, SupportParams::default()) {
+            Err(Error::NonFinite { particle, .. }) => assert_eq!(particle, 17),
+            other => panic!("{other:?}"),
         }
     }
 

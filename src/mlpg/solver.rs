@@ -771,6 +771,13 @@ impl Mlpg3d {
                 time,
                 condition,
             },
+            Error::NonFinite {
+                field, particle, ..
+            } => Error::NonFinite {
+                field,
+                particle,
+                time,
+            },
             e => e,
         };
         let mut clock = std::time::Instant::now();
@@ -782,7 +789,7 @@ impl Mlpg3d {
         g.nodal = NodalOperator::default();
         let n = self.pos.len();
         if supports || g.supports.is_none() {
-            let (sup, mirror) = self.supports_with_images()?;
+            let (sup, mirror) = self.supports_with_images().map_err(at_time)?;
             g.supports = Some(sup);
             g.mirror = mirror;
             self.profile.supports += 1;

@@ -89,11 +89,11 @@ def check_shots(rows, tmp_path, tmp_path_factory):
 
 def test_sweep_on_the_local_process_pool(tmp_path, tmp_path_factory):
     out, plot = tmp_path / "shots.csv", tmp_path / "shots.svg"
-    code, log = run_script("--speeds", "100,600,900,1500", *ARGS, "--fit-unsettled", "--workers", "2",
+    code, log = run_script("--speeds", "100,800,900,1500", *ARGS, "--fit-unsettled", "--workers", "2",
                            "--out", str(out), "--plot", str(plot))
     assert code == 1, log  # a shot stopped with an error
     rows = read(out)
-    assert sorted(rows) == [100.0, 600.0, 900.0, 1500.0]
+    assert sorted(rows) == [100.0, 800.0, 900.0, 1500.0]
     assert [rows[v]["status"] for v in sorted(rows)] == ["stopped", "unsettled", "unsettled", "error"], log
     fitted = check_shots(rows, tmp_path, tmp_path_factory)
     assert "shot at 1500 m/s: ERROR (left out of the fit): fmi3DoStep: the solver stopped: particle spacing" in log
@@ -101,7 +101,7 @@ def test_sweep_on_the_local_process_pool(tmp_path, tmp_path_factory):
     fit = lj.fit(fitted)
     assert (f"ballistic limit V_bl = {fit.v_bl:.1f} m/s, a = {fit.a:.4f}, p = {fit.p:.3f}, "
             f"rms residual {fit.rms:.2f} m/s (3 shots fitted)") in log, log
-    assert 100.0 <= fit.v_bl < 600.0
+    assert 100.0 <= fit.v_bl < 800.0
     svg = ET.parse(plot).getroot()
     ns = "{http://www.w3.org/2000/svg}"
     assert len(svg.findall(f"{ns}circle")) == 3 and len(svg.findall(f"{ns}path")) == 1  # the error's cross
@@ -114,13 +114,13 @@ def test_sweep_on_a_local_dask_cluster_leaves_unsettled_shots_out(tmp_path, tmp_
     and the script says why; the shots are those of the command line."""
     out = tmp_path / "dask.csv"
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
-        code, log = run_script("--scheduler", cluster.scheduler_address, "--speeds", "100,600", *ARGS,
+        code, log = run_script("--scheduler", cluster.scheduler_address, "--speeds", "100,800", *ARGS,
                                "--out", str(out), "--no-plot")
     assert code == 1, log
     rows = read(out)
     assert [rows[v]["status"] for v in sorted(rows)] == ["stopped", "unsettled"], log
     check_shots(rows, tmp_path, tmp_path_factory)
-    assert "left out of the fit: 600 m/s" in log
+    assert "left out of the fit: 800 m/s" in log
     assert "no fit: 0 perforating shots; the fit needs at least 2 (1 shots fitted)" in log, log
     assert "no plot (--no-plot)" in log
 
@@ -150,18 +150,20 @@ def test_a_slow_perforation_is_not_called_embedded():
 
 
 def test_extend_runs_the_unsettled_shots_again_for_twice_as_long(tmp_path, tmp_path_factory):
-    """--extend 1: the 600 m/s shot, unsettled at 10 us (still slowing),
-    runs again to 20 us, where the tiny case stops with a spacing collapse:
-    its row is then the command line's stop, message and values at the stop
-    bit for bit."""
+    """--extend 1: the 800 m/s shot, unsettled at 10 us (still slowing),
+    runs again to 20 us, where the tiny case stops by name (its energy
+    error passes the bound at 19.96 us): its row is then the command line's
+    stop, message and values at the stop bit for bit. (The 600 m/s shot of
+    these tests settled in the plate by 10 us once the first step took the
+    projectile's speed into account, issue 48.)"""
     out = tmp_path / "extend.csv"
-    code, log = run_script("--speeds", "600", *ARGS, "--extend", "1", "--workers", "1", "--out", str(out),
+    code, log = run_script("--speeds", "800", *ARGS, "--extend", "1", "--workers", "1", "--out", str(out),
                            "--no-plot")
     assert code == 1, log
-    assert "running again with twice the end time: 600 m/s to 2e-05 s" in log, log
-    row = read(out)[600.0]
+    assert "running again with twice the end time: 800 m/s to 2e-05 s" in log, log
+    row = read(out)[800.0]
     assert float(row["end_time_s"]) == 2e-5 and row["status"] == "error", row
-    message, ref = cli_stop(tmp_path, {**PARAMS, "impact_speed": 600.0, "end_time": 2e-5})
+    message, ref = cli_stop(tmp_path, {**PARAMS, "impact_speed": 800.0, "end_time": 2e-5})
     assert row["error"] == f"fmi3DoStep: the solver stopped: {message}"
     for name in OUTPUTS:
         assert float(row[name]) == ref[name], f"{name}: {row[name]} CLI {ref[name]!r}"
