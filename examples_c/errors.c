@@ -166,6 +166,8 @@ int main(void) {
            "set_material(eos = gruneisen)");
     expect(s, mi_sim_set_material(s, "preset", "ofhc_copper"), MI_UNKNOWN_MATERIAL,
            "ofhc_copper_jc", "set_material(preset = ofhc_copper)");
+    expect(s, mi_sim_set_scheme(s, "fast"), MI_UNKNOWN_MATERIAL, "large_strain, paper",
+           "set_scheme(fast)");
     check(s, mi_sim_set_material(s, "eos", "mie_gruneisen"), "mi_sim_set_material");
     expect(s, mi_sim_set_param(s, "bulk_modulus", 1e11), MI_UNKNOWN_PARAMETER, "eos_c0",
            "set(bulk_modulus) with MG");

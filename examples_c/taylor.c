@@ -4,6 +4,7 @@
  *
  *   ./taylor                       # the default scene, ~25 s
  *   ./taylor particles_radial=5    # a coarse, fast run
+ *   ./taylor scheme=paper          # Batra & Zhang's scheme exactly
  */
 #include "util.h"
 #include <string.h>

@@ -35,8 +35,13 @@ static inline void check(mi_sim *sim, mi_result r, const char *what) {
 static inline void apply_settings(mi_sim *sim, int argc, char **argv) {
     int i;
     for (i = 1; i < argc; ++i) {
-        char name[128];
+        char name[128], text[128];
         double value;
+        /* `scheme=NAME` chooses the numerical scheme by name. */
+        if (sscanf(argv[i], "scheme=%127s", text) == 1) {
+            check(sim, mi_sim_set_scheme(sim, text), "mi_sim_set_scheme");
+            continue;
+        }
         if (sscanf(argv[i], "%127[^=]=%lf", name, &value) != 2) {
             fprintf(stderr, "expected NAME=VALUE, got `%s`\n", argv[i]);
             mi_sim_free(sim);

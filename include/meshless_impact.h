@@ -412,6 +412,23 @@ mi_result mi_sim_load_toml(mi_sim *sim, const char *toml);
 mi_result mi_sim_set_material(mi_sim *sim, const char *key, const char *value);
 
 /**
+ * Chooses the numerical scheme by name (`large_strain`, `paper`, ...; the
+ * scene's `scheme` parameter, whose description lists its levels), before
+ * the run starts. The scheme sets its knobs (`smoothing_order`,
+ * `shifting`, ...) except those already set by hand with
+ * `mi_sim_set_param`, which keep their values; a knob set afterwards
+ * overrides it. `mi_sim_set_param(sim, "scheme", k)` chooses the k-th level
+ * the same way. Errors: `MI_UNKNOWN_MATERIAL` (an unknown name, listing the
+ * known ones), `MI_UNKNOWN_PARAMETER` (a scene with no scheme),
+ * `MI_WRONG_ORDER` after the first step; on failure nothing changes.
+ *
+ * # Safety
+ * `sim` must be NULL or a live handle; `name` NULL or a NUL-terminated
+ * string.
+ */
+mi_result mi_sim_set_scheme(mi_sim *sim, const char *name);
+
+/**
  * Sets a parameter by name (SI units), before the run starts. Errors:
  * `MI_UNKNOWN_PARAMETER`, `MI_OUT_OF_RANGE` (outside the allowed range, NaN,
  * infinite, or not a whole number where one is required), `MI_WRONG_ORDER`

@@ -23,7 +23,7 @@
 //! - Running: [`Scene`] (a kind of scene, [`SceneKind`], with a value for
 //!   each of its parameters), [`builtin_names`], [`Simulation`] and its
 //!   [`Progress`], [`Isa`] (the compiled copy of the hot loops to use).
-//! - Parameters: [`ParamSpec`] and [`Range`]; typed views of a scene's
+//! - Parameters: [`ParamSpec`], [`Range`] and [`Level`] (a named level of a scheme); typed views of a scene's
 //!   parameters, [`TaylorParams`], [`NohParams`] and [`Taylor3dParams`];
 //!   [`Table1Row`], a row of House et al.'s Table 1.
 //! - Results: [`ObservableSpec`] (with the tables [`TAYLOR_OBSERVABLES`] and
@@ -93,7 +93,7 @@ pub use observe::{
 };
 pub use rod::{profile_deviation, profile_radius};
 pub use scene::noh::NohParams;
-pub use scene::params::{ParamSpec, Range};
+pub use scene::params::{Level, ParamSpec, Range};
 pub use scene::table1::Table1Row;
 pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};

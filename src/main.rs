@@ -50,7 +50,7 @@ enum Command {
         #[arg(default_value = "taylor")]
         scene: String,
         #[command(flatten)]
-        material: MaterialArgs,
+        material: ChoiceArgs,
     },
     /// List the observables of a scene.
     Observables {
@@ -63,7 +63,7 @@ enum Command {
         /// Scene name (`meshless-impact scenes` lists them).
         name: String,
         #[command(flatten)]
-        material: MaterialArgs,
+        material: ChoiceArgs,
     },
     /// List the built-in scenes with their titles.
     Scenes,
@@ -73,9 +73,13 @@ enum Command {
 }
 
 /// The choice of the material models, as a scene file's `[material]` table
-/// makes it.
+/// makes it, and of the numerical scheme.
 #[derive(Args, Default)]
-struct MaterialArgs {
+struct ChoiceArgs {
+    /// Numerical scheme by name (`meshless-impact params SCENE` lists the
+    /// scene's schemes and what each sets); --set may override its knobs.
+    #[arg(long, value_name = "NAME")]
+    scheme: Option<String>,
     /// Strength model: johnson_cook or bilinear.
     #[arg(long, value_name = "MODEL")]
     strength: Option<String>,
@@ -88,9 +92,12 @@ struct MaterialArgs {
     preset: Option<String>,
 }
 
-impl MaterialArgs {
-    /// Applies the choice to `scene`, if one is made.
+impl ChoiceArgs {
+    /// Applies the choices to `scene`, if any is made.
     fn apply(&self, scene: &mut Scene) -> Result<(), Error> {
+        if let Some(name) = &self.scheme {
+            scene.set_str("scheme", name)?;
+        }
         if self.strength.is_none() && self.eos.is_none() && self.preset.is_none() {
             return Ok(());
         }
@@ -111,7 +118,7 @@ struct RunArgs {
     #[arg(long, value_name = "FILE")]
     scene_file: Option<PathBuf>,
     #[command(flatten)]
-    material: MaterialArgs,
+    material: ChoiceArgs,
     /// Override a parameter, e.g. `--set impact_speed=200` (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
@@ -270,13 +277,23 @@ fn usage_error(e: clap::Error) -> Result<(), Stop> {
         .map_err(|e| Stop::write("stdout", e))
 }
 
+/// Applies `--set NAME=VALUE`s: a scheme first (`--set scheme=paper`),
+/// then the other parameters, which override its knobs.
 fn apply_sets(scene: &mut Scene, sets: &[String]) -> Result<(), Error> {
+    let mut pairs = Vec::with_capacity(sets.len());
     for s in sets {
         let (name, value) = s.split_once('=').ok_or_else(|| Error::ParseValue {
             name: s.clone(),
             text: "expected NAME=VALUE".into(),
         })?;
-        scene.set_str(name.trim(), value)?;
+        pairs.push((name.trim(), value));
+    }
+    let has_levels =
+        |scene: &Scene, name: &str| scene.spec(name).is_ok_and(|s| !s.levels.is_empty());
+    let (schemes, knobs): (Vec<_>, Vec<_>) =
+        pairs.into_iter().partition(|(n, _)| has_levels(scene, n));
+    for (name, value) in schemes.into_iter().chain(knobs) {
+        scene.set_str(name, value)?;
     }
     scene.validate()
 }
@@ -584,7 +601,7 @@ fn report(_out: PathBuf, _quick: bool) -> Result<(), Stop> {
     ))
 }
 
-fn params(scene: &str, material: &MaterialArgs) -> Result<(), Stop> {
+fn params(scene: &str, material: &ChoiceArgs) -> Result<(), Stop> {
     let mut s = Scene::builtin(scene)?;
     material.apply(&mut s)?;
     outln!(
@@ -595,14 +612,50 @@ fn params(scene: &str, material: &MaterialArgs) -> Result<(), Stop> {
         "allowed"
     )?;
     for p in s.param_specs() {
+        let v = s.get(p.name)?;
+        let (value, allowed) = match p.level(v) {
+            Some(level) => (
+                level.name.to_string(),
+                p.levels
+                    .iter()
+                    .enumerate()
+                    .map(|(k, l)| format!("{k}={}", l.name))
+                    .collect::<Vec<_>>()
+                    .join(","),
+            ),
+            None => (v.to_string(), p.range.to_string()),
+        };
         outln!(
             "{:<24} {:<10} {:>12}  {:<28} {}",
             p.name,
             p.unit,
-            s.get(p.name)?,
-            p.range.to_string(),
+            value,
+            allowed,
             p.description
         )?;
+    }
+    for p in s.param_specs().iter().filter(|p| !p.levels.is_empty()) {
+        outln!(
+            "\n{} (--{} NAME, or `{} = \"NAME\"` in a scene file's [parameters]); each sets:",
+            p.name,
+            p.name,
+            p.name
+        )?;
+        let chosen = s.level(p.name)?.map(|l| l.name);
+        for level in p.levels {
+            let sets: Vec<String> = level
+                .sets
+                .iter()
+                .map(|(n, x)| format!("{n} = {x}"))
+                .collect();
+            let mark = if Some(level.name) == chosen {
+                " (chosen)"
+            } else {
+                ""
+            };
+            outln!("  {}{mark}: {}", level.name, level.description)?;
+            outln!("      {}", sets.join(", "))?;
+        }
     }
     Ok(())
 }

@@ -723,9 +723,14 @@ fn every_error_code_is_produced() {
             &[("particles_radial", 6.0), ("smoothing_coefficient", 0.0)],
         );
         check(r, MI_ENERGY_DRIFT, &m, "energy error");
+        // The paper's scheme at 600 m/s (the default brings it to rest).
         let (r, m) = run_code(
             "taylor",
-            &[("particles_radial", 6.0), ("impact_speed", 600.0)],
+            &[
+                ("scheme", 1.0),
+                ("particles_radial", 6.0),
+                ("impact_speed", 600.0),
+            ],
         );
         check(r, MI_SPACING_COLLAPSE, &m, "spacing");
         let noh = [
@@ -1137,4 +1142,68 @@ fn a_stop_in_the_first_step_is_sticky() {
     );
     assert_eq!(step(), MI_SINGULAR_MOMENT_MATRIX);
     assert_eq!(s.run(), MI_SINGULAR_MOMENT_MATRIX);
+}
+
+/// The scheme chosen by name through the C ABI gives the bits of the Rust
+/// API with the same choice (and of `mi_sim_set_param("scheme", 1)`), its
+/// knobs set by hand override it whatever the order, and an unknown name
+/// is refused with the known ones, changing nothing.
+#[test]
+fn the_scheme_by_name_gives_the_bits_of_the_rust_api() {
+    let rust = |scheme: &str, sets: &[(&str, f64)]| -> Vec<u64> {
+        let mut s = Scene::builtin("taylor").unwrap();
+        s.set_str("scheme", scheme).unwrap();
+        for (k, v) in [("particles_radial", 5.0), ("end_time", 10e-6)]
+            .iter()
+            .chain(sets)
+        {
+            s.set(k, *v).unwrap();
+        }
+        let mut sim = Simulation::new(s).unwrap();
+        sim.run().unwrap();
+        sim.observables().iter().map(|v| v.to_bits()).collect()
+    };
+    let scheme = |s: &Sim, name: &str| {
+        // SAFETY: live handle, valid string.
+        unsafe { mi_sim_set_scheme(s.0, c(name).as_ptr()) }
+    };
+    let capi = |s: &Sim| -> Vec<u64> {
+        assert_eq!(s.set("particles_radial", 5.0), mi_result::MI_OK);
+        assert_eq!(s.set("end_time", 10e-6), mi_result::MI_OK);
+        assert_eq!(s.run(), mi_result::MI_OK, "{}", s.error());
+        s.array(mi_sim_observables)
+            .iter()
+            .map(|v| v.to_bits())
+            .collect()
+    };
+    let paper = rust("paper", &[]);
+    assert_ne!(paper, rust("large_strain", &[]));
+    let a = new_sim("taylor");
+    assert_eq!(scheme(&a, "paper"), mi_result::MI_OK);
+    assert_eq!(capi(&a), paper);
+    let b = new_sim("taylor");
+    assert_eq!(b.set("scheme", 1.0), mi_result::MI_OK);
+    assert_eq!(capi(&b), paper);
+    // A knob by hand, before and after the scheme.
+    let shifted = rust("paper", &[("shifting", 0.05)]);
+    let d = new_sim("taylor");
+    assert_eq!(d.set("shifting", 0.05), mi_result::MI_OK);
+    assert_eq!(scheme(&d, "paper"), mi_result::MI_OK);
+    assert_eq!(capi(&d), shifted);
+    let e = new_sim("taylor");
+    assert_eq!(scheme(&e, "paper"), mi_result::MI_OK);
+    assert_eq!(e.set("shifting", 0.05), mi_result::MI_OK);
+    assert_eq!(capi(&e), shifted);
+    // Unknown name; a scene with no scheme; after the first step.
+    let f = new_sim("taylor");
+    assert_eq!(scheme(&f, "fast"), mi_result::MI_UNKNOWN_MATERIAL);
+    let msg = f.error();
+    assert!(
+        msg.contains("fast") && msg.contains("large_strain, paper"),
+        "{msg}"
+    );
+    assert_eq!(capi(&f), rust("large_strain", &[]));
+    assert_eq!(scheme(&f, "paper"), mi_result::MI_WRONG_ORDER);
+    let n = new_sim("noh");
+    assert_eq!(scheme(&n, "paper"), mi_result::MI_UNKNOWN_PARAMETER);
 }

@@ -485,8 +485,10 @@ fn material_choice_on_the_command_line() {
         );
     }
     let names = |out: String| -> Vec<String> {
+        // The table ends at the first blank line (the schemes follow).
         out.lines()
             .skip(1)
+            .take_while(|l| !l.is_empty())
             .map(|l| l.split_whitespace().next().unwrap().to_string())
             .collect()
     };
@@ -665,4 +667,80 @@ fn a_subnormal_impact_speed_is_refused_and_the_slowest_has_a_finite_energy_error
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["outcome"], "finished");
     assert!(v["energy_error"].as_f64().unwrap().is_finite(), "{v}");
+}
+
+/// `--scheme NAME` and `--set scheme=NAME` give the bits of the Rust API
+/// with the same choice, a `--set` of a knob overrides the scheme in either
+/// order, and `params` lists the schemes and what each sets.
+#[test]
+fn the_scheme_by_name_gives_the_bits_of_the_rust_api() {
+    use meshless_impact::{Scene, Simulation};
+    let dir = scratch("scheme");
+    let rust = |sets: &[(&str, &str)]| -> Vec<u64> {
+        let mut s = Scene::builtin("taylor").unwrap();
+        s.set_str("scheme", "paper").unwrap();
+        for (k, v) in [("particles_radial", "5"), ("end_time", "1e-5")]
+            .iter()
+            .chain(sets)
+        {
+            s.set_str(k, v).unwrap();
+        }
+        let mut sim = Simulation::new(s).unwrap();
+        sim.run().unwrap();
+        sim.observables().iter().map(|v| v.to_bits()).collect()
+    };
+    let cli = |args: &[&str]| -> Vec<u64> {
+        let json = dir.join("out.json");
+        let out = bin()
+            .args(["run", "taylor", "-q", "--set", "particles_radial=5"])
+            .args(["--set", "end_time=1e-5"])
+            .args(args)
+            .arg("--json")
+            .arg(&json)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        meshless_impact::Scene::builtin("taylor")
+            .unwrap()
+            .kind()
+            .observable_specs()
+            .iter()
+            .map(|o| match &v[o.name] {
+                serde_json::Value::Bool(b) => f64::from(u8::from(*b)).to_bits(),
+                x => x.as_f64().unwrap().to_bits(),
+            })
+            .collect()
+    };
+    let paper = rust(&[]);
+    assert_eq!(cli(&["--scheme", "paper"]), paper);
+    assert_eq!(cli(&["--set", "scheme=paper"]), paper);
+    let shifted = rust(&[("shifting", "0.05")]);
+    assert_eq!(
+        cli(&["--set", "shifting=0.05", "--set", "scheme=paper"]),
+        shifted
+    );
+    assert_eq!(
+        cli(&["--scheme", "paper", "--set", "shifting=0.05"]),
+        shifted
+    );
+    let out = bin().args(["run", "--scheme", "fast"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("large_strain, paper"),
+        "{}",
+        stderr(&out)
+    );
+    let out = bin().args(["params", "taylor3d"]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("scheme                   1          large_strain  0=large_strain,1=paper"),
+        "{text}"
+    );
+    assert!(text.contains("  large_strain (chosen): "), "{text}");
+    assert!(
+        text.contains("smoothing_coefficient = 0.1, smoothing_order = 1, shifting = 0, weak_form = 0, lattice = 0"),
+        "{text}"
+    );
 }

@@ -106,3 +106,18 @@ pub fn same_on_one_thread_and_two<T: PartialEq + Send>(run: impl Fn() -> T + Syn
     };
     assert!(on(1) == on(2), "the thread count changed the result");
 }
+
+/// The largest |mean normal stress + pressure| over the nodes of a run, and
+/// the largest stress component: the stress is `s − P I` with a trace-free
+/// deviator `s`, so the first is round-off (`components` is 4 in 2-D, RR,
+/// ZZ, TT, RZ; 6 in 3-D, xx, yy, zz, xy, yz, zx).
+pub fn mean_stress_residual(sim: &Simulation, components: usize) -> (f64, f64) {
+    let stress = sim.field("stress").unwrap();
+    let pressure = sim.field("pressure").unwrap();
+    let mut worst = (0.0f64, 0.0f64);
+    for (s, p) in stress.chunks(components).zip(&pressure) {
+        worst.0 = worst.0.max(((s[0] + s[1] + s[2]) / 3.0 + p).abs());
+        worst.1 = s.iter().fold(worst.1, |m, x| m.max(x.abs()));
+    }
+    worst
+}

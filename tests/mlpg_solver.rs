@@ -56,7 +56,10 @@ fn explore_elastic_rebound() {
     let mut setup = RodSetup::new(cyl, rings, 10.0, 40e-6);
     setup.damping = zeta;
     if let Ok(w) = std::env::var("WEAK") {
-        setup.weak_form = WeakForm::of(w.parse().unwrap());
+        setup.weak_form = match w.as_str() {
+            "0" => WeakForm::Sphere,
+            _ => WeakForm::Nodal,
+        };
     }
     if let Ok(a) = std::env::var("ALPHA") {
         setup.smoothing = a.parse().unwrap();
@@ -325,6 +328,10 @@ fn axisymmetric_contact_time() -> f64 {
     let sim = common::run(
         Scene::builtin("taylor").unwrap(),
         &[
+            // The paper's scheme: the contact time the bounds below were
+            // measured against (7.770 µs; the default, large_strain, gives
+            // 7.827 µs, the bar's dispersion at h = 2 spacings).
+            ("scheme", 1.0),
             ("initial_diameter", 2.0 * ROD.radius),
             ("initial_length", ROD.length),
             ("impact_speed", 10.0),
@@ -802,6 +809,25 @@ fn conforming_gradients_refuse_the_quarter_model() {
         text.contains("weak_form = 2") && text.contains("symmetry = 0"),
         "{text}"
     );
+}
+
+/// Node shifting carries the stress deviator trace-free: after a run whose
+/// nodes shift (the Wilkins bar at 3 across to 45 µs), the mean normal
+/// stress is −P at every node to round-off (`examples_c/taylor3d.c` checks
+/// the same through the C ABI; each component limited to its neighbours'
+/// range on its own left a trace of 2e-5 of the largest stress before).
+#[test]
+fn node_shifting_keeps_the_deviator_trace_free() {
+    use meshless_impact::Simulation;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/wilkins_copper_3d.toml");
+    let mut scene = Scene::from_file(path).unwrap();
+    scene.set("particles_radial", 3.0).unwrap();
+    scene.set("end_time", 45e-6).unwrap();
+    let mut sim = Simulation::new(scene).unwrap();
+    sim.run().unwrap();
+    let (residual, largest) = common::mean_stress_residual(&sim, 6);
+    assert!(largest > 1e8, "{largest}");
+    assert!(residual <= 1e-9 * largest, "{residual} of {largest}");
 }
 
 /// A run with node shifting saved mid-way (the nodes shifting) and restored

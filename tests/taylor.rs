@@ -6,13 +6,34 @@ use common::{pct, run, tail_slowdown_time};
 use meshless_impact::{Scene, Simulation, Table1Row};
 use rayon::prelude::*;
 
-/// Test 7 at the paper's resolution (20 particles across the radius, 3820 in
-/// all): final length within 1.5% of the measured 34.6 mm, impact-face radius
-/// within 8% of the measured 4.75 mm, and the tail starting to slow at
-/// L0/Ce = 6.3 us +- 0.5 us.
+/// Test 7 with the default scheme (`large_strain`) at the default
+/// resolution (20 particles across the radius): at rest, final length
+/// within 1.5% of the measured 34.6 mm, impact-face diameter within 3% of
+/// LS-DYNA's converged 10.62 mm (a converged continuum gives a larger face
+/// than the measured 9.5 mm; VALIDATION.md, "Right by default"), the tail
+/// starting to slow at L0/Ce = 6.3 us +- 0.5 us, the energy balanced within
+/// 5%. Measured: Lf −0.06%, Df 10.42 mm (−1.9%), energy error 0.0073.
 #[test]
-fn test7_at_paper_resolution_matches_experiment() {
+fn test7_with_the_default_scheme_meets_the_converged_reference() {
     let sim = run(Scene::builtin("taylor").unwrap(), &[]);
+    assert_eq!(sim.particles(), 3820, "20 x 191 particles");
+    let o = |n: &str| sim.observable(n).unwrap();
+    assert_eq!(o("at_rest"), 1.0, "the run ends with the rod at rest");
+    let lf = o("rod_length");
+    let df = 2.0 * o("mushroom_radius");
+    assert!(pct(lf, 0.0346).abs() < 1.5, "rod_length {lf} vs 0.0346");
+    assert!(pct(df, 0.01062).abs() < 3.0, "Df {df} vs 0.01062");
+    check_tail_and_energy(&sim);
+}
+
+/// Test 7 with the paper's scheme (`scheme = paper`) at the paper's
+/// resolution (20 particles across the radius, 3820 in all): final length
+/// within 1.5% of the measured 34.6 mm, impact-face radius within 8% of the
+/// measured 4.75 mm, and the tail starting to slow at L0/Ce = 6.3 us +- 0.5
+/// us.
+#[test]
+fn test7_with_the_papers_scheme_matches_experiment() {
+    let sim = run(Scene::builtin("taylor").unwrap(), &[PAPER]);
     assert_eq!(sim.particles(), 3820, "20 x 191 particles as in the paper");
     let o = |n: &str| sim.observable(n).unwrap();
     assert_eq!(o("at_rest"), 1.0, "the run ends with the rod at rest");
@@ -23,39 +44,81 @@ fn test7_at_paper_resolution_matches_experiment() {
         pct(rf, 0.00475).abs() < 8.0,
         "mushroom_radius {rf} vs 0.00475"
     );
-    let t = tail_slowdown_time(&sim);
-    assert!(
-        (t - 6.3e-6).abs() < 0.5e-6,
-        "tail slows at {t} s, expected 6.3 us"
-    );
-    let e = o("energy_error");
-    assert!(e.is_finite() && e < 0.05, "energy_error {e}");
+    check_tail_and_energy(&sim);
     // The paper's reported peaks: plastic strain about 84%, temperature about 500 K.
     assert!((0.6..1.1).contains(&o("max_plastic_strain")));
     assert!((420.0..620.0).contains(&o("max_temperature")));
 }
 
-/// All twelve Table 1 configurations at the paper's resolution (20 particles
-/// across the radius, equal axial spacing, h = 1.5 x spacing, alpha_cs = 0.2):
-/// final length within 5% and impact-face diameter within 10% of experiment.
-/// The twelve runs take about 2.5 minutes on two cores.
-#[test]
-fn table1_sweep_at_paper_resolution_matches_experiment() {
-    check_table1(20.0);
+/// Test 7's tail starts to slow at L0/Ce = 6.3 us +- 0.5 us, and its energy
+/// is balanced within 5%.
+fn check_tail_and_energy(sim: &Simulation) {
+    let t = tail_slowdown_time(sim);
+    assert!(
+        (t - 6.3e-6).abs() < 0.5e-6,
+        "tail slows at {t} s, expected 6.3 us"
+    );
+    let e = sim.observable("energy_error").unwrap();
+    assert!(e.is_finite() && e < 0.05, "energy_error {e}");
 }
 
-fn check_table1(particles: f64) {
+/// `scheme = paper`, the second level of the `taylor` scene's scheme.
+const PAPER: (&str, f64) = ("scheme", 1.0);
+
+/// All twelve Table 1 configurations with the default scheme at the default
+/// 20 particles across the radius: each at rest with the energy balanced
+/// within 5%, the mean |final length error| at most 1.5% and the largest no
+/// larger than the paper's own MSPH (4.3%). The face diameters are reported
+/// beside the experiment, not bounded: a scheme that converges gives larger
+/// faces than these experiments (VALIDATION.md, "Right by default").
+/// Measured: mean 0.44%, largest 1.33% (test 10). About 2.5 minutes on two
+/// cores.
+#[test]
+fn table1_sweep_with_the_default_scheme_meets_the_papers_bounds() {
+    let results = table1(&[]);
+    let mean = results.iter().map(|(_, el, _)| el.abs()).sum::<f64>() / 12.0;
+    let worst = results
+        .iter()
+        .map(|(_, el, _)| el.abs())
+        .fold(0.0, f64::max);
+    eprintln!("mean |Lf error| {mean:.2}%, largest {worst:.2}%");
+    assert!(mean <= 1.5, "mean |Lf error| {mean:.2}%");
+    assert!(worst <= 4.3, "largest |Lf error| {worst:.2}%");
+}
+
+/// All twelve Table 1 configurations with the paper's scheme at the paper's
+/// resolution (20 particles across the radius, equal axial spacing, h = 1.5
+/// x spacing, alpha_cs = 0.2): final length within 5% and impact-face
+/// diameter within 10% of experiment (`scripts/validate.sh`; the golden test
+/// pins the paper's scheme's bits).
+#[test]
+#[ignore = "slow: run by scripts/validate.sh"]
+fn table1_sweep_with_the_papers_scheme_matches_experiment() {
+    for (test, el, ed) in table1(&[PAPER]) {
+        assert!(el.abs() < 5.0, "test {test}: final length error {el:.2}%");
+        assert!(ed.abs() < 10.0, "test {test}: face diameter error {ed:.2}%");
+    }
+}
+
+/// The twelve Table 1 runs at 20 across with `sets`, each at rest (and,
+/// with the default scheme, its energy balanced within 5%): (test, Lf
+/// error %, Df error %).
+fn table1(sets: &[(&str, f64)]) -> Vec<(u32, f64, f64)> {
     let rows = Table1Row::all();
     let results: Vec<(u32, f64, f64)> = rows
         .par_iter()
         .map(|r| {
-            let sim = run(r.scene(), &[("particles_radial", particles)]);
+            let sim = run(r.scene(), sets);
             assert_eq!(
                 sim.observable("at_rest"),
                 Some(1.0),
                 "test {} ends at rest",
                 r.test
             );
+            if sets.is_empty() {
+                let e = sim.observable("energy_error").unwrap();
+                assert!(e < 0.05, "test {}: energy error {e}", r.test);
+            }
             let lf = sim.observable("rod_length").unwrap();
             let df = 2.0 * sim.observable("mushroom_radius").unwrap();
             (r.test, pct(lf, r.lf_test), pct(df, r.df_test))
@@ -64,30 +127,34 @@ fn check_table1(particles: f64) {
     for (test, el, ed) in &results {
         eprintln!("test {test:2}: final length {el:+.2}%, face diameter {ed:+.2}%");
     }
-    for (test, el, ed) in results {
-        assert!(el.abs() < 5.0, "test {test}: final length error {el:.2}%");
-        assert!(ed.abs() < 10.0, "test {test}: face diameter error {ed:.2}%");
-    }
+    results
 }
 
-/// 20, 31 and 41 particles across the radius change the final length by less
-/// than 1%. Slow: run by `scripts/validate.sh`.
+/// Test 7 and the Wilkins bar with the default scheme at 20, 31 and 41
+/// particles across the radius: the final length changes by less than 1%,
+/// and the finest two face diameters differ by less than 2%. Slow: run by
+/// `scripts/validate.sh`.
 #[test]
 #[ignore = "slow: run by scripts/validate.sh"]
-fn refinement_changes_final_length_by_less_than_one_percent() {
-    let lengths: Vec<f64> = [20.0, 31.0, 41.0]
-        .par_iter()
-        .map(|&n| {
-            run(
-                Scene::builtin("taylor").unwrap(),
-                &[("particles_radial", n)],
-            )
-            .observable("rod_length")
-            .unwrap()
-        })
-        .collect();
-    for l in &lengths[1..] {
-        assert!(pct(*l, lengths[0]).abs() < 1.0, "{lengths:?}");
+fn refinement_of_test7_and_the_wilkins_bar() {
+    for (name, scene) in [
+        ("test 7", Scene::builtin("taylor").unwrap()),
+        ("Wilkins", wilkins_scene()),
+    ] {
+        let runs: Vec<(f64, f64)> = [20.0, 31.0, 41.0]
+            .par_iter()
+            .map(|&n| {
+                let sim = run(scene.clone(), &[("particles_radial", n)]);
+                let o = |k: &str| sim.observable(k).unwrap();
+                assert_eq!(o("at_rest"), 1.0);
+                (o("rod_length"), 2.0 * o("mushroom_radius"))
+            })
+            .collect();
+        eprintln!("{name}: (Lf, Df) at 20, 31, 41 across: {runs:?}");
+        for (l, _) in &runs[1..] {
+            assert!(pct(*l, runs[0].0).abs() < 1.0, "{name}: {runs:?}");
+        }
+        assert!(pct(runs[2].1, runs[1].1).abs() < 2.0, "{name}: {runs:?}");
     }
 }
 
@@ -134,6 +201,18 @@ fn wilkins_shifting_coarse() -> Scene {
     s.set("particles_radial", 8.0).unwrap();
     s.set("end_time", 40e-6).unwrap();
     s
+}
+
+/// Shifting carries the stress deviator trace-free: after a run whose
+/// particles shift, the mean normal stress is −P at every particle to
+/// round-off (each component is limited to its neighbours' range on its
+/// own, which can leave a trace; the carry removes it, as in 3-D).
+#[test]
+fn shifting_keeps_the_deviator_trace_free() {
+    let sim = run(wilkins_shifting_coarse(), &[]);
+    let (residual, largest) = common::mean_stress_residual(&sim, 4);
+    assert!(largest > 1e8, "{largest}");
+    assert!(residual <= 1e-9 * largest, "{residual} of {largest}");
 }
 
 /// Without shifting, the coarse Wilkins run of the determinism tests stops
@@ -384,32 +463,17 @@ fn check_benchmark(sim: &Simulation, length: (f64, f64), radius: (f64, f64)) {
 /// with a singular moment matrix at the face centre at 15.3 us.
 #[test]
 fn test7_at_400_mps_runs_to_rest_with_the_large_strain_scheme() {
-    let sim = run(
-        Scene::builtin("taylor").unwrap(),
-        &[
-            ("impact_speed", 400.0),
-            ("smoothing_order", 2.0),
-            ("smoothing_ratio", 2.0),
-            ("shifting", 0.1),
-        ],
-    );
+    let sim = run(large_strain(&[("impact_speed", 400.0)]), &[]);
     assert_eq!(sim.observable("at_rest"), Some(1.0));
     let e = sim.observable("energy_error").unwrap();
     assert!(e < 0.05, "energy error {e}");
 }
 
-/// Test 7 with the large-strain scheme (`smoothing_order = 2`,
-/// `smoothing_ratio = 2`, `shifting = 0.1`) and the given changes.
+/// Test 7 with the default scheme, `large_strain` (`smoothing_order = 2`,
+/// `smoothing_ratio = 2`, `shifting = 0.1`), and the given changes.
 fn large_strain(sets: &[(&str, f64)]) -> Scene {
     let mut s = Scene::builtin("taylor").unwrap();
-    for (k, v) in [
-        ("smoothing_order", 2.0),
-        ("smoothing_ratio", 2.0),
-        ("shifting", 0.1),
-    ]
-    .iter()
-    .chain(sets)
-    {
+    for (k, v) in sets {
         s.set(k, *v).unwrap();
     }
     s
@@ -450,27 +514,24 @@ fn the_speed_ladder_runs_to_rest_at_10_across() {
     });
 }
 
-/// At 800 m/s, once the rod is spent, particles crowd along the anvil far
-/// out in the flange, and the run stops with the named `SpacingCollapse`
-/// (README, "Where the large-strain scheme stops") instead of running on
-/// with particles on top of each other. Measured at 10 across: 79.6 us, flange radius 27.5 mm, kinetic
-/// energy 0.86 J of 4310 J.
+/// At 800 m/s, more than four times test 7's speed, at 10 across, the rod
+/// flattens into a flange 7 times its radius and comes to rest (the quiet
+/// end) with no pair below the spacing guard and the energy balanced
+/// within 5%. Measured (2026-11-28): at rest at 80.2 us, rod 3.71 mm,
+/// flange radius 27.4 mm, energy error 0.013. Until the shifted deviator
+/// was made trace-free (README, "Particle shifting") the particles crowding
+/// along the anvil far out in the flange stopped it with `SpacingCollapse`
+/// at 79.6 us, the rod spent (kinetic energy 0.86 J of 4310 J).
 #[test]
-fn test7_at_800_mps_stops_with_a_named_error_once_spent() {
+fn test7_at_800_mps_comes_to_rest_at_10_across() {
     let scene = large_strain(&[("impact_speed", 800.0), ("particles_radial", 10.0)]);
     let mut sim = Simulation::new(scene).unwrap();
-    let err = sim.run().unwrap_err();
-    assert_eq!(err.name(), "SpacingCollapse", "{err}");
-    // The closing pair lies on the anvil far out in the flange, over four
-    // times the rod's initial radius (README, "Where the large-strain scheme
-    // stops"), once the rod has spent 99% of its impact energy.
+    sim.run().unwrap();
+    check_rest(&sim);
     let r = sim.observable("mushroom_radius").unwrap();
     assert!(r > 4.0 * 0.00381, "face radius {r}");
-    let (d, l, rho) = (0.007595, 0.03797, 7830.0);
-    let impact = 0.5 * rho * std::f64::consts::PI * 0.25 * d * d * l * 800.0 * 800.0;
-    let ke = sim.observable("kinetic_energy").unwrap();
-    assert!(ke < 0.01 * impact, "kinetic energy {ke} of {impact} J");
-    assert_eq!(sim.observable("at_rest"), Some(0.0));
+    let lf = sim.observable("rod_length").unwrap();
+    assert!(lf < 0.2 * 0.03797, "rod length {lf}");
 }
 
 /// The speed ladder at the default 20 particles across (`scripts/validate.sh`):
@@ -509,4 +570,58 @@ fn wilkins_scene() -> Scene {
         "/scenes/wilkins_copper.toml"
     ))
     .unwrap()
+}
+
+/// The default scheme at the default 20 particles across brings to rest,
+/// with the energy balanced within 5% and no named stop: the soft rod and
+/// the near-melt rod of the stability matrix (A = 50 MPa, B = 0; T0 = Tm −
+/// 50 K), and published copper and aluminium shots (the presets
+/// `ofhc_copper_jc` and `aluminium_6061t6_jc`, Johnson & Cook's cylinder,
+/// L0 = 25.4 mm, D0 = 7.62 mm, over the speeds of their cylinder tests).
+/// About 15 minutes on two cores: `scripts/validate.sh`;
+/// `scripts/scheme_matrix.py` prints the table of VALIDATION.md.
+#[test]
+#[ignore = "slow: run by scripts/validate.sh"]
+fn the_default_scheme_brings_soft_hot_copper_and_aluminium_rods_to_rest() {
+    let mut cases: Vec<(String, Scene)> = vec![
+        (
+            "soft rod".into(),
+            large_strain(&[("jc_a", 50e6), ("jc_b", 0.0)]),
+        ),
+        (
+            "near-melt rod".into(),
+            large_strain(&[("initial_temperature", 1293.0 - 50.0)]),
+        ),
+    ];
+    for (preset, speeds) in [
+        ("ofhc_copper_jc", &[130.0, 146.0, 190.0, 210.0]),
+        ("aluminium_6061t6_jc", &[150.0, 200.0, 250.0, 300.0]),
+    ] {
+        for v in speeds {
+            let mut s = Scene::builtin("taylor").unwrap();
+            s.choose_material(None, None, Some(preset)).unwrap();
+            for (k, x) in [
+                ("initial_length", 0.0254),
+                ("initial_diameter", 0.00762),
+                ("impact_speed", *v),
+            ] {
+                s.set(k, x).unwrap();
+            }
+            cases.push((format!("{preset} at {v} m/s"), s));
+        }
+    }
+    cases.par_iter().for_each(|(name, scene)| {
+        let mut sim = Simulation::new(scene.clone()).unwrap();
+        if let Err(e) = sim.run() {
+            panic!("{name}: {e}");
+        }
+        eprintln!(
+            "{name}: at rest at {:.1} us, Lf {:.2} mm, face radius {:.2} mm, energy error {:.4}",
+            sim.time() * 1e6,
+            sim.observable("rod_length").unwrap() * 1e3,
+            sim.observable("mushroom_radius").unwrap() * 1e3,
+            sim.observable("energy_error").unwrap()
+        );
+        check_rest(&sim);
+    });
 }

@@ -392,6 +392,31 @@ pub unsafe extern "C" fn mi_sim_set_material(
     })
 }
 
+/// Chooses the numerical scheme by name (`large_strain`, `paper`, ...; the
+/// scene's `scheme` parameter, whose description lists its levels), before
+/// the run starts. The scheme sets its knobs (`smoothing_order`,
+/// `shifting`, ...) except those already set by hand with
+/// `mi_sim_set_param`, which keep their values; a knob set afterwards
+/// overrides it. `mi_sim_set_param(sim, "scheme", k)` chooses the k-th level
+/// the same way. Errors: `MI_UNKNOWN_MATERIAL` (an unknown name, listing the
+/// known ones), `MI_UNKNOWN_PARAMETER` (a scene with no scheme),
+/// `MI_WRONG_ORDER` after the first step; on failure nothing changes.
+///
+/// # Safety
+/// `sim` must be NULL or a live handle; `name` NULL or a NUL-terminated
+/// string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mi_sim_set_scheme(sim: *mut mi_sim, name: *const c_char) -> mi_result {
+    with_sim(sim, |s| {
+        // SAFETY: forwarded contract on `name`.
+        let n = unsafe { text(name, "name") }?;
+        s.check_not_started("mi_sim_set_scheme")?;
+        s.scene.set_str("scheme", n)?;
+        s.sim = None;
+        Ok(())
+    })
+}
+
 /// Sets a parameter by name (SI units), before the run starts. Errors:
 /// `MI_UNKNOWN_PARAMETER`, `MI_OUT_OF_RANGE` (outside the allowed range, NaN,
 /// infinite, or not a whole number where one is required), `MI_WRONG_ORDER`

@@ -448,6 +448,62 @@ pub unsafe extern "C" fn fmi3SetInt32(
     }
 }
 
+/// `fmi3GetInt64`: the Enumeration parameters (the `scheme`; FMI 3.0 reads
+/// and writes enumerations as Int64).
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetInt64(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *mut i64,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        get_values(
+            instance,
+            "fmi3GetInt64",
+            VarType::Enumeration,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| x as i64,
+        )
+    }
+}
+
+/// `fmi3SetInt64`: the Enumeration parameters (the `scheme`), by the value
+/// of an item.
+///
+/// # Safety
+/// FMI 3.0 contract.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetInt64(
+    instance: Instance3,
+    vrs: *const Vr,
+    nvr: usize,
+    values: *const i64,
+    n_values: usize,
+) -> Fmi3Status {
+    // SAFETY: forwarded.
+    unsafe {
+        set_values(
+            instance,
+            "fmi3SetInt64",
+            VarType::Enumeration,
+            vrs,
+            nvr,
+            values,
+            n_values,
+            |x| x as f64,
+        )
+    }
+}
+
 /// `fmi3SetBoolean`: there are no Boolean inputs or parameters.
 ///
 /// # Safety
@@ -516,7 +572,7 @@ unsafe fn no_such_type(
                 function,
                 mask,
                 slice(vrs, nvr),
-                "a variable of this type (this FMU has Float64, Int32 and Boolean variables)",
+                "a variable of this type (this FMU has Float64, Int32, Boolean and Enumeration (Int64) variables)",
             )
         }) as c_int
     }
@@ -529,7 +585,6 @@ no_variables_of_type! {
     fmi3GetInt16, i16, mut, GET;
     fmi3GetUInt16, u16, mut, GET;
     fmi3GetUInt32, u32, mut, GET;
-    fmi3GetInt64, i64, mut, GET;
     fmi3GetUInt64, u64, mut, GET;
     fmi3GetString, *const c_char, mut, GET;
     fmi3SetFloat32, f32, const, SET;
@@ -538,7 +593,6 @@ no_variables_of_type! {
     fmi3SetInt16, i16, const, SET;
     fmi3SetUInt16, u16, const, SET;
     fmi3SetUInt32, u32, const, SET;
-    fmi3SetInt64, i64, const, SET;
     fmi3SetUInt64, u64, const, SET;
     fmi3SetString, *const c_char, const, SET;
 }

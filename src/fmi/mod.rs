@@ -105,7 +105,9 @@ impl Fmu {
             out.push(Variable {
                 vr,
                 name: p.name,
-                ty: if p.range.integer {
+                ty: if !p.levels.is_empty() {
+                    VarType::Enumeration
+                } else if p.range.integer {
                     VarType::Int32
                 } else {
                     VarType::Float64
@@ -228,6 +230,10 @@ pub enum VarType {
     Int32,
     /// `Boolean`.
     Boolean,
+    /// `Enumeration` (a parameter with named levels, the `scheme`): read and
+    /// written as Int64 in FMI 3, declared as an `Integer` with its levels
+    /// in the description in FMI 2 (read and written as Integer).
+    Enumeration,
 }
 
 /// Where a variable's value lives.
@@ -669,12 +675,18 @@ impl Instance {
     fn lookup(&mut self, vr: u32, ty: VarType, function: &str) -> Result<Variable, Status> {
         // The table is small (tens of rows): a linear lookup in the
         // instance's copy of [`Fmu::variables`], which allocates nothing.
-        match self.variables.iter().find(|v| v.vr == vr).copied() {
-            Some(v)
-                if v.ty == ty && !(self.standard == Standard::Fmi2 && v.kind == VarKind::Time) =>
-            {
-                Ok(v)
+        // FMI 2 reads and writes an enumeration as an Integer.
+        let fmi2 = self.standard == Standard::Fmi2;
+        let ty = if fmi2 && ty == VarType::Int32 {
+            match self.variables.iter().find(|v| v.vr == vr) {
+                Some(v) if v.ty == VarType::Enumeration => VarType::Enumeration,
+                _ => ty,
             }
+        } else {
+            ty
+        };
+        match self.variables.iter().find(|v| v.vr == vr).copied() {
+            Some(v) if v.ty == ty && !(fmi2 && v.kind == VarKind::Time) => Ok(v),
             Some(v) if v.ty != ty => Err(self.fail(&format!(
                 "{function}: variable `{}` (value reference {vr}) is of type {:?}, not {:?}",
                 v.name, v.ty, ty

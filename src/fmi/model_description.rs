@@ -76,6 +76,11 @@ pub fn full_description(v: &Variable) -> String {
     }
 }
 
+/// The name of the FMI 3 enumeration type of the parameter `name`.
+fn enum_type(name: &str) -> String {
+    format!("{name}_levels")
+}
+
 /// Default stop time of the experiment: the scene's `end_time` default.
 fn default_stop_time(fmu: Fmu) -> f64 {
     fmu.kind()
@@ -177,6 +182,33 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
         .unwrap();
     }
     x.push_str("  </UnitDefinitions>\n");
+    // FMI 3: an enumeration type per parameter with levels (the scheme),
+    // named after it; FMI 2 declares it an Integer, its levels in the
+    // description.
+    let enums: Vec<&Variable> = vars
+        .iter()
+        .filter(|v| v.ty == VarType::Enumeration)
+        .collect();
+    if version == FmiVersion::Fmi3 && !enums.is_empty() {
+        x.push_str("  <TypeDefinitions>\n");
+        for v in &enums {
+            let VarKind::Parameter(p) = v.kind else {
+                continue;
+            };
+            writeln!(x, "    <EnumerationType name=\"{}\">", enum_type(p.name)).unwrap();
+            for (k, level) in p.levels.iter().enumerate() {
+                writeln!(
+                    x,
+                    "      <Item name=\"{}\" value=\"{k}\" description=\"{}\"/>",
+                    level.name,
+                    escape(level.description)
+                )
+                .unwrap();
+            }
+            x.push_str("    </EnumerationType>\n");
+        }
+        x.push_str("  </TypeDefinitions>\n");
+    }
     x.push_str("  <LogCategories>\n");
     for (name, d) in LOG_CATEGORIES {
         writeln!(
@@ -209,7 +241,7 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
         };
         let bounds = match v.kind {
             VarKind::Parameter(p) => {
-                let (min, max, start) = if v.ty == VarType::Int32 {
+                let (min, max, start) = if matches!(v.ty, VarType::Int32 | VarType::Enumeration) {
                     (
                         format!("{}", p.range.min as i64),
                         format!("{}", p.range.max as i64),
@@ -229,6 +261,10 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
                     VarType::Float64 => ("Float64", unit_attr),
                     VarType::Int32 => ("Int32", String::new()),
                     VarType::Boolean => ("Boolean", String::new()),
+                    VarType::Enumeration => (
+                        "Enumeration",
+                        format!(" declaredType=\"{}\"", enum_type(v.name)),
+                    ),
                 };
                 // FMI 3: `initial` of the independent variable is not given.
                 writeln!(
@@ -242,7 +278,7 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
             FmiVersion::Fmi2 => {
                 let (elem, unit_attr) = match v.ty {
                     VarType::Float64 => ("Real", unit_attr),
-                    VarType::Int32 => ("Integer", String::new()),
+                    VarType::Int32 | VarType::Enumeration => ("Integer", String::new()),
                     VarType::Boolean => ("Boolean", String::new()),
                 };
                 writeln!(

@@ -368,6 +368,7 @@ macro_rules! material_block {
                 default: $default,
                 range: $range,
                 description: $desc,
+                levels: &[],
             },
         }, )* ]
     };

@@ -36,6 +36,7 @@ pub mod mls;
 pub mod nodal;
 pub mod penetration;
 pub mod profile;
+pub mod scheme;
 pub mod shift;
 pub mod solver;
 pub mod sphere;

@@ -203,16 +203,6 @@ pub enum WeakForm {
 }
 
 impl WeakForm {
-    /// The form of a scene's `weak_form` value: 0 the sphere, 1 and 2 nodal
-    /// (2 with [`RodSetup::conforming`]).
-    pub fn of(value: f64) -> Self {
-        if value >= 0.5 {
-            WeakForm::Nodal
-        } else {
-            WeakForm::Sphere
-        }
-    }
-
     /// The ratio of this form's stable step to the seed's form's,
     /// `OMEGA_FACTOR / κ` (1 for the sphere form, 0.78 for the nodal form):
     /// the factor on the per-step rates, the smoothing's α and the
@@ -1789,7 +1779,11 @@ impl Mlpg3d {
             }
             self.vel[i] = v;
             ke[1] += kinetic1(v, self.mass[i]);
-            self.dev[i] = [f[3], f[4], f[5], f[6], f[7], f[8]];
+            // Each component was limited to its neighbours' range on its
+            // own, which leaves a trace: the deviator is made trace-free
+            // again (the mean normal stress stays −P).
+            let m = (f[3] + f[4] + f[5]) / 3.0;
+            self.dev[i] = [f[3] - m, f[4] - m, f[5] - m, f[6], f[7], f[8]];
             self.rho[i] = f[9];
             self.eps_p[i] = f[10];
             self.temp[i] = f[11];

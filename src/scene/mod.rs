@@ -135,15 +135,34 @@ impl SceneKind {
 
 /// A complete, validated-on-demand description of one run: a kind of scene
 /// and a value for each parameter of its table.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// **Schemes.** A parameter with named levels (the `scheme` of the rod
+/// scenes, [`crate::Level`]) sets other parameters of the table (the
+/// scheme's knobs). A knob set by hand ([`Scene::set`]) overrides the
+/// scheme whatever the order of the two: choosing a scheme changes only
+/// the knobs not set by hand.
+#[derive(Debug, Clone)]
 pub struct Scene {
     /// Human-readable title.
     pub title: String,
     kind: SceneKind,
     /// One value per row of the kind's parameter table, in its order.
     values: Vec<f64>,
+    /// Per row: set by hand (a scheme then leaves it alone).
+    by_hand: Vec<bool>,
     /// Optional reference values (for example experimental results), by name.
     pub reference: BTreeMap<String, f64>,
+}
+
+impl PartialEq for Scene {
+    /// The same run: title, kind, values and references (which knobs were
+    /// set by hand is not compared).
+    fn eq(&self, other: &Self) -> bool {
+        self.title == other.title
+            && self.kind == other.kind
+            && self.values == other.values
+            && self.reference == other.reference
+    }
 }
 
 /// Names of the built-in scenes: the registry rows' own names, then the
@@ -214,6 +233,7 @@ impl<'de> Deserialize<'de> for Scene {
             let k = scene.index(&name).map_err(D::Error::custom)?;
             scene.values[k] = v;
         }
+        scene.mark_overrides();
         Ok(scene)
     }
 }
@@ -249,10 +269,12 @@ impl Scene {
     /// The default scene of a kind, with default parameters.
     pub fn default_of(kind: SceneKind) -> Scene {
         let row = kind.row();
+        let specs = kind.param_specs();
         Scene {
             title: row.title.to_string(),
             kind,
-            values: kind.param_specs().iter().map(|p| p.default).collect(),
+            values: specs.iter().map(|p| p.default).collect(),
+            by_hand: vec![false; specs.len()],
             reference: (row.reference)(),
         }
     }
@@ -288,10 +310,16 @@ impl Scene {
         if let Some(m) = &file.material {
             scene.choose_material(m.strength.as_deref(), m.eos.as_deref(), m.preset.as_deref())?;
         }
-        for (name, value) in &file.parameters {
+        // The schemes first: then the knobs the file gives override them.
+        let (schemes, knobs): (Vec<_>, Vec<_>) = file
+            .parameters
+            .iter()
+            .partition(|(name, _)| scene.spec(name).is_ok_and(|s| !s.levels.is_empty()));
+        for (name, value) in schemes.into_iter().chain(knobs) {
             let v = match value {
                 toml::Value::Float(f) => *f,
                 toml::Value::Integer(i) => *i as f64,
+                toml::Value::String(text) => scene.spec(name)?.parse(text)?,
                 other => {
                     return Err(Error::ParseValue {
                         name: name.clone(),
@@ -335,7 +363,24 @@ impl Scene {
         out.push_str("[parameters]\n");
         for spec in self.param_specs() {
             let v = self.get(spec.name).expect("name from own table");
-            out.push_str(&format!("{} = {:?}  # {}\n", spec.name, v, spec.unit));
+            if let Some(level) = spec.level(v) {
+                out.push_str(&format!(
+                    "{} = \"{}\"  # {}: {}\n",
+                    spec.name,
+                    level.name,
+                    spec.level_names(),
+                    level.description
+                ));
+            } else if let Some((by, level)) = self.set_by_level(spec.name) {
+                // Written as a comment: the scheme sets it, and a value
+                // written here would override another scheme chosen later.
+                out.push_str(&format!(
+                    "# {} = {:?}  # {}, set by {by} = \"{}\"\n",
+                    spec.name, v, spec.unit, level.name
+                ));
+            } else {
+                out.push_str(&format!("{} = {:?}  # {}\n", spec.name, v, spec.unit));
+            }
         }
         if !self.reference.is_empty() {
             out.push_str("\n[reference]\n");
@@ -360,6 +405,52 @@ impl Scene {
     /// [`Scene::param_specs`].
     pub fn values(&self) -> &[f64] {
         &self.values
+    }
+
+    /// The row of the parameter `name`.
+    pub fn spec(&self, name: &str) -> Result<&'static ParamSpec> {
+        Ok(&self.param_specs()[self.index(name)?])
+    }
+
+    /// The level that sets `name` to its current value, with the name of
+    /// the parameter of that level, where `name` was not set by hand (the
+    /// scheme's value, not an override).
+    fn set_by_level(&self, name: &str) -> Option<(&'static str, &'static params::Level)> {
+        let k = self.index(name).ok()?;
+        if self.by_hand[k] {
+            return None;
+        }
+        self.param_specs()
+            .iter()
+            .zip(&self.values)
+            .filter_map(|(spec, v)| Some((spec.name, spec.level(*v)?)))
+            .find(|(_, level)| {
+                level
+                    .sets
+                    .iter()
+                    .any(|(n, x)| *n == name && *x == self.values[k])
+            })
+    }
+
+    /// Marks as set by hand every knob whose value is not its level's (a
+    /// scene whose values were put whole, as a saved state's).
+    fn mark_overrides(&mut self) {
+        let specs = self.param_specs();
+        for (spec, v) in specs.iter().zip(self.values.clone()) {
+            if let Some(level) = spec.level(v) {
+                for (name, x) in level.sets {
+                    if let Ok(k) = self.index(name) {
+                        self.by_hand[k] = self.values[k] != *x;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The level of the parameter `name` (a scheme), if it has levels.
+    pub fn level(&self, name: &str) -> Result<Option<&'static params::Level>> {
+        let k = self.index(name)?;
+        Ok(self.param_specs()[k].level(self.values[k]))
     }
 
     /// Position of the parameter `name` in the table.
@@ -390,8 +481,14 @@ impl Scene {
             .iter()
             .map(|spec| self.get(spec.name).unwrap_or(spec.default))
             .collect();
+        let by_hand = kind
+            .param_specs()
+            .iter()
+            .map(|spec| self.index(spec.name).is_ok_and(|k| self.by_hand[k]))
+            .collect();
         self.kind = kind;
         self.values = values;
+        self.by_hand = by_hand;
         Ok(())
     }
 
@@ -473,21 +570,42 @@ impl Scene {
     }
 
     /// Sets a parameter after checking its name and range. Cross-parameter
-    /// constraints are checked by [`Scene::validate`].
+    /// constraints are checked by [`Scene::validate`]. A parameter with
+    /// levels (a scheme) also sets the knobs of its level that were not set
+    /// by hand; any other parameter is then set by hand, and a scheme chosen
+    /// before or after leaves it alone.
     pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
         let k = self.index(name)?;
-        self.param_specs()[k].check(value)?;
-        self.values[k] = value;
+        let spec = self.param_specs()[k];
+        spec.check(value)?;
+        match spec.level(value) {
+            Some(level) => {
+                let mut next = self.values.clone();
+                for (knob, x) in level.sets {
+                    let j = self.index(knob)?;
+                    if !self.by_hand[j] {
+                        next[j] = *x;
+                    }
+                }
+                next[k] = value;
+                self.values = next;
+            }
+            None => {
+                // A knob set to the value its scheme gives it stays the
+                // scheme's: a host that sets every parameter to its start
+                // value has still chosen no knob.
+                let scheme_value = self.set_by_level(name).map(|_| self.values[k]);
+                self.by_hand[k] = self.by_hand[k] || scheme_value != Some(value);
+                self.values[k] = value;
+            }
+        }
         Ok(())
     }
 
-    /// Parses `text` as a number and sets the parameter.
+    /// Parses `text` as a number (or the name of a level, for a parameter
+    /// with levels) and sets the parameter.
     pub fn set_str(&mut self, name: &str, text: &str) -> Result<()> {
-        self.index(name)?;
-        let v: f64 = text.trim().parse().map_err(|_| Error::ParseValue {
-            name: name.to_string(),
-            text: text.to_string(),
-        })?;
+        let v = self.spec(name)?.parse(text)?;
         self.set(name, v)
     }
 
@@ -711,6 +829,145 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("no material"), "{e}");
+    }
+
+    /// Every scheme of every scene names knobs of its table with values in
+    /// their ranges, every level of a scheme sets the same knobs, and the
+    /// table's defaults are the default level's values (for every material
+    /// choice).
+    #[test]
+    fn schemes_set_knobs_of_their_tables_and_the_defaults_are_the_default_scheme() {
+        let mut seen = 0;
+        for row in registry::SCENES {
+            let kind = SceneKind::default_of_row(row);
+            let choices: Vec<SceneKind> = match &row.material {
+                Some(_) => MaterialChoice::ALL
+                    .iter()
+                    .map(|c| kind.with_material(*c).unwrap())
+                    .collect(),
+                None => vec![kind],
+            };
+            for kind in choices {
+                let specs = kind.param_specs();
+                for spec in specs.iter().filter(|p| !p.levels.is_empty()) {
+                    seen += 1;
+                    let knobs: Vec<&str> = spec.levels[0].sets.iter().map(|(n, _)| *n).collect();
+                    for level in spec.levels {
+                        let names: Vec<&str> = level.sets.iter().map(|(n, _)| *n).collect();
+                        assert_eq!(names, knobs, "{kind} {}", level.name);
+                        for (n, v) in level.sets {
+                            let knob = specs.iter().find(|p| p.name == *n).unwrap();
+                            knob.check(*v).unwrap();
+                        }
+                    }
+                    let default = &spec.levels[spec.default as usize];
+                    for (n, v) in default.sets {
+                        let knob = specs.iter().find(|p| p.name == *n).unwrap();
+                        assert_eq!(knob.default, *v, "{kind}: {n}");
+                    }
+                }
+            }
+        }
+        // taylor and taylor3d for each of four choices, and penetration.
+        assert_eq!(seen, 9);
+    }
+
+    /// A scheme sets its knobs; a knob set by hand overrides it whichever
+    /// comes first; a knob set to the value its scheme gives it stays the
+    /// scheme's; names and numbers both choose a level; unknown names list
+    /// the known ones.
+    #[test]
+    fn a_scheme_sets_its_knobs_and_a_knob_set_by_hand_overrides_it() {
+        let mut s = Scene::builtin("taylor").unwrap();
+        assert_eq!(s.level("scheme").unwrap().unwrap().name, "large_strain");
+        s.set_str("scheme", "paper").unwrap();
+        assert_eq!(s.get("smoothing_order").unwrap(), 1.0);
+        assert_eq!(s.get("smoothing_ratio").unwrap(), 1.5);
+        assert_eq!(s.get("shifting").unwrap(), 0.0);
+        // By hand after the scheme, then the scheme again: the knob stays.
+        s.set("shifting", 0.05).unwrap();
+        s.set_str("scheme", "large_strain").unwrap();
+        assert_eq!(s.get("shifting").unwrap(), 0.05);
+        assert_eq!(s.get("smoothing_order").unwrap(), 2.0);
+        // By hand before the scheme: the knob stays.
+        let mut t = Scene::builtin("taylor").unwrap();
+        t.set("smoothing_ratio", 3.0).unwrap();
+        t.set("scheme", 1.0).unwrap();
+        assert_eq!(t.get("smoothing_ratio").unwrap(), 3.0);
+        assert_eq!(t.get("smoothing_order").unwrap(), 1.0);
+        // Every knob set to its start value (as an FMI host may) chooses no
+        // knob: the paper's scheme then sets them all.
+        let mut u = Scene::builtin("taylor").unwrap();
+        for spec in u.param_specs() {
+            u.set(spec.name, spec.default).unwrap();
+        }
+        u.set_str("scheme", "paper").unwrap();
+        let mut paper = Scene::builtin("taylor").unwrap();
+        paper.set_str("scheme", "paper").unwrap();
+        assert_eq!(u, paper);
+        let e = u.set_str("scheme", "fast").unwrap_err().to_string();
+        assert!(
+            e.contains("scheme") && e.contains("large_strain, paper"),
+            "{e}"
+        );
+        assert!(u.set("scheme", 2.0).is_err());
+        assert_eq!(u, paper, "nothing changes on an error");
+        assert!(
+            Scene::builtin("noh")
+                .unwrap()
+                .set_str("scheme", "paper")
+                .is_err()
+        );
+    }
+
+    /// A scene file chooses the scheme by name, its knobs override it in
+    /// any order, and a written scene reads back the same, its scheme's
+    /// knobs as comments (so that another scheme chosen in the file
+    /// takes effect).
+    #[test]
+    fn scene_files_choose_the_scheme_by_name() {
+        let s = Scene::from_toml_str(
+            "scene = \"taylor\"\n[parameters]\nshifting = 0.2\nscheme = \"paper\"\n",
+        )
+        .unwrap();
+        assert_eq!(s.level("scheme").unwrap().unwrap().name, "paper");
+        assert_eq!(s.get("shifting").unwrap(), 0.2);
+        assert_eq!(s.get("smoothing_order").unwrap(), 1.0);
+        let text = s.to_toml();
+        assert!(text.contains("scheme = \"paper\""), "{text}");
+        assert!(text.contains("# smoothing_order = 1.0"), "{text}");
+        assert!(text.contains("\nshifting = 0.2"), "{text}");
+        assert_eq!(Scene::from_toml_str(&text).unwrap(), s);
+        let other = text.replace("scheme = \"paper\"", "scheme = \"large_strain\"");
+        let o = Scene::from_toml_str(&other).unwrap();
+        assert_eq!(o.get("smoothing_order").unwrap(), 2.0);
+        assert_eq!(o.get("shifting").unwrap(), 0.2);
+        let e = Scene::from_toml_str("scene = \"taylor\"\n[parameters]\nscheme = \"fast\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fast") && e.contains("large_strain, paper"),
+            "{e}"
+        );
+    }
+
+    /// The combinations that cannot work are refused when the scene is
+    /// validated, with both parameters named: conforming gradients
+    /// (`weak_form = 2`, the 3-D default) on the quarter model.
+    #[test]
+    fn unworkable_scheme_combinations_are_refused_by_name() {
+        for scene in ["taylor3d", "penetration"] {
+            let mut s = Scene::builtin(scene).unwrap();
+            s.set("weak_form", 2.0).unwrap();
+            s.set("symmetry", 1.0).unwrap();
+            let e = s.validate().unwrap_err().to_string();
+            assert!(
+                e.contains("weak_form = 2") && e.contains("symmetry = 1"),
+                "{scene}: {e}"
+            );
+            s.set("weak_form", 1.0).unwrap();
+            s.validate().unwrap();
+        }
     }
 
     /// Changing the models keeps the parameters both tables share.

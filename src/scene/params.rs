@@ -84,6 +84,20 @@ impl std::fmt::Display for Range {
     }
 }
 
+/// One named level of a parameter with levels (a scheme): its name, what it
+/// is, and the values it gives other parameters of the table. A level's
+/// value is its index in [`ParamSpec::levels`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Level {
+    /// The name in scene files, on the command line, in the C ABI and FMUs.
+    pub name: &'static str,
+    /// One-line meaning.
+    pub description: &'static str,
+    /// The parameters it sets and their values; a parameter set by hand
+    /// keeps its own value whatever the level ([`crate::Scene::set`]).
+    pub sets: &'static [(&'static str, f64)],
+}
+
 /// One row of a parameter table.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamSpec {
@@ -97,9 +111,49 @@ pub struct ParamSpec {
     pub range: Range,
     /// One-line meaning.
     pub description: &'static str,
+    /// Named levels, for a parameter whose values are choices by name (the
+    /// `scheme`); empty for a number.
+    pub levels: &'static [Level],
 }
 
 impl ParamSpec {
+    /// The level of value `value`, for a parameter with levels.
+    pub fn level(&self, value: f64) -> Option<&'static Level> {
+        if self.levels.is_empty() || !self.range.contains(value) {
+            return None;
+        }
+        self.levels.get(value as usize)
+    }
+
+    /// The value of `text`: a level's name, for a parameter with levels, or
+    /// a number; an error naming the parameter otherwise.
+    pub fn parse(&self, text: &str) -> Result<f64> {
+        let t = text.trim();
+        if let Some(k) = self.levels.iter().position(|l| l.name == t) {
+            return Ok(k as f64);
+        }
+        if !self.levels.is_empty() && t.parse::<f64>().is_err() {
+            return Err(Error::UnknownModel {
+                key: self.name.to_string(),
+                name: t.to_string(),
+                allowed: self.level_names(),
+            });
+        }
+        t.parse().map_err(|_| Error::ParseValue {
+            name: self.name.to_string(),
+            text: text.to_string(),
+        })
+    }
+
+    /// The names of the levels, comma-separated.
+    pub fn level_names(&self) -> String {
+        self.levels
+            .iter()
+            .map(|l| l.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// Checks `value` against the range, with an error naming the parameter.
     pub fn check(&self, value: f64) -> Result<()> {
         if self.range.contains(value) {
@@ -128,6 +182,25 @@ pub const fn spec(
         default,
         range,
         description,
+        levels: &[],
+    }
+}
+
+/// The row of a parameter with named levels: its value is the index of a
+/// level (integers `[0, levels - 1]`), `default` the default level's.
+pub const fn levels_spec(
+    name: &'static str,
+    default: usize,
+    levels: &'static [Level],
+    description: &'static str,
+) -> ParamSpec {
+    ParamSpec {
+        name,
+        unit: "1",
+        default: default as f64,
+        range: Range::integer(0.0, (levels.len() - 1) as f64),
+        description,
+        levels,
     }
 }
 
@@ -140,6 +213,7 @@ pub const fn concat<const N: usize>(parts: &[&[ParamSpec]]) -> [ParamSpec; N] {
         default: 0.0,
         range: Range::closed(0.0, 0.0),
         description: "",
+        levels: &[],
     }; N];
     let (mut k, mut p) = (0, 0);
     while p < parts.len() {
@@ -179,6 +253,7 @@ macro_rules! param_table {
                 default: $default,
                 range: $range,
                 description: $desc,
+                levels: &[],
             }, )*
         ];
 

@@ -8,7 +8,7 @@
 //! block, defaults AD85 of the seed's Table 1).
 
 use super::Scene;
-use super::params::{ParamSpec, Range, concat, spec as row};
+use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
 use super::registry::{SceneRow, no_variants, restore};
 use super::taylor3d::ring_lattice_nodes;
 use crate::budget::MemoryPerNode;
@@ -18,7 +18,8 @@ use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::Cylinder;
 use crate::mlpg::penetration::{Penetration, PenetrationSetup};
-use crate::mlpg::solver::{DAMPING, REBUILD_STRAIN, RodSetup, WeakForm};
+use crate::mlpg::scheme::MlpgScheme;
+use crate::mlpg::solver::{DAMPING, REBUILD_STRAIN, RodSetup};
 use crate::observe::PENETRATION_OBSERVABLES;
 use std::collections::BTreeMap;
 
@@ -166,28 +167,22 @@ const AFTER: &[ParamSpec] = &[
         "1",
         0.1,
         Range::closed(0.0, 0.5),
-        "alpha of the MLPG velocity smoothing (smoothing_order) at each node (README, penetration)",
+        "alpha of the MLPG velocity smoothing (smoothing_order) at each node (README, penetration) (scheme)",
     ),
     // The order-2 smoothing, the nodal form and node shifting: the only
     // choices measured to run the seed's case to 20 µs (README,
-    // "Ballistic penetration").
-    ParamSpec {
-        default: 2.0,
-        ..super::taylor3d::SMOOTHING_ORDER_SPEC
-    },
-    row(
-        "shifting",
-        "1",
-        0.1,
-        Range::closed(0.0, 1.0),
-        "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian",
-    ),
+    // "Ballistic penetration"; the scheme `ballistic`).
+    super::taylor3d::SMOOTHING_ORDER_SPEC,
+    super::taylor3d::SHIFTING,
     ParamSpec {
         default: 1.0,
         ..super::taylor3d::WEAK_FORM
     },
     super::taylor3d::SYMMETRY,
-    super::taylor3d::LATTICE,
+    ParamSpec {
+        default: 0.0,
+        ..super::taylor3d::LATTICE
+    },
     row(
         "end_time",
         "s",
@@ -195,6 +190,32 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(1.0e-9, 1.0e-3),
         "simulated time at which the run ends",
     ),
+    levels_spec(
+        "scheme",
+        0,
+        SCHEMES,
+        "numerical scheme by name, which sets the knobs marked (scheme); a knob set by hand overrides it: \
+         0 = ballistic (the default, measured on the seed's case), 1 = paper (the seed's MLPG mixed method exactly)",
+    ),
+];
+
+/// The schemes of the penetration scene, by name (the `scheme` row;
+/// [`MlpgScheme`] decodes the knobs they set). The first is the default.
+pub const SCHEMES: &[Level] = &[
+    Level {
+        name: "ballistic",
+        description: "the default: the nodal form, the order-2 smoothing with alpha = 0.1, node shifting \
+                      beta = 0.1, the aligned lattice: the only choices measured to run the seed's case to \
+                      20 us (README, \"Ballistic penetration\")",
+        sets: &[
+            ("smoothing_coefficient", 0.1),
+            ("smoothing_order", 2.0),
+            ("shifting", 0.1),
+            ("weak_form", 1.0),
+            ("lattice", 0.0),
+        ],
+    },
+    super::taylor3d::PAPER_3D,
 ];
 
 const LEN: usize = BEFORE.len() + PLATE_CERAMIC.len() + AFTER.len();
@@ -266,13 +287,8 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     let mut numerics = RodSetup::new(projectile, rings, setup.impact_speed, end_time);
     numerics.damping = DAMPING;
     numerics.rebuild_strain = REBUILD_STRAIN;
-    numerics.smoothing = v("smoothing_coefficient")?;
-    numerics.smoothing_order = v("smoothing_order")? as u32;
-    numerics.shifting = v("shifting")?;
-    numerics.weak_form = WeakForm::of(v("weak_form")?);
-    numerics.conforming = v("weak_form")? >= 1.5;
     numerics.quarter = quarter;
-    numerics.staggered = v("lattice")? >= 0.5;
+    MlpgScheme::decode(v)?.apply(&mut numerics);
     Ok((setup, (projectile_material, plate_material), numerics))
 }
 
@@ -280,6 +296,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
 mod tests {
     use super::*;
     use crate::material::presets::Preset;
+    use crate::mlpg::solver::WeakForm;
 
     /// The projectile's defaults are the preset `tungsten_seed`, by value.
     #[test]

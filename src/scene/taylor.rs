@@ -12,7 +12,7 @@
 //! `TaylorImpactBilinearMieGruneisen`.
 
 use super::Scene;
-use super::params::{ParamSpec, Range, choice_tables, param_struct};
+use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec, param_struct};
 use super::registry::{FmuIdentity, MaterialSlot, SceneRow, restore};
 use crate::budget::MemoryPerNode;
 use crate::material::choice::{MaterialChoice, Prefix};
@@ -129,32 +129,67 @@ const AFTER: &[ParamSpec] = &[
     spec(
         "smoothing_ratio",
         "1",
-        1.5,
+        2.0,
         Range::closed(0.5, 4.0),
-        "smoothing length h divided by the particle spacing",
+        "smoothing length h divided by the particle spacing (scheme)",
     ),
     spec(
         "smoothing_coefficient",
         "1",
         0.2,
         Range::closed(0.0, 0.5),
-        "alpha_cs of the conservative smoothing (3.23)",
+        "alpha_cs of the conservative smoothing (3.23) (scheme)",
     ),
     spec(
         "smoothing_order",
         "1",
-        1.0,
+        2.0,
         Range::integer(1.0, 2.0),
-        "velocity and density smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain)",
+        "velocity and density smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian (large strain) (scheme)",
     ),
     spec(
         "shifting",
         "1",
-        0.0,
+        0.1,
         Range::closed(0.0, 1.0),
-        "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper",
+        "particle shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the paper (scheme)",
     ),
     END_TIME,
+    levels_spec(
+        "scheme",
+        0,
+        SCHEMES,
+        "numerical scheme by name, which sets the knobs marked (scheme); a knob set by hand overrides it: \
+         0 = large_strain (the validated default), 1 = paper (Batra & Zhang's MSPH exactly)",
+    ),
+];
+
+/// The schemes of the axisymmetric MSPH solver, by name (the `scheme` row;
+/// [`crate::solver::scheme::MsphScheme`] decodes the knobs they set). The
+/// first is the default.
+pub const SCHEMES: &[Level] = &[
+    Level {
+        name: "large_strain",
+        description: "the validated default: h = 2 spacings, the order-2 (bi-Laplacian) smoothing of velocity \
+                      and density, particle shifting beta = 0.1 (VALIDATION.md, \"Right by default\")",
+        sets: &[
+            ("smoothing_ratio", 2.0),
+            ("smoothing_coefficient", 0.2),
+            ("smoothing_order", 2.0),
+            ("shifting", 0.1),
+        ],
+    },
+    Level {
+        name: "paper",
+        description: "Batra & Zhang (2008) exactly: h = 1.5 spacings, the conservative smoothing (3.23), \
+                      Lagrangian particles",
+        sets: &[
+            ("smoothing_ratio", 1.5),
+            ("smoothing_coefficient", 0.2),
+            ("smoothing_order", 1.0),
+            ("shifting", 0.0),
+        ],
+    },
 ];
 
 /// The end time of a rod scene.
@@ -251,13 +286,13 @@ mod tests {
     fn default_table_is_the_fields_in_order() {
         let names: Vec<&str> = TAYLOR_PARAMS.iter().map(|s| s.name).collect();
         let p = TaylorParams::default();
-        assert!(names.iter().all(|n| p.get(n).is_some()));
+        assert!(names.iter().all(|n| p.get(n).is_some() || *n == "scheme"));
         assert_eq!(
             names.join(" "),
             "impact_speed initial_length initial_diameter density shear_modulus bulk_modulus \
              specific_heat taylor_quinney jc_a jc_b jc_n jc_c jc_m melt_temperature \
              room_temperature initial_temperature ref_strain_rate particles_radial \
-             smoothing_ratio smoothing_coefficient smoothing_order shifting end_time"
+             smoothing_ratio smoothing_coefficient smoothing_order shifting end_time scheme"
         );
         for c in MaterialChoice::ALL {
             let t = params_of(c);

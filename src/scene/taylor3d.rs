@@ -9,16 +9,15 @@
 //! damping ratio.
 
 use super::Scene;
-use super::params::{ParamSpec, Range, choice_tables, param_struct};
+use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec, param_struct};
 use super::registry::{MaterialSlot, SceneRow, restore};
 use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
 use crate::budget::MemoryPerNode;
 use crate::material::Material;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::mlpg::Cylinder;
-use crate::mlpg::solver::{
-    DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING, SMOOTHING_ORDER, WeakForm,
-};
+use crate::mlpg::scheme::MlpgScheme;
+use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
 use crate::observe::TAYLOR3D_OBSERVABLES;
 
 /// The registry row of the `taylor3d` scene.
@@ -86,7 +85,7 @@ fn material_choice(s: &Scene) -> MaterialChoice {
 pub(crate) const SMOOTHING_ORDER_SPEC: ParamSpec = spec(
     "smoothing_order",
     "1",
-    SMOOTHING_ORDER as f64,
+    2.0,
     Range::integer(1.0, 2.0),
     "MLPG velocity smoothing with H = I - Phi (Phi: the MLS approximation at the nodes): 1 = v <- v - alpha H v, 2 = v <- v - alpha M^-1 H^T M H v, its symmetric square, which spares smooth fields (README, 3-D MLPG)",
 );
@@ -99,7 +98,7 @@ pub(crate) const SYMMETRY: ParamSpec = spec(
     0.0,
     Range::integer(0.0, 1.0),
     "0 = the whole body; 1 = the quarter x >= 0, y >= 0 with the symmetry planes x = 0 and y = 0 by mirror images of the nodes \
-     near them (a quarter of the nodes; energies are reported for the whole body)",
+     near them (a quarter of the nodes; energies are reported for the whole body; the forces of weak_form = 0 or 1)",
 );
 
 /// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
@@ -109,11 +108,11 @@ pub(crate) const SYMMETRY: ParamSpec = spec(
 pub(crate) const WEAK_FORM: ParamSpec = spec(
     "weak_form",
     "1",
-    0.0,
+    2.0,
     Range::integer(0.0, 2.0),
     "forces of the MLPG solver: 0 = the seed's local weak form over test spheres (eq. 10), 1 = nodal Galerkin form, \
      the adjoint of the collocated gradients, which conserves momentum and energy, 2 = the nodal form with gradients \
-     corrected so that a uniform stress leaves the nodes off the surfaces in equilibrium (whole body only; README, 3-D MLPG)",
+     corrected so that a uniform stress leaves the nodes off the surfaces in equilibrium (whole body only; README, 3-D MLPG) (scheme)",
 );
 
 /// The `lattice` row of the 3-D scenes: 0 the ring lattice with every
@@ -122,10 +121,10 @@ pub(crate) const WEAK_FORM: ParamSpec = spec(
 pub(crate) const LATTICE: ParamSpec = spec(
     "lattice",
     "1",
-    0.0,
+    1.0,
     Range::integer(0.0, 1.0),
     "node lattice of the rod: 0 = rings with the nodes of every layer on the same radial lines, 1 = staggered, the odd \
-     layers turned by half a node's angle so that layers pressed together interleave (README, 3-D MLPG)",
+     layers turned by half a node's angle so that layers pressed together interleave (README, 3-D MLPG) (scheme)",
 );
 
 /// The numerical parameters and the end time: the rows after the material
@@ -150,7 +149,7 @@ const AFTER: &[ParamSpec] = &[
         "1",
         SMOOTHING,
         Range::closed(0.0, 0.5),
-        "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, 3-D MLPG)",
+        "alpha of the MLPG velocity smoothing toward the MLS approximation at each node (README, 3-D MLPG) (scheme)",
     ),
     SMOOTHING_ORDER_SPEC,
     spec(
@@ -160,17 +159,63 @@ const AFTER: &[ParamSpec] = &[
         Range::closed(1.0e-4, 0.2),
         "relative motion of neighbours past which the MLPG shapes, test spheres and traction operator are rebuilt",
     ),
-    spec(
-        "shifting",
-        "1",
-        0.0,
-        Range::closed(0.0, 1.0),
-        "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; 0 = Lagrangian, as the seed",
-    ),
+    SHIFTING,
     WEAK_FORM,
     SYMMETRY,
     LATTICE,
     END_TIME,
+    levels_spec(
+        "scheme",
+        0,
+        SCHEMES,
+        "numerical scheme by name, which sets the knobs marked (scheme); a knob set by hand overrides it: \
+         0 = large_strain (the validated default), 1 = paper (the seed's MLPG mixed method exactly)",
+    ),
+];
+
+/// The `shifting` row of the 3-D scenes.
+pub(crate) const SHIFTING: ParamSpec = spec(
+    "shifting",
+    "1",
+    0.1,
+    Range::closed(0.0, 1.0),
+    "node shifting beta: pairs closer than half the spacing push apart by up to beta times the spacing per step; \
+     0 = Lagrangian, as the seed (scheme)",
+);
+
+/// The seed's MLPG mixed method exactly: the local weak form over test
+/// spheres, the order-1 velocity smoothing, Lagrangian nodes on the aligned
+/// ring lattice.
+pub(crate) const PAPER_3D: Level = Level {
+    name: "paper",
+    description: "the seed's MLPG mixed method exactly: the local weak form over test spheres (eq. 10), the \
+                  order-1 velocity smoothing, Lagrangian nodes on the aligned ring lattice",
+    sets: &[
+        ("smoothing_coefficient", SMOOTHING),
+        ("smoothing_order", 1.0),
+        ("shifting", 0.0),
+        ("weak_form", 0.0),
+        ("lattice", 0.0),
+    ],
+};
+
+/// The schemes of the 3-D MLPG solver on a rod, by name (the `scheme` row;
+/// [`MlpgScheme`] decodes the knobs they set). The first is the default.
+pub const SCHEMES: &[Level] = &[
+    Level {
+        name: "large_strain",
+        description: "the validated default: the nodal form with conforming gradients, the order-2 smoothing, \
+                      node shifting beta = 0.1, the staggered lattice (whole body only; VALIDATION.md, \
+                      \"Right by default\")",
+        sets: &[
+            ("smoothing_coefficient", SMOOTHING),
+            ("smoothing_order", 2.0),
+            ("shifting", 0.1),
+            ("weak_form", 2.0),
+            ("lattice", 1.0),
+        ],
+    },
+    PAPER_3D,
 ];
 
 choice_tables! {
@@ -256,6 +301,7 @@ impl Taylor3dParams {
     /// the matched spacing; the material's are
     /// [`MaterialChoice::check_consistency`]).
     pub fn check_consistency(&self) -> crate::Result<()> {
+        self.setup()?;
         self.taylor().check_consistency()
     }
 
@@ -270,8 +316,17 @@ impl Taylor3dParams {
             .expect("Taylor3dParams has every parameter of Johnson-Cook and the linear EOS")
     }
 
+    /// The numerical scheme, decoded and checked against the symmetry.
+    pub fn scheme(&self) -> crate::Result<MlpgScheme> {
+        let get = |name: &str| {
+            self.get(name)
+                .ok_or_else(|| crate::Error::Inconsistent(format!("no parameter {name}")))
+        };
+        MlpgScheme::decode(get)
+    }
+
     /// The rod and the numerical choices.
-    pub(crate) fn setup(&self) -> RodSetup {
+    pub(crate) fn setup(&self) -> crate::Result<RodSetup> {
         let mut s = RodSetup::new(
             Cylinder {
                 radius: 0.5 * self.initial_diameter,
@@ -283,14 +338,9 @@ impl Taylor3dParams {
         );
         s.damping = self.damping;
         s.rebuild_strain = self.rebuild_strain;
-        s.smoothing = self.smoothing_coefficient;
-        s.smoothing_order = self.smoothing_order as u32;
-        s.shifting = self.shifting;
-        s.weak_form = WeakForm::of(self.weak_form);
-        s.conforming = self.weak_form >= 1.5;
         s.quarter = self.symmetry >= 0.5;
-        s.staggered = self.lattice >= 0.5;
-        s
+        self.scheme()?.apply(&mut s);
+        Ok(s)
     }
 
     /// The run at the instant of impact, of the default material choice.
@@ -306,7 +356,7 @@ impl Taylor3dParams {
     /// [`Taylor3dParams::build`]).
     #[doc(hidden)]
     pub fn build_with(&self, material: Material) -> crate::Result<Mlpg3d> {
-        Mlpg3d::new(self.setup(), material)
+        Mlpg3d::new(self.setup()?, material)
     }
 }
 

@@ -49,6 +49,7 @@ use crate::neighbors::padded_rows;
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{self, RodSets};
 use crate::scene::taylor::TaylorParams;
+use crate::solver::scheme::{MsphScheme, SmoothingOrder};
 
 /// Smallest distance between two neighbouring particles (every pair, mirror
 /// images included), relative to the initial spacing, below which a run
@@ -801,7 +802,7 @@ impl TaylorSolver {
         ws.sbc.resize(m, [0.0; 4]);
         ws.vel.resize(m, [0.0; 2]);
         ws.vel_s.resize(m, [0.0; 2]);
-        if self.p.smoothing_order == 2.0 {
+        if MsphScheme::of(&self.p).order == SmoothingOrder::BiLaplacian {
             ws.lap.resize(m, [0.0; 2]);
             ws.lap_rho.resize(m, [0.0]);
         }
@@ -999,7 +1000,11 @@ impl TaylorSolver {
             ke[0] += kinetic1(self.vel[i], self.mass[i]);
             self.vel[i] = [fi[0], fi[1]];
             ke[1] += kinetic1(self.vel[i], self.mass[i]);
-            self.dev[i] = [fi[2], fi[3], fi[4], fi[5]];
+            // Each component was limited to its neighbours' range on its
+            // own, which leaves a trace: the deviator (RR, ZZ, TT, RZ) is
+            // made trace-free again (the mean normal stress stays −P).
+            let m = (fi[2] + fi[3] + fi[4]) / 3.0;
+            self.dev[i] = [fi[2] - m, fi[3] - m, fi[4] - m, fi[5]];
             self.rho[i] = fi[6];
             self.eps_p[i] = fi[7].max(0.0);
             self.temp[i] = fi[8];
@@ -1192,8 +1197,9 @@ impl TaylorSolver {
                 bound: SPACING_COLLAPSE_BOUND,
                 time: self.time,
                 hint: if self.p.shifting == 0.0 {
-                    "; at large strain, use smoothing_order = 2, smoothing_ratio = 2 and \
-                     shifting = 0.1 (README, \"Particle shifting\")"
+                    "; at large strain, use scheme = large_strain, the default (it sets \
+                     smoothing_order = 2, smoothing_ratio = 2 and shifting = 0.1; README, \
+                     \"Particle shifting\")"
                 } else {
                     ""
                 },
@@ -1211,7 +1217,7 @@ impl TaylorSolver {
             part,
             stride,
         };
-        let order2 = self.p.smoothing_order == 2.0;
+        let order2 = MsphScheme::of(&self.p).order == SmoothingOrder::BiLaplacian;
         if order2 {
             // Order 2: first the operator L v = (Shepard mean of v) - v.
             laplacians(team, isa, rows, vel, lap, n, images);

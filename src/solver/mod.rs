@@ -8,6 +8,7 @@ pub mod axisymmetric;
 pub mod boundary;
 mod pairs;
 pub mod radial;
+pub mod scheme;
 mod shift;
 // Shares disjoint chunks of the step's arrays between the threads of a
 // team: the only unsafe code of the solver besides the AVX-512 kernels.

@@ -89,9 +89,21 @@ def cli_json(tmp_path_factory, *args):
 
 
 def params_of(*args):
-    """Names and values of `meshless-impact params ARGS`, in order."""
-    rows = cli("params", *args).splitlines()[1:]
-    return [(r.split()[0], float(r.split()[2])) for r in rows]
+    """Names and values of `meshless-impact params ARGS`, in order: the table
+    down to its first blank line (the schemes' listing follows). A scheme's
+    value is its level's name, whose index the `allowed` column gives
+    (`0=large_strain,1=paper`)."""
+    lines = cli("params", *args).splitlines()[1:]
+    rows = lines[: lines.index("")] if "" in lines else lines
+    out = []
+    for r in rows:
+        name, _, value, allowed = r.split()[:4]
+        try:
+            out.append((name, float(value)))
+        except ValueError:
+            levels = [a.split("=", 1)[1] for a in allowed.split(",")]
+            out.append((name, float(levels.index(value))))
+    return out
 
 
 def assert_simulated_equal_to_cli(r, ref, names):

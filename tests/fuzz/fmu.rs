@@ -239,6 +239,10 @@ trait Fmu: Sized {
     ) -> c_int;
     unsafe fn get_f64(&mut self, vrs: *const u32, nvr: usize, v: *mut f64, n: usize) -> c_int;
     unsafe fn get_i32(&mut self, vrs: *const u32, nvr: usize, v: *mut i32, n: usize) -> c_int;
+    /// The Int64 setter and getter (FMI 3's enumerations); FMI 2 reads and
+    /// writes enumerations as Integer.
+    unsafe fn set_i64(&mut self, vrs: *const u32, nvr: usize, v: *const i64, n: usize) -> c_int;
+    unsafe fn get_i64(&mut self, vrs: *const u32, nvr: usize, v: *mut i64, n: usize) -> c_int;
     unsafe fn get_bool(
         &mut self,
         vrs: *const u32,
@@ -265,6 +269,10 @@ trait Fmu: Sized {
                 VarType::Int32 => {
                     let v = typed(values, |x| x as i32);
                     self.set_i32(vrs, nvr, ptr_of(&v), n_values)
+                }
+                VarType::Enumeration => {
+                    let v = typed(values, |x| x as i64);
+                    self.set_i64(vrs, nvr, ptr_of(&v), n_values)
                 }
                 VarType::Boolean => {
                     let v = typed(values, |x| Self::Bool::from(x != 0.0));
@@ -301,6 +309,13 @@ trait Fmu: Sized {
                     len,
                     |p| self.get_i32(vrs, nvr, p, n_values),
                     |x: i32| x as f64,
+                ),
+                VarType::Enumeration => read_into(
+                    out,
+                    null,
+                    len,
+                    |p| self.get_i64(vrs, nvr, p, n_values),
+                    |x: i64| x as f64,
                 ),
                 VarType::Boolean => read_into(
                     out,
@@ -342,6 +357,16 @@ macro_rules! forward {
             unsafe { $f(self.0 $(, $pass)*) }
         }
     )*};
+}
+
+/// The type through which standard `F` reads and writes a variable of type
+/// `ty`: FMI 2 reads and writes an enumeration as an Integer.
+fn ty_in<F: Fmu>(ty: VarType) -> VarType {
+    if F::FMI2 && ty == VarType::Enumeration {
+        VarType::Int32
+    } else {
+        ty
+    }
 }
 
 struct Fmi3(*mut c_void);
@@ -436,6 +461,8 @@ impl Fmu for Fmi3 {
         set_bool(r: *const u32, n: usize, v: *const u8, m: usize) => fmi3::fmi3SetBoolean[r, n, v, m];
         get_f64(r: *const u32, n: usize, v: *mut f64, m: usize) => fmi3::fmi3GetFloat64[r, n, v, m];
         get_i32(r: *const u32, n: usize, v: *mut i32, m: usize) => fmi3::fmi3GetInt32[r, n, v, m];
+        set_i64(r: *const u32, n: usize, v: *const i64, m: usize) => fmi3::fmi3SetInt64[r, n, v, m];
+        get_i64(r: *const u32, n: usize, v: *mut i64, m: usize) => fmi3::fmi3GetInt64[r, n, v, m];
         get_bool(r: *const u32, n: usize, v: *mut u8, m: usize) => fmi3::fmi3GetBoolean[r, n, v, m];
         get_state(s: *mut *mut c_void) => fmi3::fmi3GetFMUState[s];
         set_state(s: *mut c_void) => fmi3::fmi3SetFMUState[s];
@@ -600,6 +627,12 @@ impl Fmu for Fmi2 {
     unsafe fn enter_init(&mut self, _: f64, _: Option<f64>) -> c_int {
         // SAFETY: a live instance or NULL.
         unsafe { fmi2::fmi2EnterInitializationMode(self.0) }
+    }
+    unsafe fn set_i64(&mut self, _: *const u32, _: usize, _: *const i64, _: usize) -> c_int {
+        unreachable!("FMI 2 writes enumerations as Integer (`ty_in`)")
+    }
+    unsafe fn get_i64(&mut self, _: *const u32, _: usize, _: *mut i64, _: usize) -> c_int {
+        unreachable!("FMI 2 reads enumerations as Integer (`ty_in`)")
     }
     forward! {
         exit_init() => fmi2::fmi2ExitInitializationMode[];
@@ -1015,21 +1048,23 @@ impl<F: Fmu> Case<F> {
 
     fn set(&mut self, rng: &mut Rng, logged: usize) {
         let vars = self.info.vars.clone();
-        let ty = *rng.pick(&[
+        let ty = ty_in::<F>(*rng.pick(&[
             VarType::Float64,
             VarType::Float64,
             VarType::Int32,
             VarType::Int32,
             VarType::Boolean,
-        ]);
+            VarType::Enumeration,
+        ]));
         let mut vrs = self.refs(rng);
         if ty == VarType::Int32 && rng.below(2) == 0 {
             vrs = vec![self.info.vr("particles_radial")];
         } else if rng.below(2) == 0 {
             // Only parameters of this type: the sets that may work.
             vrs.retain(|&r| {
-                vars.get(r as usize)
-                    .is_some_and(|v| v.ty == ty && matches!(v.kind, VarKind::Parameter(_)))
+                vars.get(r as usize).is_some_and(|v| {
+                    ty_in::<F>(v.ty) == ty && matches!(v.kind, VarKind::Parameter(_))
+                })
             });
         }
         let nvr = vrs.len();
@@ -1045,7 +1080,7 @@ impl<F: Fmu> Case<F> {
                 }
                 Some(fmi::Variable {
                     kind: VarKind::Parameter(p),
-                    ty: VarType::Int32,
+                    ty: VarType::Int32 | VarType::Enumeration,
                     ..
                 }) => *rng.pick(&[
                     p.range.min,
@@ -1080,14 +1115,15 @@ impl<F: Fmu> Case<F> {
         let received = |x: f64| match ty {
             VarType::Float64 => x,
             VarType::Int32 => x as i32 as f64,
+            VarType::Enumeration => x as i64 as f64,
             VarType::Boolean => (x != 0.0) as u8 as f64,
         };
         let settable = vrs.iter().zip(&values).all(|(&r, &x)| {
-            matches!(vars.get(r as usize), Some(v) if v.ty == ty
+            matches!(vars.get(r as usize), Some(v) if ty_in::<F>(v.ty) == ty
                 && matches!(v.kind, VarKind::Parameter(p) if p.range.contains(received(x))))
         });
         let typed_params = vrs.iter().all(|&r| {
-            matches!(vars.get(r as usize), Some(v) if v.ty == ty && matches!(v.kind, VarKind::Parameter(_)))
+            matches!(vars.get(r as usize), Some(v) if ty_in::<F>(v.ty) == ty && matches!(v.kind, VarKind::Parameter(_)))
         });
         let arrays = !null_vrs && !null_vals && n == nvr;
         let allowed = self.m.is(&[St::Instantiated, St::Init]);
@@ -1118,18 +1154,19 @@ impl<F: Fmu> Case<F> {
 
     fn get(&mut self, rng: &mut Rng, logged: usize) {
         let vars = self.info.vars.clone();
-        let ty = *rng.pick(&[
+        let ty = ty_in::<F>(*rng.pick(&[
             VarType::Float64,
             VarType::Float64,
             VarType::Int32,
             VarType::Boolean,
-        ]);
+            VarType::Enumeration,
+        ]));
         let mut vrs = self.refs(rng);
         if rng.below(2) == 0 {
             // Only variables of this type: the reads that must work.
             vrs.retain(|&r| {
                 vars.get(r as usize)
-                    .is_some_and(|v| v.ty == ty && !(F::FMI2 && r == fmi::VR_TIME))
+                    .is_some_and(|v| ty_in::<F>(v.ty) == ty && !(F::FMI2 && r == fmi::VR_TIME))
             });
         }
         let nvr = vrs.len();
@@ -1152,7 +1189,7 @@ impl<F: Fmu> Case<F> {
         };
         let typed = vrs.iter().all(|&r| {
             vars.get(r as usize)
-                .is_some_and(|v| v.ty == ty && !(F::FMI2 && r == fmi::VR_TIME))
+                .is_some_and(|v| ty_in::<F>(v.ty) == ty && !(F::FMI2 && r == fmi::VR_TIME))
         });
         let fail = self.m.st.is_some()
             && (self.m.is(&[St::Instantiated]) || null_vrs || null_out || n != nvr || !typed);
