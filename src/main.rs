@@ -288,11 +288,7 @@ fn apply_sets(scene: &mut Scene, sets: &[String]) -> Result<(), Error> {
         })?;
         pairs.push((name.trim(), value));
     }
-    let has_levels =
-        |scene: &Scene, name: &str| scene.spec(name).is_ok_and(|s| !s.levels.is_empty());
-    let (schemes, knobs): (Vec<_>, Vec<_>) =
-        pairs.into_iter().partition(|(n, _)| has_levels(scene, n));
-    for (name, value) in schemes.into_iter().chain(knobs) {
+    for (name, value) in scene.schemes_first(pairs) {
         scene.set_str(name, value)?;
     }
     scene.validate()

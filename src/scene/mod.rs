@@ -310,19 +310,15 @@ impl Scene {
         if let Some(m) = &file.material {
             scene.choose_material(m.strength.as_deref(), m.eos.as_deref(), m.preset.as_deref())?;
         }
-        // The schemes first: then the knobs the file gives override them.
-        let (schemes, knobs): (Vec<_>, Vec<_>) = file
-            .parameters
-            .iter()
-            .partition(|(name, _)| scene.spec(name).is_ok_and(|s| !s.levels.is_empty()));
-        for (name, value) in schemes.into_iter().chain(knobs) {
+        let pairs = file.parameters.iter().map(|(n, v)| (n.as_str(), v));
+        for (name, value) in scene.schemes_first(pairs) {
             let v = match value {
                 toml::Value::Float(f) => *f,
                 toml::Value::Integer(i) => *i as f64,
                 toml::Value::String(text) => scene.spec(name)?.parse(text)?,
                 other => {
                     return Err(Error::ParseValue {
-                        name: name.clone(),
+                        name: name.to_string(),
                         text: other.to_string(),
                     });
                 }
@@ -405,6 +401,20 @@ impl Scene {
     /// [`Scene::param_specs`].
     pub fn values(&self) -> &[f64] {
         &self.values
+    }
+
+    /// `pairs` of parameter names and values with the parameters that have
+    /// levels (the schemes) first, each group in its order: set in this
+    /// order, the knobs given with a scheme override it.
+    pub fn schemes_first<'a, T>(
+        &self,
+        pairs: impl IntoIterator<Item = (&'a str, T)>,
+    ) -> Vec<(&'a str, T)> {
+        let (mut schemes, knobs): (Vec<_>, Vec<_>) = pairs
+            .into_iter()
+            .partition(|(name, _)| self.spec(name).is_ok_and(|s| !s.levels.is_empty()));
+        schemes.extend(knobs);
+        schemes
     }
 
     /// The row of the parameter `name`.
