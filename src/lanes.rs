@@ -390,15 +390,7 @@ pub fn total(x: Lanes) -> f64 {
 mod tests {
     use super::*;
 
-    fn rng(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::test_rng::rng;
 
     #[test]
     fn exp_is_within_two_ulp_of_the_standard_library() {

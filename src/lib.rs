@@ -81,6 +81,8 @@ mod rod;
 mod scene;
 mod sim;
 mod solver;
+#[cfg(test)]
+mod test_rng;
 mod uniaxial;
 
 pub use budget::{DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_VAR, MemoryPerNode, memory_budget};

@@ -1033,13 +1033,8 @@ mod tests {
 
     #[test]
     fn gauss_jordan_inverse_equals_nalgebra() {
-        let mut s = 99u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = crate::test_rng::rng(99);
+        let mut next = || uniform() - 0.5;
         for _ in 0..200 {
             let a: [[f64; 6]; 6] = std::array::from_fn(|_| std::array::from_fn(|_| next()));
             let ours = invert(a).unwrap();

@@ -487,16 +487,9 @@ mod tests {
         let inner: Vec<bool> = lat.surfaces.iter().map(|s| s.interior()).collect();
         let columns = Columns::of(&shapes, n);
         let sys = System::new(&shapes, pts, &lat.volume, &inner, &columns);
-        let mut seed = 11u64;
+        let mut uniform = crate::test_rng::rng(11);
         let mu: Vec<[f64; 3]> = (0..n)
-            .map(|_| {
-                std::array::from_fn(|_| {
-                    seed = seed
-                        .wrapping_mul(6364136223846793005)
-                        .wrapping_add(1442695040888963407);
-                    (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-                })
-            })
+            .map(|_| std::array::from_fn(|_| uniform() - 0.5))
             .collect();
         let mut e = vec![[0.0; 3]; shapes.nodes.len()];
         sys.entries(&mu, &mut e);

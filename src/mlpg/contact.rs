@@ -171,13 +171,7 @@ mod tests {
     /// the brute-force search.
     #[test]
     fn pairs_are_the_brute_force_ones() {
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng::rng(12345);
         let mut pos = Vec::new();
         let mut group = Vec::new();
         for g in 0..2u8 {

@@ -155,13 +155,8 @@ mod tests {
     /// the quarter model are the derivative of its stress power).
     #[test]
     fn the_fold_is_the_adjoint_of_the_extension() {
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = crate::test_rng::rng(7);
+        let mut rnd = || uniform() - 0.5;
         let pos: Vec<[f64; 3]> = (0..200)
             .map(|_| [rnd() + 0.5, rnd() + 0.5, rnd()])
             .collect();
