@@ -631,11 +631,18 @@ fn params(scene: &str, material: &ChoiceArgs) -> Result<(), Stop> {
         )?;
     }
     for p in s.param_specs().iter().filter(|p| !p.levels.is_empty()) {
+        let flag = if p.name == "scheme" {
+            "--scheme NAME, ".to_string()
+        } else {
+            String::new()
+        };
+        let sets = p.levels.iter().any(|l| !l.sets.is_empty());
         outln!(
-            "\n{} (--{} NAME, or `{} = \"NAME\"` in a scene file's [parameters]); each sets:",
+            "\n{} ({flag}--set {}=NAME, or `{} = \"NAME\"` in a scene file's [parameters]){}:",
             p.name,
             p.name,
-            p.name
+            p.name,
+            if sets { "; each sets" } else { "" }
         )?;
         let chosen = s.level(p.name)?.map(|l| l.name);
         for level in p.levels {
@@ -650,7 +657,9 @@ fn params(scene: &str, material: &ChoiceArgs) -> Result<(), Stop> {
                 ""
             };
             outln!("  {}{mark}: {}", level.name, level.description)?;
-            outln!("      {}", sets.join(", "))?;
+            if !sets.is_empty() {
+                outln!("      {}", sets.join(", "))?;
+            }
         }
     }
     Ok(())

@@ -378,4 +378,5 @@ observables! {
     contact_dissipation: "J", "kinetic energy removed by the contact between the bodies (perfectly inelastic along the line of centres)";
     smoothing_dissipation: "J", "kinetic energy removed by the velocity smoothing toward the MLS approximation";
     energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
+    shot_outcome: "1", "what the shot has come to, decided by the state (README, \"Ballistic limit\"): 0 undecided, 1 perforated (the projectile wholly past the plate's original back face and faster along the flight than the intact plate around the hole), 2 stopped (not perforated, and no faster than the plate's centre of mass)";
 }

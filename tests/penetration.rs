@@ -31,6 +31,7 @@ fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
         impact_speed: 1500.0,
         rings,
         end_time,
+        until_outcome: false,
     };
     let mut numerics = RodSetup::new(setup.projectile, rings, 1500.0, end_time);
     numerics.smoothing = smoothing;
@@ -472,4 +473,73 @@ fn same_bits_on_one_thread_and_two() {
         let s = coarse_with(2e-6, &[("symmetry", 1.0)]);
         (s.field("position"), s.field("velocity"), s.observables())
     });
+}
+
+/// The seed's case at 3 nodes across, as a quarter model, at `speed`,
+/// with `run_until` and `end_time`.
+fn shot(speed: f64, until: &str, end_time: f64) -> Simulation {
+    let mut scene = Scene::builtin("penetration").unwrap();
+    scene.set("particles_radial", 3.0).unwrap();
+    scene.set("symmetry", 1.0).unwrap();
+    scene.set("impact_speed", speed).unwrap();
+    scene.set_str("run_until", until).unwrap();
+    scene.set("end_time", end_time).unwrap();
+    let mut sim = Simulation::new(scene).unwrap();
+    sim.run().unwrap();
+    sim
+}
+
+/// The shot's outcome is decided by the state and is final. At 3 across
+/// (quarter model) a 1000 m/s shot perforates slowly: at 20 µs it is
+/// still above the back face and undecided (measured: clearance −3.63 mm
+/// at 456.3 m/s); with `run_until = outcome` the run goes on and ends when
+/// the projectile is through and leaving (measured 29.06 µs, 378.4 m/s),
+/// never as stopped. The oracle is the run continued 8 µs past that
+/// decision with `run_until = end_time`: the projectile has gone further
+/// below the back face (2.79 mm), still moves along its flight (332.4 m/s:
+/// the fragments ahead of it still slow it), and is still perforated. A
+/// 600 m/s shot stops (measured 40.67 µs, 78.4 m/s against the capture
+/// speed `m_p V / (m_p + m_plate)` = 80.6 m/s); continued 10 µs it has not
+/// crossed the back face (−6.76 mm, rebounding at 30.0 m/s) and is still
+/// stopped.
+#[test]
+fn a_slow_perforation_is_not_called_stopped() {
+    let o = |sim: &Simulation, name: &str| sim.observable(name).unwrap();
+    let at_20 = shot(1000.0, "end_time", 20e-6);
+    println!(
+        "1000 m/s at 20 us: outcome {}, clearance {:.3} mm, {:.1} m/s",
+        o(&at_20, "shot_outcome"),
+        o(&at_20, "projectile_clearance") * 1e3,
+        o(&at_20, "projectile_velocity")
+    );
+    assert_eq!(o(&at_20, "shot_outcome"), 0.0);
+    assert!(o(&at_20, "projectile_clearance") < 0.0);
+    for (speed, outcome, more) in [(1000.0, 1.0, 8e-6), (600.0, 2.0, 10e-6)] {
+        let decided = shot(speed, "outcome", 1e-4);
+        let t = decided.time();
+        println!(
+            "{speed} m/s: outcome {} at {:.2} us, clearance {:.3} mm, {:.1} m/s",
+            o(&decided, "shot_outcome"),
+            t * 1e6,
+            o(&decided, "projectile_clearance") * 1e3,
+            o(&decided, "projectile_velocity")
+        );
+        assert_eq!(o(&decided, "shot_outcome"), outcome, "{speed} m/s");
+        assert!(t < 1e-4, "{speed} m/s decided at the cap");
+        let later = shot(speed, "end_time", t + more);
+        println!(
+            "  {:.2} us later: outcome {}, clearance {:.3} mm, {:.1} m/s",
+            more * 1e6,
+            o(&later, "shot_outcome"),
+            o(&later, "projectile_clearance") * 1e3,
+            o(&later, "projectile_velocity")
+        );
+        assert_eq!(o(&later, "shot_outcome"), outcome, "{speed} m/s");
+        if outcome == 1.0 {
+            assert!(o(&later, "projectile_clearance") > o(&decided, "projectile_clearance"));
+            assert!(o(&later, "projectile_velocity") > 0.0);
+        } else {
+            assert!(o(&later, "projectile_clearance") < 0.0);
+        }
+    }
 }

@@ -39,6 +39,23 @@ pub struct PenetrationSetup {
     pub rings: usize,
     /// Latest simulated time (s).
     pub end_time: f64,
+    /// The run ends as soon as the shot's outcome is decided
+    /// ([`Penetration::outcome`]), with `end_time` as its cap; false (the
+    /// default): it runs to `end_time`.
+    #[serde(default)]
+    pub until_outcome: bool,
+}
+
+/// What a shot has come to ([`Penetration::outcome`]; the observable
+/// `shot_outcome` is its number).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// 0: neither of the others yet.
+    Undecided,
+    /// 1: the projectile is through the plate and leaving it.
+    Perforated,
+    /// 2: the projectile moves no faster than the plate.
+    Stopped,
 }
 
 /// A penetration run: the two-body MLPG run and what its observables need.
@@ -108,9 +125,64 @@ impl Penetration {
         self.run.particles()
     }
 
-    /// Whether the end time is reached.
+    /// Whether the end time is reached, or, with
+    /// [`PenetrationSetup::until_outcome`], the outcome is decided.
     pub fn finished(&self) -> bool {
-        self.run.finished()
+        self.run.finished() || (self.setup.until_outcome && self.outcome() != Outcome::Undecided)
+    }
+
+    /// The shot's outcome, decided by the state, not by the clock:
+    ///
+    /// - **perforated**: the projectile's highest node is below the plate's
+    ///   original back face (`projectile_clearance > 0`) and its centre of
+    ///   mass moves faster along the flight than the intact plate material
+    ///   around the hole (the mass-weighted mean over the plate nodes not
+    ///   pulverized within two node spacings of `hole_radius`): it is
+    ///   leaving the plate;
+    /// - **stopped**: not perforated, and the projectile's centre of mass
+    ///   moves no faster along the flight than the plate's centre of mass
+    ///   (or than 0, where the plate moves back): it no longer gains on the
+    ///   plate. With a free rim and momentum conserved this is the capture
+    ///   speed `m_p V / (m_p + m_plate)`, at which projectile and plate
+    ///   move on together;
+    /// - otherwise **undecided**.
+    pub fn outcome(&self) -> Outcome {
+        let v_p = self.projectile_velocity();
+        let (x, v, m) = (
+            self.run.positions(),
+            self.run.velocities(),
+            self.run.masses(),
+        );
+        if self.projectile_clearance() > 0.0 {
+            let spacing = self.setup.projectile.radius / self.setup.rings.max(1) as f64;
+            let reach = self.hole_radius() + 2.0 * spacing;
+            let points = self.run.material_points();
+            let (mut p, mut total) = (0.0, 0.0);
+            for i in self.nodes(1) {
+                let intact = points
+                    .get(i)
+                    .and_then(|p| p.ceramic())
+                    .is_none_or(|c| c.pulverized.is_none());
+                if intact && (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt() <= reach {
+                    p -= m[i] * v[i][2];
+                    total += m[i];
+                }
+            }
+            let around = if total > 0.0 { p / total } else { 0.0 };
+            if v_p > around {
+                return Outcome::Perforated;
+            }
+        }
+        let (mut p, mut total) = (0.0, 0.0);
+        for i in self.nodes(1) {
+            p -= m[i] * v[i][2];
+            total += m[i];
+        }
+        if v_p <= (p / total).max(0.0) {
+            Outcome::Stopped
+        } else {
+            Outcome::Undecided
+        }
     }
 
     /// One step.
@@ -250,6 +322,7 @@ impl Penetration {
             e.contact,
             e.smoothing,
             e.error,
+            self.outcome() as u8 as f64,
         ];
         debug_assert_eq!(values.len(), PENETRATION_OBSERVABLES.len());
         values

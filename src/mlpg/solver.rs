@@ -185,10 +185,10 @@ pub struct RodSetup {
     #[serde(default)]
     pub staggered: bool,
     /// The shifting carries the velocities conservatively
-    /// ([`super::shift::exchange`]): a moved node's momentum increment is
+    /// (`mlpg::shift::exchange`): a moved node's momentum increment is
     /// drawn from the nodes around it, so that a shift changes the total
     /// momentum by round-off only; false (the default): a moved node takes
-    /// the velocity of its new place ([`super::shift::carry`]). Either way
+    /// the velocity of its new place (`mlpg::shift::carry`). Either way
     /// the kinetic energy a shift changes is booked with the smoothing's.
     #[serde(default)]
     pub conservative_carry: bool,

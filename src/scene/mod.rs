@@ -878,8 +878,9 @@ mod tests {
                 }
             }
         }
-        // taylor and taylor3d for each of four choices, and penetration.
-        assert_eq!(seen, 9);
+        // taylor's and taylor3d's schemes for each of four choices,
+        // penetration's scheme and its run_until.
+        assert_eq!(seen, 10);
     }
 
     /// A scheme sets its knobs; a knob set by hand overrides it whichever

@@ -197,6 +197,29 @@ const AFTER: &[ParamSpec] = &[
         "numerical scheme by name, which sets the knobs marked (scheme); a knob set by hand overrides it: \
          0 = ballistic (the default, measured on the seed's case), 1 = paper (the seed's MLPG mixed method exactly)",
     ),
+    levels_spec(
+        "run_until",
+        0,
+        RUN_UNTIL,
+        "when the run ends: 0 = end_time (the default: at end_time, whatever the shot's outcome), \
+         1 = outcome (as soon as shot_outcome is decided, perforated or stopped, with end_time as the cap; \
+         README, \"Ballistic limit\")",
+    ),
+];
+
+/// The levels of `run_until`.
+const RUN_UNTIL: &[Level] = &[
+    Level {
+        name: "end_time",
+        description: "the run ends at end_time, whatever the shot's outcome (the residual velocity of the seed's case at 20 us)",
+        sets: &[],
+    },
+    Level {
+        name: "outcome",
+        description: "the run ends as soon as the shot is perforated or stopped (shot_outcome), at end_time at the latest \
+                      (shot_outcome 0 then): the ballistic-limit sweep's choice",
+        sets: &[],
+    },
 ];
 
 /// The schemes of the penetration scene, by name (the `scheme` row;
@@ -283,6 +306,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
         impact_speed: v("impact_speed")?,
         rings,
         end_time,
+        until_outcome: v("run_until")? >= 0.5,
     };
     let mut numerics = RodSetup::new(projectile, rings, setup.impact_speed, end_time);
     numerics.damping = DAMPING;
