@@ -8,29 +8,24 @@ plots them with the fit.
 One shot per process: locally with a process pool by default, or on a Dask
 cluster with --scheduler ADDRESS (as examples/sweep_fmu.py).
 
-Each shot runs to end_time. Its status:
-  through    faster than the capture speed (below), settled (its velocity
-             changed by at most --settle-tol x V over the last tenth of the
-             run) and wholly past the plate's original back face
-             (projectile_clearance > 0): perforated, its final
-             projectile_velocity is the residual velocity V_r;
-  stopped    its final velocity is no more than the capture speed
-             m_p V / (m_p + m_plate), at which projectile and whole plate move
-             together (the plate's rim is free, so a stopped projectile moves
-             on with it), or it is embedded: settled, with part of it still
-             above the plate's original back face, and too slow to cross that
-             face within another run of the same length (its depth above the
-             face exceeds its velocity times end_time): V_r = 0;
-  unsettled  faster than the capture speed, and not yet a residual velocity:
-             its velocity still changed by more than --settle-tol x V over the
-             last tenth of the run (still slowing, in the plate or pushed by
-             its fragments), or it is settled but still partly above the
-             plate's back face and fast enough to cross it within another run
-             of the same length (a slow perforation near the ballistic limit
-             looks settled by the first rule while the bulging plate still
-             carries it). Left out of the fit unless --fit-unsettled is given;
-             with --extend K the script runs these shots again with twice the
-             end time, up to K times;
+Each shot runs with run_until = outcome: it ends as soon as the scene
+decides its outcome from the state (the output shot_outcome; README,
+"The shot's outcome"), with end_time as the cap. Its status:
+  through    shot_outcome 1, perforated: wholly past the plate's original
+             back face and faster along the flight than the intact plate
+             material around the hole; its projectile_velocity then is the
+             residual velocity V_r (near the ballistic limit the fragments
+             ahead of it may still slow it a little: an upper bound);
+  stopped    shot_outcome 2: not perforated, and no faster than the plate's
+             centre of mass (with the free rim, the capture speed
+             m_p V / (m_p + m_plate), at which projectile and plate move on
+             together): V_r = 0;
+  unsettled  shot_outcome 0 at end_time, the cap: neither yet. Left out of
+             the fit unless --fit-unsettled is given (its V_r is then its
+             velocity at the cap); with --extend K the script runs these
+             shots again with twice the end time, up to K times (the
+             column time_s is the last communication point the host
+             recorded; the run ended within one communication step after it);
   error      the FMU run stopped with an error (for example a named solver
              stop such as a particle spacing collapse): reported with the
              message and left out of the fit; the CSV has the outputs at the
@@ -59,9 +54,11 @@ from sweep_fmu import parse_sets, run_jobs
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_FMU = ROOT / "target" / "fmu" / "BallisticImpact.fmu"
 OUTPUTS = ["projectile_velocity", "projectile_extent", "hole_radius", "damaged_fraction",
-           "pulverized_fraction", "max_damage", "energy_error", "projectile_clearance"]
+           "pulverized_fraction", "max_damage", "energy_error", "projectile_clearance", "shot_outcome"]
+# The scene's run_until levels: the sweep ends each shot at its outcome.
+RUN_UNTIL_OUTCOME = 1
 COLUMNS = ["V_mps", "status", "Vr_mps", "capture_speed_mps", "velocity_change_mps", *OUTPUTS,
-           "end_time_s", "error", "wall_time_s"]
+           "time_s", "end_time_s", "error", "wall_time_s"]
 
 
 def parse_speeds(text):
@@ -110,6 +107,7 @@ def run_shot(fmu_path, params, end_time, step):
         t, v = res["time"], res["projectile_velocity"]
         k = next(i for i in range(len(t)) if t[i] >= 0.9 * t[-1])
         row["velocity_change_mps"] = abs(float(v[-1] - v[k]))
+        row["time_s"] = float(t[-1])
         row["error"] = ""
     except Exception as e:  # a solver stop or a bad value: reported, not fatal
         row["error"] = " | ".join(errors) or str(e)
@@ -134,28 +132,21 @@ def capture_speed(p):
     return mp * p["impact_speed"] / (mp + mt)
 
 
-def classify(row, params, settle_tol):
-    """Adds the status, V_r, the capture speed and the end time to a shot's
-    row (`params`: every parameter's value, end_time included)."""
+STATUS = {1: "through", 2: "stopped", 0: "unsettled"}
+
+
+def classify(row, params):
+    """Adds the status (from the shot's shot_outcome), V_r, the capture
+    speed and the end time (the cap) to a shot's row (`params`: every
+    parameter's value, end_time included)."""
     row["capture_speed_mps"] = capture_speed(params)
     row["end_time_s"] = params["end_time"]
     row["Vr_mps"] = ""
     if row["error"]:
         row["status"] = "error"
-    elif row["projectile_velocity"] <= row["capture_speed_mps"]:
-        row["status"], row["Vr_mps"] = "stopped", 0.0
-    else:
-        settled = row["velocity_change_mps"] <= settle_tol * row["V_mps"]
-        inside = row["projectile_clearance"] <= 0.0
-        # At its present speed, would it cross the back face within another
-        # run of the same length?
-        within_reach = -row["projectile_clearance"] <= row["projectile_velocity"] * params["end_time"]
-        if settled and inside and not within_reach:
-            # Embedded, moving on with the plate and its fragments.
-            row["status"], row["Vr_mps"] = "stopped", 0.0
-        else:
-            row["status"] = "through" if settled and not inside else "unsettled"
-            row["Vr_mps"] = row["projectile_velocity"]
+        return row
+    row["status"] = STATUS[int(row["shot_outcome"])]
+    row["Vr_mps"] = 0.0 if row["status"] == "stopped" else row["projectile_velocity"]
     return row
 
 
@@ -168,7 +159,7 @@ def print_table(rows):
         values = [r.get(n, math.nan) for n in ("projectile_velocity", "projectile_clearance", "hole_radius",
                                                 "pulverized_fraction", "energy_error")]
         print(f"{r['V_mps']:9.1f} {r['status']:>9} {vr:>10} {values[0]:11.1f} {dv:>11} {1e3 * values[1]:10.2f} "
-              f"{1e6 * r['end_time_s']:8.1f} {1e3 * values[2]:9.3f} {values[3]:10.4f} {values[4]:10.4f} "
+              f"{1e6 * r.get('time_s', r['end_time_s']):8.1f} {1e3 * values[2]:9.3f} {values[3]:10.4f} {values[4]:10.4f} "
               f"{r['wall_time_s']:8.1f}")
 
 
@@ -301,11 +292,9 @@ def main(argv=None):
                     help="an FMU parameter for every shot (repeatable)")
     ap.add_argument("--step", type=float, default=None,
                     help="communication step in s, the resolution of the recorded velocity (default end_time/100)")
-    ap.add_argument("--settle-tol", type=float, default=0.01,
-                    help="a shot is settled when its velocity changed by at most this fraction of V over the last "
-                         "tenth of the run (default %(default)s)")
     ap.add_argument("--extend", type=int, default=0, metavar="K",
-                    help="run the unsettled shots again with twice the end time, up to K times (default %(default)s)")
+                    help="run the unsettled shots (no outcome by end_time, the cap) again with twice the end time, "
+                         "up to K times (default %(default)s)")
     ap.add_argument("--fit-unsettled", action="store_true",
                     help="fit the unsettled shots too (their velocities are not residual velocities)")
     ap.add_argument("--workers", type=int, default=os.cpu_count(), help="local worker processes (default: one per CPU)")
@@ -321,7 +310,7 @@ def main(argv=None):
 
     md = read_model_description(args.fmu)
     defaults = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
-    common = parse_sets(args.set, set(defaults), ap)
+    common = {"run_until": RUN_UNTIL_OUTCOME, **parse_sets(args.set, set(defaults), ap)}
     for name, value in (("particles_radial", args.particles_radial), ("end_time", args.end_time),
                         ("plate_thickness", args.plate_thickness)):
         if value is not None:
@@ -337,7 +326,7 @@ def main(argv=None):
     t0 = time.perf_counter()
     rows = run_jobs(run_shot, [(args.fmu, p, end_time, step) for p in shots], args.workers, args.scheduler)
     wall = time.perf_counter() - t0
-    rows = [classify(r, {**defaults, **p}, args.settle_tol) for r, p in zip(rows, shots)]
+    rows = [classify(r, {**defaults, **p}) for r, p in zip(rows, shots)]
     if args.extend < 0:
         ap.error(f"--extend {args.extend}: need K >= 0")
     for _ in range(args.extend):
@@ -353,7 +342,7 @@ def main(argv=None):
         wall += time.perf_counter() - t1
         for k, r, p in zip(again, redone, longer):
             shots[k] = p
-            rows[k] = classify(r, {**defaults, **p}, args.settle_tol)
+            rows[k] = classify(r, {**defaults, **p})
 
     print_table(rows)
     print(f"{len(rows)} shots in {wall:.1f} s -> {args.out}")
@@ -370,10 +359,8 @@ def main(argv=None):
         what = "fitted anyway (--fit-unsettled)" if args.fit_unsettled else "left out of the fit"
         times = sorted({r["end_time_s"] for r in unsettled})
         at = f"end_time = {times[0]:g} s" if len(times) == 1 else f"end_time = {times[0]:g} to {times[-1]:g} s"
-        print(f"warning: {len(unsettled)} shots unsettled at {at} (velocity still changing by "
-              f"more than {args.settle_tol:g} V over the last tenth of the run, or still in the plate and fast enough "
-              f"to cross its back face within another run of the same length: not residual velocities; run longer "
-              f"with --end-time or --extend), {what}: "
+        print(f"warning: {len(unsettled)} shots unsettled at {at} (neither perforated nor stopped by then: "
+              f"not residual velocities; run longer with --end-time or --extend), {what}: "
               + ", ".join(f"{r['V_mps']:g} m/s" for r in unsettled), file=sys.stderr)
     fitted = {"through", "stopped"} | ({"unsettled"} if args.fit_unsettled else set())
     data = [(r["V_mps"], r["Vr_mps"]) for r in rows if r["status"] in fitted]
