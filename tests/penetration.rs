@@ -287,8 +287,10 @@ fn the_seed_case_perforates_the_plate() {
 
 /// The seed's case as the scene sets it (6 across, 30 527 nodes; about
 /// 100 s on two cores): the residual velocity within the 10 % of
-/// the seed's 1240 m/s (measured 1123.6 m/s, −9.4 %), settled over the
-/// last 5 µs (−1.5 m/s). Run by `scripts/validate.sh`.
+/// the seed's 1240 m/s (measured 1123.6 m/s, −9.4 %, settled over the
+/// last 5 µs to −1.5 m/s; 1127.0 m/s with the trace-free carry and 1126.4
+/// m/s with the conservative carry, both 2026-11-28). Run by
+/// `scripts/validate.sh`.
 #[test]
 #[ignore = "slow: run by scripts/validate.sh"]
 fn the_seed_case_at_the_default_resolution_is_within_ten_percent() {
