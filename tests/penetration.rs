@@ -545,3 +545,53 @@ fn a_slow_perforation_is_not_called_stopped() {
         }
     }
 }
+
+/// The seed's case at 3 nodes across as the whole body (2546 nodes), run
+/// to 20 µs with the scene's default scheme: the plate's rim is free, so
+/// nothing outside acts on the two bodies, and the projectile, the plate's
+/// pulverized fragments and the plate's remainder carry the impact
+/// momentum between them. Measured: −12.695, −3.179 and −4.130 kg m/s of
+/// −20.004 kg m/s, the sum equal to it to 3e-16 (the nodal form's forces,
+/// the contact's impulses and the shifting's conservative carry each
+/// conserve momentum); the issue asks 1 %, this test 1e-9. The energy
+/// error is 0.43 % (bound 5 %), and the projectile is through the plate
+/// (`shot_outcome` 1) at 951.9 m/s.
+#[test]
+fn the_momentum_of_the_impact_is_shared_by_projectile_fragments_and_plate() {
+    let mut scene = Scene::builtin("penetration").unwrap();
+    scene.set("particles_radial", 3.0).unwrap();
+    let mut sim = Simulation::new(scene).unwrap();
+    sim.run().unwrap();
+    let o = |name: &str| sim.observable(name).unwrap();
+    let (m, v) = (node_masses(&sim), sim.field("velocity").unwrap());
+    let (body, loose) = (sim.field("body").unwrap(), sim.field("pulverized").unwrap());
+    let mut parts = [0.0; 3];
+    for i in 0..m.len() {
+        let part = if body[i] == 0.0 {
+            0
+        } else if loose[i] == 1.0 {
+            1
+        } else {
+            2
+        };
+        parts[part] += m[i] * v[3 * i + 2];
+    }
+    let mp = 16980.0 * std::f64::consts::PI * 25e-6 * 0.01;
+    let impact = -mp * 1500.0;
+    let sum: f64 = parts.iter().sum();
+    println!(
+        "projectile {:.4}, fragments {:.4}, plate {:.4}: sum {sum:.6} of {impact:.6} kg m/s ({:+.2e}); \
+         energy error {:.4}, outcome {}, {:.1} m/s",
+        parts[0],
+        parts[1],
+        parts[2],
+        sum / impact - 1.0,
+        o("energy_error"),
+        o("shot_outcome"),
+        o("projectile_velocity")
+    );
+    assert!((sum / impact - 1.0).abs() < 1e-9, "{parts:?} against {impact}");
+    assert!(parts.iter().all(|p| *p < 0.0), "{parts:?}");
+    assert!(o("energy_error") < 0.05);
+    assert_eq!(o("shot_outcome"), 1.0);
+}
