@@ -590,7 +590,10 @@ fn the_momentum_of_the_impact_is_shared_by_projectile_fragments_and_plate() {
         o("shot_outcome"),
         o("projectile_velocity")
     );
-    assert!((sum / impact - 1.0).abs() < 1e-9, "{parts:?} against {impact}");
+    assert!(
+        (sum / impact - 1.0).abs() < 1e-9,
+        "{parts:?} against {impact}"
+    );
     assert!(parts.iter().all(|p| *p < 0.0), "{parts:?}");
     assert!(o("energy_error") < 0.05);
     assert_eq!(o("shot_outcome"), 1.0);
