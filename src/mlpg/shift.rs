@@ -153,17 +153,18 @@ pub fn carry<const K: usize>(
 /// spread over the row). `f` and `w` cover the columns of `shapes` (real
 /// nodes and mirror images), `d` its rows; `delta` (resized to the
 /// columns) receives the change of each column's amount, the images' to be
-/// folded back onto their nodes. The rows' limits in parallel, the pairs in
-/// row order (the same bits for any number of threads).
+/// folded back onto their nodes; `share` is a buffer for the `θ_i`, reused
+/// from call to call. The rows' limits in parallel, the pairs in row order
+/// (the same bits for any number of threads).
 pub fn exchange<const K: usize>(
     shapes: &NodalShapes,
     f: &[[f64; K]],
     w: &[f64],
     d: &[[f64; 3]],
+    share: &mut Vec<Option<[f64; K]>>,
     delta: &mut Vec<[f64; K]>,
 ) {
-    let share: Vec<Option<[f64; K]>> = d
-        .par_iter()
+    d.par_iter()
         .enumerate()
         .map(|(i, di)| {
             if *di == [0.0; 3] {
@@ -189,7 +190,7 @@ pub fn exchange<const K: usize>(
                 }
             }))
         })
-        .collect();
+        .collect_into_vec(share);
     delta.clear();
     delta.resize(f.len(), [0.0; K]);
     for (i, theta) in share.iter().enumerate() {
@@ -284,8 +285,8 @@ mod tests {
                 }
             })
             .collect();
-        let mut delta = Vec::new();
-        exchange(&shapes, &f, &w, &d, &mut delta);
+        let (mut share, mut delta) = (Vec::new(), Vec::new());
+        exchange(&shapes, &f, &w, &d, &mut share, &mut delta);
         let scale: f64 = (0..n)
             .map(|i| w[i] * f[i].iter().map(|x| x.abs()).sum::<f64>())
             .sum();
@@ -305,7 +306,7 @@ mod tests {
         let i = 86;
         let mut d = vec![[0.0; 3]; n];
         d[i] = [0.03, -0.02, 0.04];
-        exchange(&shapes, &f, &w, &d, &mut delta);
+        exchange(&shapes, &f, &w, &d, &mut share, &mut delta);
         let x: [f64; 3] = std::array::from_fn(|k| pts[i][k] + d[i][k]);
         for c in 0..3 {
             let want = lin(x)[c] - f[i][c];

@@ -475,6 +475,8 @@ struct Scratch {
     /// The change of each node's momentum in the conservative carry
     /// (images after the real nodes).
     momentum: Vec<[f64; 3]>,
+    /// The limits' shares of the conservative carry.
+    share: Vec<Option<[f64; 3]>>,
 }
 
 fn one() -> u32 {
@@ -1786,7 +1788,14 @@ impl Mlpg3d {
             ke[0] = kinetic(&self.vel, &self.mass);
             let vel = extended(images, &self.vel, &mut scratch.ext_vel, mirror::vector);
             let mass = extended(images, &self.mass, &mut scratch.ext_mass, mirror::same);
-            exchange(&g.shapes, vel, mass, d, &mut scratch.momentum);
+            exchange(
+                &g.shapes,
+                vel,
+                mass,
+                d,
+                &mut scratch.share,
+                &mut scratch.momentum,
+            );
             images.fold(self.pos.len(), &mut scratch.momentum);
             for (i, p) in scratch.momentum.iter().enumerate().take(self.pos.len()) {
                 if *p == [0.0; 3] {
