@@ -205,7 +205,7 @@ MARKERS = {
 
 
 def fit_label(fit):
-    return f"Lambert-Jonas: V_bl = {fit.v_bl:.1f} m/s, a = {fit.a:.4f}, p = {fit.p:.3f}"
+    return f"Lambert-Jonas: V_bl = {fit.v_bl:.1f} +- {fit.v_bl_err:.1f} m/s, a = {fit.a:.4f}, p = {fit.p:.3f}"
 
 
 def curve(fit, rows):
@@ -366,7 +366,9 @@ def main(argv=None):
     data = [(r["V_mps"], r["Vr_mps"]) for r in rows if r["status"] in fitted]
     try:
         fit = lambert_jonas.fit(data)
-        print(f"ballistic limit V_bl = {fit.v_bl:.1f} m/s, a = {fit.a:.4f}, p = {fit.p:.3f}, "
+        print(f"ballistic limit V_bl = {fit.v_bl:.1f} +- {fit.v_bl_err:.1f} m/s (shots bracket "
+              f"{fit.bracket[0]:.1f}-{fit.bracket[1]:.1f}), a = {fit.a:.4f} +- {fit.a_err:.4f}, "
+              f"p = {fit.p:.3f} +- {fit.p_err:.3f}, "
               f"rms residual {fit.rms:.2f} m/s ({len(data)} shots fitted)")
     except ValueError as e:
         fit = None

@@ -15,6 +15,12 @@ grid search refined with Nelder-Mead. Shots that did not perforate
 (V_r = 0) bound V_bl from below: V_bl is searched between the fastest of
 them and the slowest perforating shot.
 
+Uncertainty: the shots bracket V_bl (`bracket`: the fastest stopped shot
+and the slowest perforating one, whatever the curve), and the jackknife
+gives the standard errors of V_bl, a and p (`v_bl_err`, `a_err`, `p_err`:
+the fit repeated with each shot left out, where at least two perforating
+shots remain; sqrt((n - 1)/n sum (x_i - mean)^2) over the n refits).
+
 This module is what `examples/ballistic_limit.py` (the sweep of the
 penetration FMU, to come with the `penetration` scene) will call. On its own:
 
@@ -29,12 +35,19 @@ from dataclasses import dataclass
 
 @dataclass
 class Fit:
-    """A fitted Lambert-Jonas curve and its residual."""
+    """A fitted Lambert-Jonas curve, its residual and its uncertainty."""
 
     a: float
     p: float
     v_bl: float
     rms: float  # root-mean-square residual speed over all shots (m/s)
+    # The fastest stopped shot (0 if none) and the slowest perforating one
+    # (m/s): V_bl lies between them whatever the curve.
+    bracket: tuple = (0.0, math.inf)
+    # Jackknife standard errors (m/s, 1, 1); NaN with fewer than two refits.
+    v_bl_err: float = math.nan
+    a_err: float = math.nan
+    p_err: float = math.nan
 
     def residual_speed(self, v):
         """V_r of the curve at impact speed v."""
@@ -90,8 +103,32 @@ def _nelder_mead(f, x0, step, iters=400, tol=1e-12):
 
 def fit(shots, p_range=(1.0, 6.0)):
     """Fits the curve to `shots`, a list of (V, V_r) in m/s (V_r = 0 where
-    the plate stopped the projectile). Needs at least two perforating shots;
-    raises ValueError otherwise or when a speed is negative or not finite."""
+    the plate stopped the projectile), with its bracket and jackknife
+    standard errors. Needs at least two perforating shots; raises
+    ValueError otherwise or when a speed is negative or not finite."""
+    best = _fit(shots, p_range)
+    shots = [(float(v), float(vr)) for v, vr in shots]
+    refits = []
+    for k in range(len(shots)):
+        rest = shots[:k] + shots[k + 1:]
+        if sum(1 for _, vr in rest if vr > 0) >= 2:
+            refits.append(_fit(rest, p_range))
+    n = len(refits)
+
+    def err(values):
+        if n < 2:
+            return math.nan
+        mean = sum(values) / n
+        return math.sqrt((n - 1) / n * sum((x - mean) ** 2 for x in values))
+
+    best.v_bl_err = err([f.v_bl for f in refits])
+    best.a_err = err([f.a for f in refits])
+    best.p_err = err([f.p for f in refits])
+    return best
+
+
+def _fit(shots, p_range):
+    """The least-squares curve of `shots` ([`fit`] without the errors)."""
     shots = [(float(v), float(vr)) for v, vr in shots]
     for v, vr in shots:
         if not (math.isfinite(v) and math.isfinite(vr)) or v <= 0 or vr < 0:
@@ -125,7 +162,7 @@ def fit(shots, p_range=(1.0, 6.0)):
     x, _ = _nelder_mead(cost, start, [(hi - lo) / 40, (phi - plo) / 40])
     v_bl, p = clamp(x)
     a, sse = _best_a(shots, v_bl, p)
-    return Fit(a=a, p=p, v_bl=v_bl, rms=math.sqrt(sse / len(shots)))
+    return Fit(a=a, p=p, v_bl=v_bl, rms=math.sqrt(sse / len(shots)), bracket=(lo, hi))
 
 
 def main(argv):
@@ -137,8 +174,10 @@ def main(argv):
     shots = [(float(r["V_mps"]), float(r["Vr_mps"])) for r in rows]
     result = fit(shots)
     print(
-        f"ballistic limit V_bl = {result.v_bl:.1f} m/s, a = {result.a:.4f}, "
-        f"p = {result.p:.3f}, rms residual {result.rms:.2f} m/s ({len(shots)} shots)"
+        f"ballistic limit V_bl = {result.v_bl:.1f} +- {result.v_bl_err:.1f} m/s "
+        f"(shots bracket {result.bracket[0]:.1f}-{result.bracket[1]:.1f}), "
+        f"a = {result.a:.4f} +- {result.a_err:.4f}, p = {result.p:.3f} +- {result.p_err:.3f}, "
+        f"rms residual {result.rms:.2f} m/s ({len(shots)} shots)"
     )
     return 0
 

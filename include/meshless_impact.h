@@ -323,6 +323,8 @@ const char *mi_result_description(int32_t code);
  *     mm, D0 = 7.62 mm (assumed; the seed misprints them), to 50 us
  * - `"penetration"`: Ballistic penetration in 3-D by MLPG: tungsten rod (10 x 10 mm, 1500 m/s)
  *   through a 5 mm AD85 plate
+ * - `"plate_impact"`: Plate impact in uniaxial strain: AD85 flyer (2 mm) on an AD85 target (4 mm)
+ *   at 300 m/s
  *
  * On `MI_OK`, `*out` receives a new handle that the caller must release with
  * `mi_sim_free`; on failure `*out` is left unchanged (`MI_NULL_POINTER`,

@@ -90,8 +90,8 @@ pub use error::{Error, MomentMethod, Result};
 pub use isa::Isa;
 pub use model::{Model, ModelState};
 pub use observe::{
-    Field, FieldSpec, History, NOH_OBSERVABLES, ObservableSpec, Snapshot, TAYLOR_OBSERVABLES,
-    write_pvd,
+    Field, FieldSpec, History, LOG10_NO_CRACKS, NOH_OBSERVABLES, ObservableSpec,
+    PLATE_IMPACT_OBSERVABLES, Snapshot, TAYLOR_OBSERVABLES, write_pvd,
 };
 pub use rod::{profile_deviation, profile_radius};
 pub use scene::noh::NohParams;
@@ -102,7 +102,7 @@ pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
 pub use scene::{Scene, SceneKind, builtin_names};
 pub use sim::{Progress, Simulation};
 pub use solver::axisymmetric::ENERGY_ERROR_BOUND;
-pub use uniaxial::{Layer, PlateImpact};
+pub use uniaxial::{FreeSurfaceReading, Layer, PLATE_IMPACT_FIELDS, PlateImpact};
 
 /// Material models and their composition into a [`Material`](materials::Material):
 /// an equation of state ([`Eos`](materials::Eos)), a strength model

@@ -380,3 +380,23 @@ observables! {
     energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
     shot_outcome: "1", "what the shot has come to, decided by the state (README, \"Ballistic limit\"): 0 undecided, 1 perforated (the projectile wholly past the plate's original back face and faster along the flight than the intact plate around the hole), 2 stopped (not perforated, and no faster than the plate's centre of mass)";
 }
+
+/// The log10 crack-density field's value where there are no cracks (a
+/// metal, a projectile), and its floor.
+pub const LOG10_NO_CRACKS: f64 = -12.0;
+
+observables! {
+    PLATE_IMPACT_OBSERVABLES, "Observables of the plate-impact scene (a flyer on a target in uniaxial strain), in output order; stresses and energies per unit area of the plates.",
+    free_surface_velocity: "m/s", "velocity of the target's free (back) surface, positive along the flight";
+    precursor_velocity: "m/s", "the free surface's velocity at its first local maximum after the first wave arrived (0 before): the elastic precursor, or the whole elastic pulse under the HEL";
+    precursor_stress: "Pa", "rho0 c_L u / 2 of the precursor with the target's reference density and longitudinal sound speed: the Hugoniot elastic limit when the impact passes it";
+    peak_velocity: "m/s", "the peak of the first pulse: the highest free-surface velocity before it first fell by 5 % of impact_speed";
+    pullback_velocity: "m/s", "the peak less the lowest velocity after it, until the velocity rose again by 5 % of impact_speed (the spall signal or the next pulse): the pullback";
+    spall_strength: "Pa", "rho0 c_B du / 2 of the pullback du with the target's bulk sound speed, once a target cell has failed in tension (0 before, and in a target that has not)";
+    spall_depth: "m", "depth below the target's impact face (reference configuration) of the first target cell that failed in tension: a ceramic pulverized in expansion (0 while none has)";
+    max_damage: "1", "largest crack density gamma = N0* a^3 in the target (0 for a metal target)";
+    kinetic_energy: "J/m2", "kinetic energy of both plates per unit area";
+    internal_energy: "J/m2", "stress work stored and dissipated in both plates per unit area";
+    contact_dissipation: "J/m2", "kinetic energy lost in the inelastic meeting of the contact nodes, per unit area";
+    energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
+}

@@ -939,10 +939,11 @@ fn only_the_documented_scene_names_are_accepted() {
         assert_eq!(d.to_str().unwrap(), "unknown scene name");
     }
     let names = meshless_impact::builtin_names();
-    assert_eq!(names.len(), 17);
+    assert_eq!(names.len(), 18);
     assert_eq!(names[3], "penetration");
-    assert_eq!(names[15], "table1-12");
-    assert_eq!(names[16], "taylor3d-aisi310");
+    assert_eq!(names[4], "plate_impact");
+    assert_eq!(names[16], "table1-12");
+    assert_eq!(names[17], "taylor3d-aisi310");
     for name in &names {
         let s = new_sim(name);
         let scene = Scene::builtin(name).unwrap();

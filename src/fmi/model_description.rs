@@ -29,6 +29,7 @@ pub fn base_units(unit: &str) -> Option<&'static [(&'static str, i32)]> {
         "kg/m3" => &[("kg", 1), ("m", -3)],
         "Pa" => &[("kg", 1), ("m", -1), ("s", -2)],
         "J" => &[("kg", 1), ("m", 2), ("s", -2)],
+        "J/m2" => &[("kg", 1), ("s", -2)],
         "J/(kg.K)" => &[("m", 2), ("s", -2), ("K", -1)],
         _ => return None,
     })

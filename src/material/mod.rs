@@ -166,7 +166,7 @@ pub struct Loading<T: SymTensor> {
 }
 
 /// The mechanical state of a particle that a material updates.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Point<T> {
     /// Deviatoric stress (Pa).
     pub deviator: T,

@@ -348,6 +348,21 @@ impl Penetration {
                     _ => 0.0,
                 })
                 .collect(),
+            "log10_damage" => damage()
+                .map(|(c, v, g)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => c
+                        .crack_density(v.crack_size)
+                        .log10()
+                        .max(crate::observe::LOG10_NO_CRACKS),
+                    _ => crate::observe::LOG10_NO_CRACKS,
+                })
+                .collect(),
+            "crack_size" => damage()
+                .map(|(_, v, g)| match v {
+                    Some(v) if g == 1 => v.crack_size,
+                    _ => 0.0,
+                })
+                .collect(),
             "pulverized" => damage()
                 .map(|(_, v, _)| v.is_some_and(|v| v.pulverized.is_some()) as u8 as f64)
                 .collect(),
@@ -361,7 +376,10 @@ impl Penetration {
 
 /// The node fields of a penetration run: those of the 3-D solver, then the
 /// body of each node (0 projectile, 1 plate), the crack density γ, the
-/// pulverized flag, the porosity and the node mass.
+/// pulverized flag, the porosity, the node mass, and, so that partial
+/// damage shows, log10 γ (floored at [`crate::LOG10_NO_CRACKS`],
+/// its value at the projectile's nodes) and the crack radius a (m; 0 at
+/// the projectile's nodes).
 pub const PENETRATION_FIELDS: &[FieldSpec] = &{
     const fn scalar(
         name: &'static str,
@@ -380,8 +398,10 @@ pub const PENETRATION_FIELDS: &[FieldSpec] = &{
         scalar("pulverized", "bool", &["pulverized"]),
         scalar("porosity", "1", &["f"]),
         scalar("mass", "kg", &["m"]),
+        scalar("log10_damage", "1", &["log10_gamma"]),
+        scalar("crack_size", "m", &["a"]),
     ];
-    let mut out = [own[0]; MLPG_FIELDS.len() + 5];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 7];
     let mut i = 0;
     while i < out.len() {
         out[i] = if i < MLPG_FIELDS.len() {

@@ -20,6 +20,34 @@ const HALF_WIDTH: f64 = 20e-3;
 /// Critical crack density of pulverization (the top of the colour scale).
 const PULVERIZED: f64 = 0.75;
 
+/// The crack density past which a node counts as damaged: 1 % of
+/// pulverization, as the observable `damaged_fraction` counts it.
+const DAMAGED: f64 = 0.01 * PULVERIZED;
+
+/// The half-angle from the axis (degrees) of the cone the damaged plate
+/// nodes fill (`points` (x, z) in m of the slice, `gamma` their crack
+/// densities): the damaged zone's largest distance from the axis in the
+/// plate's back layer (z within one spacing of `-thickness`) less that in
+/// its top layer (z within one spacing of 0), over the thickness; `None`
+/// when either layer holds no damaged node.
+fn cone_half_angle(
+    points: &[(f64, f64)],
+    gamma: &[f64],
+    thickness: f64,
+    spacing: f64,
+) -> Option<f64> {
+    let reach = |z0: f64| {
+        points
+            .iter()
+            .zip(gamma)
+            .filter(|((_, z), g)| (z - z0).abs() < spacing && **g >= DAMAGED)
+            .map(|((x, _), _)| x.abs())
+            .reduce(f64::max)
+    };
+    let (top, back) = (reach(0.0)?, reach(-thickness)?);
+    Some(((back - top) / thickness).atan().to_degrees())
+}
+
 pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
     // The scene's default (6 across) in the full plan; 4 across (7463
     // nodes, about 20 s) in the quick one.
@@ -91,6 +119,7 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
             "hole_radius_mm",
             "damaged_fraction",
             "pulverized_fraction",
+            "cone_half_angle_deg",
             "energy_error",
         ],
     );
@@ -99,7 +128,34 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
         let k = h.times.iter().position(|&s| s >= t).unwrap_or(h.len() - 1);
         col(name)[k]
     };
+    let param = |name: &str| {
+        run.scene
+            .as_ref()
+            .and_then(|s| s.get(name).ok())
+            .unwrap_or(f64::NAN)
+    };
+    let thickness = param("plate_thickness");
+    // The colour scale: log10 of the crack density, from the plate's
+    // initial one to pulverization.
+    let gamma0 = param("plate_flaw_density") * param("plate_crack_size").powi(3);
+    let scale = (gamma0.log10().floor(), PULVERIZED.log10());
+    let mut slices = Vec::new();
     for snap in &run.snapshots {
+        let body = &snap.field("body").expect("penetration field").data;
+        let gamma = &snap.field("damage").expect("penetration field").data;
+        let (mut plate, mut values, mut projectile) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, p) in snap.positions.iter().enumerate() {
+            if p[1].abs() >= 0.5 * spacing {
+                continue;
+            }
+            if body[i] == 0.0 {
+                projectile.push((p[0], p[2]));
+            } else {
+                plate.push((p[0], p[2]));
+                values.push(gamma[i]);
+            }
+        }
+        let cone = cone_half_angle(&plate, &values, thickness, spacing);
         let t = snap.time;
         zones.push(vec![
             sig(t * 1e6, 4),
@@ -107,41 +163,41 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
             sig(at(t, "hole_radius") * 1e3, 4),
             sig(at(t, "damaged_fraction"), 3),
             sig(at(t, "pulverized_fraction"), 3),
+            cone.map_or("none".into(), |a| sig(a, 3)),
             sig(at(t, "energy_error"), 3),
         ]);
+        slices.push((t, plate, values, projectile));
     }
     doc.para(&format!(
-        "Crack density γ of the plate in the slice |y| < {:.2} mm through the axis (x, z in \
-         mm; the plate's top face at z = 0), the projectile grey; γ = {PULVERIZED} is \
-         pulverized. The fields at each time are in the VTK snapshots of \
-         `meshless-impact run penetration --vtk-dir DIR --vtk-times 4e-6,8e-6,12e-6`.",
-        0.5e3 * spacing
+        "log10 of the crack density γ of the plate in the slice |y| < {:.2} mm through the \
+         axis (x, z in mm; the plate's top face at z = 0), the projectile grey, from the \
+         plate's initial γ0 = {} (log10 {:.0}) to γ = {PULVERIZED}, pulverized, so that \
+         partial damage shows. The table's cone half-angle is measured from the axis: the \
+         damaged zone's (γ ≥ {DAMAGED}) reach from the axis in the back layer less that in \
+         the top layer, over the thickness (\"none\" when a layer holds no damaged node); \
+         the classical ceramic-armour models put it at 60-70° (Florence's a + 2h gives \
+         63°). The fields at each time, `log10_damage` and `crack_size` among them, are in \
+         the VTK snapshots of `meshless-impact run penetration --vtk-dir DIR --vtk-times \
+         4e-6,8e-6,12e-6`.",
+        0.5e3 * spacing,
+        sig(gamma0, 3),
+        scale.0,
     ));
-    for snap in &run.snapshots {
-        let body = &snap.field("body").expect("penetration field").data;
-        let gamma = &snap.field("damage").expect("penetration field").data;
-        let mut plate = Vec::new();
-        let mut values = Vec::new();
-        let mut projectile = Vec::new();
-        for (i, p) in snap.positions.iter().enumerate() {
-            if p[1].abs() >= 0.5 * spacing {
-                continue;
-            }
-            let q = (p[0] * 1e3, p[2] * 1e3);
-            if body[i] == 0.0 {
-                projectile.push(q);
-            } else {
-                plate.push(q);
-                values.push(gamma[i]);
-            }
-        }
+    for (time, plate, gamma, projectile) in &slices {
+        let mm = |q: &(f64, f64)| (q.0 * 1e3, q.1 * 1e3);
+        let plate: Vec<(f64, f64)> = plate.iter().map(mm).collect();
+        let projectile: Vec<(f64, f64)> = projectile.iter().map(mm).collect();
+        let values: Vec<f64> = gamma
+            .iter()
+            .map(|g| g.max(1e-300).log10().max(scale.0))
+            .collect();
         let zs = plate.iter().chain(&projectile).map(|q| q.1);
         let (z0, z1) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| {
             (a.min(z), b.max(z))
         });
-        let label = format!("{:.0}us", (snap.time * 1e6).round());
+        let label = format!("{:.0}us", (time * 1e6).round());
         let file = format!("penetration_damage_{label}.svg");
-        let title = format!("Penetration, t = {:.1} µs: crack density", snap.time * 1e6);
+        let title = format!("Penetration, t = {:.1} µs: log10 crack density", time * 1e6);
         let w = HALF_WIDTH * 1e3;
         plot::plane(
             &doc.dir.join(&file),
@@ -151,7 +207,7 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
                 y: "z (mm)",
                 xs: (-w, w),
                 ys: (z0 - 1.0, z1 + 1.0),
-                values: (0.0, PULVERIZED),
+                values: scale,
             },
             &plate,
             &values,

@@ -180,7 +180,70 @@ fn cases(plan: &Plan) -> Vec<Def> {
     .chain(invalid_inputs("", "taylor"))
     .chain(cases_3d(plan))
     .chain(cases_penetration(plan))
+    .chain(cases_plate_impact())
     .collect()
+}
+
+/// The rows of the plate-impact scene (one-dimensional, each a second at
+/// most in both plans): AD85 on AD85 at 10, 100, 1000 and 3000 m/s, a
+/// tungsten flyer at 3000 m/s, plates two cells thick, and each kind of
+/// invalid input.
+fn cases_plate_impact() -> Vec<Def> {
+    let p = "plate_impact";
+    let mut rows: Vec<Def> = [10.0, 100.0, 1000.0, 3000.0]
+        .into_iter()
+        .map(|v| {
+            def(
+                format!("plate_impact_speed_{v}"),
+                p,
+                vec![("impact_speed", v)],
+            )
+        })
+        .collect();
+    rows.extend([
+        def(
+            "plate_impact_tungsten_3000",
+            p,
+            vec![("flyer_material", 3.0), ("impact_speed", 3000.0)],
+        ),
+        def(
+            "plate_impact_thin",
+            p,
+            vec![("flyer_thickness", 20e-6), ("target_thickness", 20e-6)],
+        ),
+        def(
+            "plate_impact_invalid_material",
+            p,
+            vec![("target_material", 7.0)],
+        ),
+        def(
+            "plate_impact_invalid_thickness",
+            p,
+            vec![("target_thickness", -1e-3)],
+        ),
+        def(
+            "plate_impact_invalid_speed_nan",
+            p,
+            vec![("impact_speed", f64::NAN)],
+        ),
+        def("plate_impact_invalid_cell", p, vec![("cell", 0.0)]),
+        def(
+            "plate_impact_invalid_cells",
+            p,
+            vec![
+                ("flyer_thickness", 0.1),
+                ("target_thickness", 0.1),
+                ("cell", 1e-7),
+            ],
+        ),
+        def(
+            "plate_impact_invalid_porosity",
+            p,
+            vec![("plate_porosity", 0.7)],
+        ),
+        def("plate_impact_invalid_name", p, vec![("impact_sped", 300.0)]),
+    ]);
+    rows
 }
 
 /// The rows of the penetration scene (issue of the ballistic run): impact

@@ -5,6 +5,7 @@
 pub mod noh;
 pub mod params;
 pub mod penetration;
+pub mod plate_impact;
 pub mod registry;
 pub mod table1;
 pub mod taylor;
@@ -732,7 +733,7 @@ mod tests {
                     let msg = e.to_string();
                     assert!(
                         msg.starts_with(&format!(
-                            "unknown scene `{name}`; allowed: taylor, noh, taylor3d, penetration, table1-1,"
+                            "unknown scene `{name}`; allowed: taylor, noh, taylor3d, penetration, plate_impact, table1-1,"
                         )),
                         "{msg}"
                     );
@@ -758,7 +759,11 @@ mod tests {
                     scene,
                     Scene::default_of(SceneKind::named("penetration").unwrap())
                 ),
-                4..16 => assert_eq!(scene, rows[k - 4].scene(), "{name}"),
+                4 => assert_eq!(
+                    scene,
+                    Scene::default_of(SceneKind::named("plate_impact").unwrap())
+                ),
+                5..17 => assert_eq!(scene, rows[k - 5].scene(), "{name}"),
                 _ => {
                     assert_eq!(name, "taylor3d-aisi310");
                     assert_eq!(scene.kind().name(), "taylor3d");
@@ -767,7 +772,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(builtin_names().len(), 17);
+        assert_eq!(builtin_names().len(), 18);
     }
 
     /// A `[material]` table chooses the models; the table then lists only
@@ -879,8 +884,9 @@ mod tests {
             }
         }
         // taylor's and taylor3d's schemes for each of four choices,
-        // penetration's scheme and its run_until.
-        assert_eq!(seen, 10);
+        // penetration's scheme and its run_until, plate_impact's two
+        // plate materials.
+        assert_eq!(seen, 12);
     }
 
     /// A scheme sets its knobs; a knob set by hand overrides it whichever

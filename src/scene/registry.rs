@@ -107,6 +107,7 @@ pub static SCENES: &[&SceneRow] = &[
     &super::noh::ROW,
     &super::taylor3d::ROW,
     &super::penetration::ROW,
+    &super::plate_impact::ROW,
 ];
 
 /// The row called `name`.

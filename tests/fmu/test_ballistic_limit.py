@@ -98,8 +98,9 @@ def test_sweep_on_the_local_process_pool(tmp_path, tmp_path_factory):
     assert "shot at 1500 m/s: ERROR (left out of the fit): fmi3DoStep: the solver stopped: particle spacing" in log
     assert "warning: 2 shots unsettled at end_time = 1e-05 s" in log and "fitted anyway" in log
     fit = lj.fit(fitted)
-    assert (f"ballistic limit V_bl = {fit.v_bl:.1f} m/s, a = {fit.a:.4f}, p = {fit.p:.3f}, "
-            f"rms residual {fit.rms:.2f} m/s (3 shots fitted)") in log, log
+    assert (f"ballistic limit V_bl = {fit.v_bl:.1f} +- {fit.v_bl_err:.1f} m/s (shots bracket "
+            f"{fit.bracket[0]:.1f}-{fit.bracket[1]:.1f}), a = {fit.a:.4f} +- {fit.a_err:.4f}, "
+            f"p = {fit.p:.3f} +- {fit.p_err:.3f}, rms residual {fit.rms:.2f} m/s (3 shots fitted)") in log, log
     assert 100.0 <= fit.v_bl < 800.0
     svg = ET.parse(plot).getroot()
     ns = "{http://www.w3.org/2000/svg}"

@@ -51,6 +51,22 @@ def test_scatter_of_two_percent_moves_the_limit_little():
         assert abs(f.residual_speed(v) - vr) < 0.03 * max(TRUE.residual_speed(v), 1.0) + 5.0
 
 
+def test_the_errors_are_nil_for_exact_shots_and_cover_the_truth_with_scatter():
+    """Exact shots: the jackknife errors vanish (to the fit's own
+    tolerance) and the shots bracket the limit. With +-2 % scatter the
+    true V_bl lies within three standard errors of the fit, and within
+    the bracket."""
+    exact = lj.fit(shots(TRUE))
+    assert exact.v_bl_err < 1e-3 and exact.a_err < 1e-6, exact
+    lo, hi = exact.bracket
+    assert lo < TRUE.v_bl < hi
+    scatter = [0.0, 0.0, 0.0, 0.02, -0.02, 0.015, -0.01, 0.02, -0.015]
+    f = lj.fit(shots(TRUE, scatter))
+    assert f.v_bl_err > 0 and math.isfinite(f.v_bl_err), f
+    assert abs(f.v_bl - TRUE.v_bl) < 3 * f.v_bl_err + 1e-9, f
+    assert f.bracket[0] < f.v_bl < f.bracket[1]
+
+
 def test_shot_lists_it_cannot_fit_are_refused():
     with pytest.raises(ValueError, match="at least 2"):
         lj.fit([(500, 0.0), (1000, 300.0)])

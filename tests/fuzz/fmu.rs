@@ -50,8 +50,12 @@ pub struct Info {
     pub fmu: fmi::Fmu,
     /// Its variables.
     vars: Vec<fmi::Variable>,
+    /// The value reference of its `particles_radial`, the lattice's
+    /// resolution, if its scene has one (a scene without one, such as
+    /// `plate_impact`, is cheap at its default: tests/fuzz.rs measures it).
+    pr: Option<u32>,
     /// The coarse `particles_radial` of its scene (tests/fuzz.rs's
-    /// `coarse_radial`), and the default.
+    /// `coarse_radial`), and the default; 0 for a scene without one.
     radial: i32,
     default_radial: i32,
     /// Whether a coarse run to its end is cheap (steps of any size).
@@ -63,11 +67,6 @@ pub struct Info {
 }
 
 impl Info {
-    /// The value reference of a variable.
-    fn vr(&self, name: &str) -> u32 {
-        self.vars.iter().find(|v| v.name == name).unwrap().vr
-    }
-
     /// `particles_radial` values a case sets: cheap lattices, and values
     /// out of range. (Large in-range lattices take seconds to build: not
     /// fuzzed here.)
@@ -739,16 +738,17 @@ fn reference_state(info: &Info) -> Bytes {
             (f, _, _) => unsafe { f.free() },
         }
     };
-    let pr = info.vr("particles_radial");
     let mut m = Model::new(info);
     let mut s = null_mut();
     let mut size = 0;
     // SAFETY: a live instance; valid arrays and outputs; the state freed once.
     let data = unsafe {
-        assert_eq!(
-            f.set(VarType::Int32, &pr, 1, Some(&[info.radial as f64]), 1),
-            OK
-        );
+        if let Some(pr) = info.pr {
+            assert_eq!(
+                f.set(VarType::Int32, &pr, 1, Some(&[info.radial as f64]), 1),
+                OK
+            );
+        }
         assert_eq!(f.enter_init(0.0, None), OK);
         assert_eq!(f.exit_init(), OK);
         for _ in 0..3 {
@@ -1057,8 +1057,11 @@ impl<F: Fmu> Case<F> {
             VarType::Enumeration,
         ]));
         let mut vrs = self.refs(rng);
-        if ty == VarType::Int32 && rng.below(2) == 0 {
-            vrs = vec![self.info.vr("particles_radial")];
+        if let Some(pr) = self.info.pr
+            && ty == VarType::Int32
+            && rng.below(2) == 0
+        {
+            vrs = vec![pr];
         } else if rng.below(2) == 0 {
             // Only parameters of this type: the sets that may work.
             vrs.retain(|&r| {
@@ -1142,8 +1145,9 @@ impl<F: Fmu> Case<F> {
         if ty == VarType::Float64 && nvr > 0 {
             self.m.tuned = true;
         }
-        let pr = self.info.vr("particles_radial");
-        if let Some(k) = vrs.iter().rposition(|&r| r == pr) {
+        if let Some(pr) = self.info.pr
+            && let Some(k) = vrs.iter().rposition(|&r| r == pr)
+        {
             self.m.radial = if code == OK {
                 Some(values[k] as i32)
             } else {
@@ -1215,7 +1219,7 @@ impl<F: Fmu> Case<F> {
             if r == fmi::VR_TIME {
                 assert_eq!(x, self.m.time, "{what}");
             }
-            if r == self.info.vr("particles_radial")
+            if Some(r) == self.info.pr
                 && let Some(n) = self.m.radial
             {
                 assert_eq!(x, n as f64, "{what}");
@@ -1461,9 +1465,11 @@ impl<F: Fmu> Case<F> {
     /// Sets `particles_radial` to a cheap value (at the default, 20, a
     /// thin rod takes minutes per microsecond).
     fn cheapen(&mut self, rng: &mut Rng) {
+        let Some(pr) = self.info.pr else {
+            return;
+        };
         let logged = self.errors_logged();
         let n = self.info.radial + rng.below(2) as i32;
-        let pr = self.info.vr("particles_radial");
         let code = unsafe { self.fmu.set(VarType::Int32, &pr, 1, Some(&[n as f64]), 1) };
         self.check(
             format!("set particles_radial {n}"),
@@ -1561,13 +1567,18 @@ impl Pool {
                     .param_specs()
                     .iter()
                     .find(|p| p.name == "particles_radial")
-                    .expect("an FMU's scene has particles_radial")
-                    .default as i32;
+                    .map_or(0, |p| p.default as i32);
+                let vars = fmu.variables();
+                let pr = vars
+                    .iter()
+                    .find(|v| v.name == "particles_radial")
+                    .map(|v| v.vr);
                 let steps_per_second = 1.0 / e.step_secs;
                 let mut info = Info {
                     fmu,
-                    vars: fmu.variables(),
-                    radial: e.radial as i32,
+                    vars,
+                    pr,
+                    radial: if pr.is_some() { e.radial as i32 } else { 0 },
                     default_radial,
                     to_end: e.to_end,
                     h: (e.dt * 0.1 * steps_per_second).clamp(e.dt, 2.1e-6),

@@ -1,0 +1,238 @@
+//! The `plate_impact` scene: a flyer plate strikes a target plate in
+//! uniaxial strain ([`crate::PlateImpact`], `src/uniaxial.rs`), the
+//! experiment that ceramic models are calibrated with. Either plate is the
+//! Rajendran-Grove ceramic (the `plate_` block, defaults AD85 as in
+//! `penetration`) or one of the metal presets ([`crate::Preset`]). The
+//! target's free-surface velocity is read as an experimenter reads a VISAR
+//! record: the elastic precursor gives the Hugoniot elastic limit
+//! `rho0 c_L u / 2`, and the pullback after the peak gives the spall
+//! strength `rho0 c_B du / 2` once the target has failed in tension.
+//!
+//! The default is the symmetric spall experiment: AD85 2 mm thick on AD85
+//! 4 mm thick at 300 m/s (about 4.4 GPa elastic, under the HEL), so that
+//! the release waves from the two free faces meet mid-way through the
+//! target.
+
+use super::Scene;
+use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
+use super::registry::{FmuIdentity, SceneRow, no_variants, restore};
+use crate::budget::MemoryPerNode;
+use crate::error::{Error, Result};
+use crate::material::Damage;
+use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
+use crate::material::presets::Preset;
+use crate::observe::PLATE_IMPACT_OBSERVABLES;
+use crate::uniaxial::{Layer, PlateImpact};
+use std::collections::BTreeMap;
+
+/// The registry row of the `plate_impact` scene.
+pub static ROW: SceneRow = SceneRow {
+    name: "plate_impact",
+    title: "Plate impact in uniaxial strain: AD85 flyer (2 mm) on an AD85 target (4 mm) at 300 m/s",
+    params: PLATE_IMPACT_PARAMS,
+    material: None,
+    observables: PLATE_IMPACT_OBSERVABLES,
+    reference: BTreeMap::new,
+    variants: no_variants,
+    check: |s| setup(s).map(|_| ()),
+    nodes: |s| {
+        let v = |name: &str| s.get(name).expect("a plate_impact parameter");
+        (v("flyer_thickness") + v("target_thickness")) / v("cell")
+    },
+    // A cell holds its node, its material point and its fields: about
+    // 0.4 kB (the ceramic point is the largest part); twice that for room.
+    memory: MemoryPerNode { bytes: 1000.0 },
+    build: |s: &Scene| Ok(Box::new(setup(s)?)),
+    restore: restore::<PlateImpact>,
+    fmu: Some(FmuIdentity {
+        model_identifier: "PlateImpact",
+        model_name: "PlateImpact",
+        description: "Plate impact in uniaxial strain: a flyer plate on a target plate, either the \
+                      Rajendran-Grove ceramic or a metal preset; the target's free-surface velocity, \
+                      its elastic precursor (HEL) and its spall strength",
+    }),
+};
+
+/// The materials a plate can be made of: the ceramic of the `plate_` block,
+/// then the metal presets in their listing order ([`PRESETS`]).
+pub const LAYER_MATERIALS: &[Level] = &[
+    Level {
+        name: "ceramic",
+        description: "the Rajendran-Grove ceramic of the plate_ parameters (defaults: AD85)",
+        sets: &[],
+    },
+    Level {
+        name: "steel_4340_house",
+        description: "preset steel_4340_house",
+        sets: &[],
+    },
+    Level {
+        name: "aisi310_bilinear",
+        description: "preset aisi310_bilinear",
+        sets: &[],
+    },
+    Level {
+        name: "tungsten_seed",
+        description: "preset tungsten_seed",
+        sets: &[],
+    },
+    Level {
+        name: "ofhc_copper_jc",
+        description: "preset ofhc_copper_jc",
+        sets: &[],
+    },
+    Level {
+        name: "aluminium_6061t6_jc",
+        description: "preset aluminium_6061t6_jc",
+        sets: &[],
+    },
+    Level {
+        name: "copper_wilkins_bilinear",
+        description: "preset copper_wilkins_bilinear",
+        sets: &[],
+    },
+];
+
+/// The plates, the speed and the cells, before the ceramic's block.
+const BEFORE: &[ParamSpec] = &[
+    row(
+        "impact_speed",
+        "m/s",
+        300.0,
+        Range::closed(1.0, 1.0e4),
+        "speed of the flyer toward the target",
+    ),
+    levels_spec(
+        "flyer_material",
+        0,
+        LAYER_MATERIALS,
+        "material of the flyer: 0 = ceramic (the plate_ parameters), or a metal preset by name",
+    ),
+    row(
+        "flyer_thickness",
+        "m",
+        0.002,
+        Range::open_closed(0.0, 0.1),
+        "thickness of the flyer plate",
+    ),
+    levels_spec(
+        "target_material",
+        0,
+        LAYER_MATERIALS,
+        "material of the target: 0 = ceramic (the plate_ parameters), or a metal preset by name",
+    ),
+    row(
+        "target_thickness",
+        "m",
+        0.004,
+        Range::open_closed(0.0, 0.1),
+        "thickness of the target plate (its back face is the free surface whose velocity is read)",
+    ),
+];
+
+/// The resolution and the end time, after the ceramic's block.
+const AFTER: &[ParamSpec] = &[
+    row(
+        "cell",
+        "m",
+        10.0e-6,
+        Range::closed(1.0e-7, 1.0e-3),
+        "length of a cell (each plate is cut into cells of about this length, at least two)",
+    ),
+    row(
+        "end_time",
+        "s",
+        2.0e-6,
+        Range::closed(1.0e-9, 1.0e-3),
+        "simulated time at which the run ends",
+    ),
+];
+
+const LEN: usize = BEFORE.len() + PLATE_CERAMIC.len() + AFTER.len();
+
+/// Parameters of the plate-impact scene (SI units).
+pub const PLATE_IMPACT_PARAMS: &[ParamSpec] = &concat::<LEN>(&[BEFORE, &PLATE_CERAMIC, AFTER]);
+
+/// The most cells a run may have: each step visits every cell, and a
+/// longer run than this would take hours.
+const MAX_CELLS: f64 = 1.0e6;
+
+/// The plate made of material level `level`.
+fn layer(level: f64, s: &Scene) -> Result<Layer> {
+    let k = level as usize;
+    if k == 0 {
+        let material = ceramic_material(|name| s.get(name))?;
+        return match material.damage {
+            Damage::RajendranGrove(c) => Ok(Layer::Ceramic(c)),
+            _ => unreachable!("the ceramic block makes a Rajendran-Grove material"),
+        };
+    }
+    let preset: &Preset = Preset::named(LAYER_MATERIALS[k].name)?;
+    Ok(Layer::Solid(preset.material()?))
+}
+
+/// The run of a scene, with the cross-parameter checks.
+fn setup(s: &Scene) -> Result<PlateImpact> {
+    let v = |name: &str| s.get(name);
+    let (flyer_thickness, target_thickness, cell) =
+        (v("flyer_thickness")?, v("target_thickness")?, v("cell")?);
+    let cells = (flyer_thickness + target_thickness) / cell;
+    if cells > MAX_CELLS {
+        return Err(Error::Inconsistent(format!(
+            "flyer_thickness + target_thickness = {} m over cell = {cell} m makes {cells:.0} cells, \
+             more than {MAX_CELLS:.0}; raise cell",
+            flyer_thickness + target_thickness
+        )));
+    }
+    let flyer = layer(v("flyer_material")?, s)?;
+    let target = layer(v("target_material")?, s)?;
+    Ok(PlateImpact::new(
+        flyer,
+        flyer_thickness,
+        target,
+        target_thickness,
+        v("impact_speed")?,
+        cell,
+    )?
+    .until(v("end_time")?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::presets::PRESETS;
+
+    /// The levels after the ceramic are the presets, in their order.
+    #[test]
+    fn the_metal_levels_are_the_presets() {
+        let names: Vec<&str> = LAYER_MATERIALS[1..].iter().map(|l| l.name).collect();
+        let presets: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+        assert_eq!(names, presets);
+    }
+
+    /// Every name is unique, every default in range, and the default scene
+    /// builds.
+    #[test]
+    fn the_table_is_consistent() {
+        let mut names: Vec<_> = PLATE_IMPACT_PARAMS.iter().map(|p| p.name).collect();
+        names.sort_unstable();
+        let n = names.len();
+        names.dedup();
+        assert_eq!(names.len(), n);
+        for p in PLATE_IMPACT_PARAMS {
+            p.check(p.default).unwrap();
+        }
+        let s = Scene::builtin("plate_impact").unwrap();
+        (ROW.check)(&s).unwrap();
+    }
+
+    /// Too many cells is refused by name before anything is allocated.
+    #[test]
+    fn too_many_cells_are_refused() {
+        let mut s = Scene::builtin("plate_impact").unwrap();
+        s.set("target_thickness", 0.1).unwrap();
+        s.set("cell", 1.0e-7).unwrap();
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.contains("cell") && e.contains("cells"), "{e}");
+    }
+}
