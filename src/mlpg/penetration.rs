@@ -44,6 +44,11 @@ pub struct PenetrationSetup {
     /// default): it runs to `end_time`.
     #[serde(default)]
     pub until_outcome: bool,
+    /// The plate's rim is clamped (its outer ring of nodes held still,
+    /// [`crate::mlpg::solver::Body::clamped_rim`]); false (the default,
+    /// the seed's case): free.
+    #[serde(default)]
+    pub clamped_rim: bool,
 }
 
 /// What a shot has come to ([`Penetration::outcome`]; the observable
@@ -95,6 +100,7 @@ impl Penetration {
             base: -setup.plate.length,
             velocity: 0.0,
             material: plate,
+            clamped_rim: setup.clamped_rim,
         };
         let run = Mlpg3d::bodies(rod, projectile, vec![plate_body])?;
         Ok(Penetration { setup, run })

@@ -290,6 +290,11 @@ pub struct Body {
     pub velocity: f64,
     /// Its material.
     pub material: Material,
+    /// Whether its rim is clamped: the nodes of its outer ring are held
+    /// still (their velocities zero, never shifted); a held node's
+    /// reaction does no work. Default: free.
+    #[serde(default)]
+    pub clamped_rim: bool,
 }
 
 /// What follows from the positions at the last build: supports, nodal
@@ -374,6 +379,10 @@ pub struct Mlpg3d {
     /// `Y` of `src/mlpg/mirror.rs`) in the quarter model; empty for the whole body.
     #[serde(default)]
     plane: Vec<u8>,
+    /// The nodes held still (a clamped rim, [`Body::clamped_rim`]); empty
+    /// when none is.
+    #[serde(default)]
+    held: Vec<bool>,
     /// Positions the supports were computed from.
     supports_at: Vec<[f64; 3]>,
     /// Positions the operator was last built at.
@@ -588,6 +597,7 @@ impl Mlpg3d {
         if !others.is_empty() {
             group = vec![0u8; n0];
         }
+        let mut held = Vec::new();
         for (b, body) in others.iter().enumerate() {
             let d = density_of(&body.material)?;
             let mut l = NodeLattice::cylinder(body.cylinder, body.rings);
@@ -598,6 +608,14 @@ impl Mlpg3d {
             }
             reach = reach.min(l.radial_spacing);
             let k = l.len();
+            if body.clamped_rim {
+                // The outer ring: within half a spacing of the rim.
+                let rim = body.cylinder.radius - 0.5 * l.radial_spacing;
+                held.resize(lattice.len(), false);
+                held.extend(l.position.iter().map(|x| x[0].hypot(x[1]) >= rim));
+            } else if !held.is_empty() {
+                held.resize(lattice.len() + k, false);
+            }
             lattice
                 .position
                 .extend(l.position.iter().map(|x| [x[0], x[1], x[2] + body.base]));
@@ -639,6 +657,7 @@ impl Mlpg3d {
             reaction: vec![0.0; n],
             contact,
             plane,
+            held,
             supports_at: pos.clone(),
             built_at: pos.clone(),
             reference: pos.clone(),
@@ -1225,6 +1244,7 @@ impl Mlpg3d {
         let d0 = self.d_min0;
         let (volume, rho, mass) = (&g.op.volume, &self.rho, &self.mass);
         let plane = &self.plane;
+        let still = &self.held;
         let kicked = &mut scratch.kicked;
         let now = self.time;
         self.vel
@@ -1264,6 +1284,11 @@ impl Mlpg3d {
                 }
                 if let Some(&on) = plane.get(i) {
                     pin(v, on);
+                }
+                // A node of a clamped rim: the clamp's reaction cancels the
+                // force, and does no work on a node that does not move.
+                if still.get(i) == Some(&true) {
+                    *v = [0.0; 3];
                 }
                 *out = (held, released);
             });
@@ -1397,6 +1422,20 @@ impl Mlpg3d {
                     }
                 }
             }
+        }
+        // A held node (a clamped rim) stays still: what the smoothing and
+        // the contact gave it this step (the forces' share the clamp took
+        // at once, above) the clamp takes back, booked with the contact's
+        // dissipation.
+        for ((v, &m), _) in self
+            .vel
+            .iter_mut()
+            .zip(&self.mass)
+            .zip(&self.held)
+            .filter(|(_, h)| **h)
+        {
+            self.contact_dissipation += kinetic1(*v, m);
+            *v = [0.0; 3];
         }
         let anvil = self.anvil;
         let moved = &mut scratch.moved;
@@ -1743,9 +1782,17 @@ impl Mlpg3d {
             SHIFT_CAP * spacing * step_scale,
             &mut scratch.shift,
         );
-        // A node on a symmetry plane moves in it.
+        // A node on a symmetry plane moves in it; a held node stays.
         for (d, &on) in scratch.shift.iter_mut().zip(&self.plane) {
             pin(d, on);
+        }
+        for (d, _) in scratch
+            .shift
+            .iter_mut()
+            .zip(&self.held)
+            .filter(|(_, h)| **h)
+        {
+            *d = [0.0; 3];
         }
         let d = &scratch.shift;
         if d.iter().all(|d| *d == [0.0; 3]) {
@@ -2256,7 +2303,7 @@ impl Mlpg3d {
             json(&(
                 &s.setup,
                 &s.material,
-                (&s.others, &s.group, s.anvil, s.reach, &s.plane),
+                (&s.others, &s.group, s.anvil, s.reach, &s.plane, &s.held),
                 &s.lattice,
                 &s.mass,
                 s.dt0,

@@ -884,9 +884,9 @@ mod tests {
             }
         }
         // taylor's and taylor3d's schemes for each of four choices,
-        // penetration's scheme and its run_until, plate_impact's two
-        // plate materials.
-        assert_eq!(seen, 12);
+        // penetration's scheme, its run_until and its plate_rim,
+        // plate_impact's two plate materials.
+        assert_eq!(seen, 13);
     }
 
     /// A scheme sets its knobs; a knob set by hand overrides it whichever

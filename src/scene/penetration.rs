@@ -205,6 +205,27 @@ const AFTER: &[ParamSpec] = &[
          1 = outcome (as soon as shot_outcome is decided, perforated or stopped, with end_time as the cap; \
          README, \"Ballistic limit\")",
     ),
+    levels_spec(
+        "plate_rim",
+        0,
+        PLATE_RIM,
+        "the plate's rim: 0 = free (the default, the seed's case: momentum is shared by projectile and plate \
+         alone), 1 = clamped (the outer ring of plate nodes held still; README, \"Ballistic penetration\")",
+    ),
+];
+
+/// The levels of `plate_rim`.
+const PLATE_RIM: &[Level] = &[
+    Level {
+        name: "free",
+        description: "the plate's rim is free (the seed's case)",
+        sets: &[],
+    },
+    Level {
+        name: "clamped",
+        description: "the plate's outer ring of nodes is held still (a plate clamped at its rim)",
+        sets: &[],
+    },
 ];
 
 /// The levels of `run_until`.
@@ -307,6 +328,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
         rings,
         end_time,
         until_outcome: v("run_until")? >= 0.5,
+        clamped_rim: v("plate_rim")? >= 0.5,
     };
     let mut numerics = RodSetup::new(projectile, rings, setup.impact_speed, end_time);
     numerics.damping = DAMPING;
