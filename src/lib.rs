@@ -1,10 +1,14 @@
 //! # meshless-impact
 //!
-//! A meshless particle solver for high-speed impact of solids: the
+//! Meshless particle solvers for high-speed impact of solids: the
 //! axisymmetric Modified SPH (MSPH) method of Batra & Zhang (2008) for the
 //! Taylor rod impact test with Johnson-Cook thermo-viscoplasticity and the
-//! cylindrical Noh problem, the 3-D MLPG mixed method (`taylor3d`), and plate
-//! impact in uniaxial strain.
+//! cylindrical Noh problem (scenes `taylor`, `table1-1` ... `table1-12`,
+//! `noh`); the 3-D MLPG mixed method of Han, Liu, Rajendran & Atluri for the
+//! Taylor test in 3-D (`taylor3d`, `taylor3d-aisi310`) and a projectile
+//! perforating a Rajendran-Grove ceramic plate (`penetration`); and plate
+//! impact in uniaxial strain (`plate_impact`), the ceramic's calibration
+//! experiment.
 //!
 //! ```no_run
 //! use meshless_impact::{Scene, Simulation};
@@ -36,7 +40,10 @@
 //!   budget a run is checked against before it allocates
 //!   ([`memory_budget`], [`MEMORY_BUDGET_VAR`], [`DEFAULT_MEMORY_BUDGET`]).
 //! - The interface every solver implements: [`Model`], [`ModelState`].
-//! - Plate impact in uniaxial strain: [`PlateImpact`] of [`Layer`]s.
+//! - Plate impact in uniaxial strain: [`PlateImpact`] of [`Layer`]s, its
+//!   free-surface reading [`FreeSurfaceReading`], the tables
+//!   [`PLATE_IMPACT_OBSERVABLES`] and [`PLATE_IMPACT_FIELDS`], and the floor
+//!   of the log10 crack-density fields, [`LOG10_NO_CRACKS`].
 //! - [`materials`]: the models a [`materials::Material`] is composed of
 //!   (equation of state, strength, damage), their choice by name, the
 //!   presets, and the Rajendran-Grove ceramic.
