@@ -172,10 +172,14 @@ pub struct PlateImpact {
     /// The depth below the target's impact face of the first target cell
     /// that failed in tension, and when (m, s).
     spall: Option<(f64, f64)>,
-    /// Every step's `(t, u)` of the free surface since the run was made or
-    /// restored (not part of the saved state).
+    /// Every step's `(t, u)` of the free surface since the run was made
+    /// (not part of the saved state; not kept by a scene's run, whose
+    /// histories record the observables: [`PlateImpact::without_history`]).
     #[serde(skip)]
     free_surface: Vec<(f64, f64)>,
+    /// Whether `free_surface` is kept (a restored run keeps none).
+    #[serde(skip)]
+    keep_history: bool,
 }
 
 impl PlateImpact {
@@ -241,6 +245,7 @@ impl PlateImpact {
             reading: FreeSurfaceReading::default(),
             spall: None,
             free_surface: Vec::new(),
+            keep_history: true,
         };
         let mut start = -flyer_thickness;
         for (k, (&n, thickness)) in counts
@@ -298,7 +303,9 @@ impl PlateImpact {
     /// Records the free surface's velocity and reads it.
     fn record(&mut self) {
         let u = *self.v.last().expect("nodes");
-        self.free_surface.push((self.time, u));
+        if self.keep_history {
+            self.free_surface.push((self.time, u));
+        }
         let r = &mut self.reading;
         if r.arrival.is_none() {
             if u > 0.01 * self.impact_speed.abs() {
@@ -333,6 +340,15 @@ impl PlateImpact {
     /// holds there.
     pub fn until(mut self, end_time: f64) -> Self {
         self.end_time = end_time;
+        self
+    }
+
+    /// Keeps no per-step history of the free surface from now on (a long
+    /// run's history would grow by 16 bytes a step; the reading and the
+    /// observables do not need it).
+    pub fn without_history(mut self) -> Self {
+        self.keep_history = false;
+        self.free_surface = Vec::new();
         self
     }
 
@@ -384,7 +400,8 @@ impl PlateImpact {
     }
 
     /// The target's free-surface velocity history `(t, u)`, one entry per
-    /// step since the run was made or restored.
+    /// step since the run was made (empty after
+    /// [`PlateImpact::without_history`] and in a restored run).
     pub fn free_surface(&self) -> &[(f64, f64)] {
         &self.free_surface
     }
@@ -439,20 +456,6 @@ impl PlateImpact {
     pub fn advance(&mut self) -> Result<()> {
         let dt = self.stable_step().min(self.end_time - self.time);
         self.step(dt)
-    }
-
-    /// The first target cell, if any, that is a ceramic pulverized in
-    /// tension (its elastic volumetric strain at pulverization, which the
-    /// pulverized state keeps, is an expansion): its depth below the
-    /// target's impact face in the reference configuration, and the time.
-    fn first_tensile_failure(&self) -> Option<(f64, f64)> {
-        (self.flyer_cells..self.state.len()).find_map(|c| match &self.state[c] {
-            CellState::Ceramic(p) if p.pulverized.is_some_and(|z| z.volumetric_strain > 0.0) => {
-                let k = (c - self.flyer_cells) as f64;
-                Some(((k + 0.5) * self.length0[c], self.time))
-            }
-            _ => None,
-        })
     }
 
     /// The stable time step of the cells now (s).
@@ -518,6 +521,16 @@ impl PlateImpact {
             let material = match (&layer, &mut self.state[c]) {
                 (Layer::Ceramic(m), CellState::Ceramic(p)) => {
                     m.update(&load, self.energy[c], p);
+                    // The first target cell pulverized in tension (its
+                    // elastic volumetric strain at pulverization, which the
+                    // pulverized state keeps, an expansion): the spall.
+                    if self.spall.is_none()
+                        && c >= self.flyer_cells
+                        && p.pulverized.is_some_and(|z| z.volumetric_strain > 0.0)
+                    {
+                        let k = (c - self.flyer_cells) as f64;
+                        self.spall = Some(((k + 0.5) * self.length0[c], self.time));
+                    }
                     p.deviator[0] - p.pressure
                 }
                 (Layer::Solid(m), CellState::Solid(p, s)) => {
@@ -557,9 +570,6 @@ impl PlateImpact {
             });
         }
         self.steps += 1;
-        if self.spall.is_none() {
-            self.spall = self.first_tensile_failure();
-        }
         self.record();
         Ok(())
     }
@@ -640,15 +650,14 @@ impl PlateImpact {
         } else {
             0.0
         };
-        let max_damage = self
-            .target_ceramic()
-            .iter()
-            .zip(std::iter::repeat(&self.layers[1]))
-            .map(|(p, layer)| match layer {
-                Layer::Ceramic(m) => m.flaw_density * p.crack_size.powi(3),
-                Layer::Solid(_) => 0.0,
-            })
-            .fold(0.0, f64::max);
+        let max_damage = match &self.layers[1] {
+            Layer::Ceramic(m) => self
+                .target_ceramic()
+                .iter()
+                .map(|p| m.crack_density(p.crack_size))
+                .fold(0.0, f64::max),
+            Layer::Solid(_) => 0.0,
+        };
         let [kinetic, internal, contact] = self.energies();
         vec![
             self.free_surface_velocity(),
@@ -716,9 +725,7 @@ impl PlateImpact {
             "log10_crack_density" => cells
                 .map(|c| {
                     ceramic(c).map_or(LOG10_NO_CRACKS, |(p, m)| {
-                        (m.flaw_density * p.crack_size.powi(3))
-                            .log10()
-                            .max(LOG10_NO_CRACKS)
+                        m.crack_density(p.crack_size).log10().max(LOG10_NO_CRACKS)
                     })
                 })
                 .collect(),

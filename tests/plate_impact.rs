@@ -233,7 +233,7 @@ fn a_spall_signal_mid_way_through_the_target() {
     let s = |name: &str| seed.observable(name).unwrap();
     assert_eq!(s("spall_depth"), 0.0);
     assert_eq!(s("spall_strength"), 0.0);
-    let gamma0 = m.flaw_density * m.initial_crack_size.powi(3);
+    let gamma0 = m.crack_density(m.initial_crack_size);
     assert!(
         (s("max_damage") / gamma0 - 1.0).abs() < 1e-12,
         "{} {gamma0}",

@@ -194,6 +194,7 @@ fn setup(s: &Scene) -> Result<PlateImpact> {
         v("impact_speed")?,
         cell,
     )?
+    .without_history()
     .until(v("end_time")?))
 }
 
