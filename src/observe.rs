@@ -370,7 +370,7 @@ observables! {
     projectile_extent: "m", "extent of the projectile along the axis (highest minus lowest node): its current length (the parameter `projectile_length` is its initial length)";
     projectile_clearance: "m", "depth of the projectile's highest node below the plate's original back face (z = -plate_thickness): positive once the whole projectile has passed it, negative while any of it is above";
     hole_radius: "m", "radius of the channel about the axis free of intact (not pulverized) plate material within the plate's original thickness: the distance from the axis of the nearest such plate node (0, to round-off, before the plate is pierced)";
-    damaged_fraction: "1", "mass fraction of the plate whose crack density has grown past 1% of its value at pulverization";
+    damaged_fraction: "1", "mass fraction of the plate whose crack density has grown past 1% of its value at pulverization and past twice its initial value";
     pulverized_fraction: "1", "mass fraction of the plate that is pulverized";
     max_damage: "1", "largest crack density gamma = N0* a^3 in the plate";
     kinetic_energy: "J", "kinetic energy of both bodies";

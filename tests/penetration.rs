@@ -200,9 +200,18 @@ const PLAIN: &[(&str, f64)] = &[
     ("shifting", 0.0),
 ];
 
+/// The scene with the seed's AD85 as printed, named (`plate_ceramic =
+/// ad85_seed`, a0 = 0.58 µm, the default): the constants the tests of the
+/// seed's case below were measured with, whatever the default becomes.
+fn seed_scene() -> Scene {
+    let mut scene = Scene::builtin("penetration").unwrap();
+    scene.set_str("plate_ceramic", "ad85_seed").unwrap();
+    scene
+}
+
 /// [`coarse`] with parameters set.
 fn coarse_with(t: f64, sets: &[(&str, f64)]) -> Simulation {
-    let mut scene = Scene::builtin("penetration").unwrap();
+    let mut scene = seed_scene();
     scene.set("particles_radial", 4.0).unwrap();
     scene.set("end_time", t).unwrap();
     for (k, v) in sets {
@@ -388,7 +397,7 @@ fn node_masses(sim: &Simulation) -> Vec<f64> {
 #[test]
 fn a_penetration_run_saved_mid_way_resumes_to_the_same_bits() {
     let whole = coarse(1.5e-6);
-    let mut scene = Scene::builtin("penetration").unwrap();
+    let mut scene = seed_scene();
     scene.set("particles_radial", 4.0).unwrap();
     scene.set("end_time", 1.5e-6).unwrap();
     let mut mid = Simulation::new(scene).unwrap();
@@ -425,7 +434,7 @@ fn a_penetration_run_saved_mid_way_resumes_to_the_same_bits() {
 #[test]
 fn a_quarter_model_saved_mid_way_resumes_and_a_forged_one_is_refused() {
     let whole = coarse_with(1.5e-6, &[("symmetry", 1.0)]);
-    let mut scene = Scene::builtin("penetration").unwrap();
+    let mut scene = seed_scene();
     scene.set("particles_radial", 4.0).unwrap();
     scene.set("end_time", 1.5e-6).unwrap();
     scene.set("symmetry", 1.0).unwrap();
@@ -479,9 +488,9 @@ fn same_bits_on_one_thread_and_two() {
 }
 
 /// The seed's case at 3 nodes across, as a quarter model, at `speed`,
-/// with `run_until` and `end_time`.
+/// with `run_until` and `end_time`, the seed's AD85 (`ad85_seed`).
 fn shot(speed: f64, until: &str, end_time: f64) -> Simulation {
-    let mut scene = Scene::builtin("penetration").unwrap();
+    let mut scene = seed_scene();
     scene.set("particles_radial", 3.0).unwrap();
     scene.set("symmetry", 1.0).unwrap();
     scene.set("impact_speed", speed).unwrap();
@@ -551,53 +560,72 @@ fn a_slow_perforation_is_not_called_stopped() {
 /// to 20 µs with the scene's default scheme: the plate's rim is free, so
 /// nothing outside acts on the two bodies, and the projectile, the plate's
 /// pulverized fragments and the plate's remainder carry the impact
-/// momentum between them. Measured: −12.695, −3.179 and −4.130 kg m/s of
-/// −20.004 kg m/s, the sum equal to it to 3e-16 (the nodal form's forces,
-/// the contact's impulses and the shifting's conservative carry each
-/// conserve momentum); the issue asks 1 %, this test 1e-9. The energy
-/// error is 0.43 % (bound 5 %), and the projectile is through the plate
-/// (`shot_outcome` 1) at 951.9 m/s.
+/// momentum between them, with either set of the ceramic's constants (the
+/// nodal form's forces, the contact's impulses and the shifting's
+/// conservative carry each conserve momentum); the issue asks 1 %, this
+/// test 1e-9. Measured, of −20.004 kg m/s:
+///
+/// - the default, `ad85_seed`: −12.695, −3.179 and −4.130 kg m/s, the sum
+///   to 3e-16; 8 % of the plate pulverized, energy error 0.43 %, through
+///   at 951.9 m/s;
+/// - `ad85_spall` (a0 = 100 µm): −15.861, −4.163 and +0.019 kg m/s, the
+///   sum exact to round-off; 85 % of the plate pulverized, the remainder a
+///   rim that springs back; energy error 0.50 %, through at 1189.3 m/s.
+///
+/// The energy errors are within taylor3d's 5 %.
 #[test]
 fn the_momentum_of_the_impact_is_shared_by_projectile_fragments_and_plate() {
-    let mut scene = Scene::builtin("penetration").unwrap();
-    scene.set("particles_radial", 3.0).unwrap();
-    let mut sim = Simulation::new(scene).unwrap();
-    sim.run().unwrap();
-    let o = |name: &str| sim.observable(name).unwrap();
-    let (m, v) = (node_masses(&sim), sim.field("velocity").unwrap());
-    let (body, loose) = (sim.field("body").unwrap(), sim.field("pulverized").unwrap());
-    let mut parts = [0.0; 3];
-    for i in 0..m.len() {
-        let part = if body[i] == 0.0 {
-            0
-        } else if loose[i] == 1.0 {
-            1
-        } else {
-            2
-        };
-        parts[part] += m[i] * v[3 * i + 2];
+    for seed in [true, false] {
+        let mut scene = seed_scene();
+        if !seed {
+            scene.set_str("plate_ceramic", "ad85_spall").unwrap();
+        }
+        scene.set("particles_radial", 3.0).unwrap();
+        let mut sim = Simulation::new(scene).unwrap();
+        sim.run().unwrap();
+        let o = |name: &str| sim.observable(name).unwrap();
+        let (m, v) = (node_masses(&sim), sim.field("velocity").unwrap());
+        let (body, loose) = (sim.field("body").unwrap(), sim.field("pulverized").unwrap());
+        let mut parts = [0.0; 3];
+        for i in 0..m.len() {
+            let part = if body[i] == 0.0 {
+                0
+            } else if loose[i] == 1.0 {
+                1
+            } else {
+                2
+            };
+            parts[part] += m[i] * v[3 * i + 2];
+        }
+        let mp = 16980.0 * std::f64::consts::PI * 25e-6 * 0.01;
+        let impact = -mp * 1500.0;
+        let sum: f64 = parts.iter().sum();
+        println!(
+            "{}: projectile {:.4}, fragments {:.4}, plate {:.4}: sum {sum:.6} of {impact:.6} kg m/s ({:+.2e}); \
+             energy error {:.4}, pulverized {:.4}, outcome {}, {:.1} m/s",
+            if seed { "ad85_seed" } else { "ad85_spall" },
+            parts[0],
+            parts[1],
+            parts[2],
+            sum / impact - 1.0,
+            o("energy_error"),
+            o("pulverized_fraction"),
+            o("shot_outcome"),
+            o("projectile_velocity")
+        );
+        assert!(
+            (sum / impact - 1.0).abs() < 1e-9,
+            "{parts:?} against {impact}"
+        );
+        // The projectile and the fragments move on along the shot; the
+        // seed's plate, barely damaged, carries its share the same way.
+        assert!(parts[0] < 0.0 && parts[1] < 0.0, "{parts:?}");
+        if seed {
+            assert!(parts[2] < 0.0, "{parts:?}");
+        }
+        assert!(o("energy_error") < 0.05);
+        assert_eq!(o("shot_outcome"), 1.0);
     }
-    let mp = 16980.0 * std::f64::consts::PI * 25e-6 * 0.01;
-    let impact = -mp * 1500.0;
-    let sum: f64 = parts.iter().sum();
-    println!(
-        "projectile {:.4}, fragments {:.4}, plate {:.4}: sum {sum:.6} of {impact:.6} kg m/s ({:+.2e}); \
-         energy error {:.4}, outcome {}, {:.1} m/s",
-        parts[0],
-        parts[1],
-        parts[2],
-        sum / impact - 1.0,
-        o("energy_error"),
-        o("shot_outcome"),
-        o("projectile_velocity")
-    );
-    assert!(
-        (sum / impact - 1.0).abs() < 1e-9,
-        "{parts:?} against {impact}"
-    );
-    assert!(parts.iter().all(|p| *p < 0.0), "{parts:?}");
-    assert!(o("energy_error") < 0.05);
-    assert_eq!(o("shot_outcome"), 1.0);
 }
 
 /// `plate_rim = clamped`: the plate's outer ring of nodes stays where it
@@ -605,11 +633,11 @@ fn the_momentum_of_the_impact_is_shared_by_projectile_fragments_and_plate() {
 /// momentum (the free rim's bodies keep all of it), the energy balance
 /// still closes, and the slow shot that the free plate carries away is
 /// held back more by the clamped one. 3 nodes across, a plate 30 mm
-/// across, 600 m/s, 15 us.
+/// across, 600 m/s, 15 us, the seed's AD85 (`ad85_seed`).
 #[test]
 fn a_clamped_rim_holds_its_ring_still() {
     let run = |rim: &str| {
-        let mut scene = Scene::builtin("penetration").unwrap();
+        let mut scene = seed_scene();
         scene.set("particles_radial", 3.0).unwrap();
         scene.set("plate_diameter", 0.03).unwrap();
         scene.set("impact_speed", 600.0).unwrap();

@@ -168,46 +168,64 @@ fn scene_run(sets: &[(&str, f64)]) -> meshless_impact::Simulation {
 /// Through the scene (CLI, C ABI and FMU alike): the rate-independent AD85
 /// struck by AD85 at 1000 m/s reads a precursor of twice the particle
 /// velocity of an elastic shock to the HEL of the constants, and its
-/// `precursor_stress` is the experimenter's rho0 c_L u / 2 of it.
+/// `precursor_stress` is the experimenter's rho0 c_L u / 2 of it. So for
+/// the default, the seed's set (`ad85_seed`, a0 = 0.58 µm), and for
+/// `ad85_spall` (a0 = 100 µm): the larger initial cracks leave the HEL
+/// where it was (measured 353.97 m/s with either, against 353.10 m/s of
+/// the constants of either).
 #[test]
 fn the_scenes_precursor_is_the_hel_of_the_constants() {
-    let sim = scene_run(&[
-        ("plate_rg_c3", 0.0),
-        ("impact_speed", 1000.0),
-        ("target_thickness", 8e-3),
-        ("cell", 2e-5),
-        ("end_time", 1.3e-6),
-    ]);
-    let m = RajendranGrove {
-        c3: 0.0,
-        ..RajendranGrove::ad85()
-    };
-    let (hel, x) = m.hugoniot_elastic_limit();
-    let expected = 2.0 * (hel * (1.0 - (-x).exp()) / m.density).sqrt();
-    let o = |name: &str| sim.observable(name).unwrap();
-    let u = o("precursor_velocity");
-    let c_l = (m.longitudinal_modulus(m.density, m.initial_porosity) / m.density).sqrt();
-    eprintln!(
-        "precursor {u:.3} m/s against {expected:.3} m/s; precursor_stress {:.4e} Pa, HEL {hel:.4e} Pa",
-        o("precursor_stress")
-    );
-    assert!((u / expected - 1.0).abs() < 0.005, "{u} {expected}");
-    assert_eq!(o("precursor_stress"), 0.5 * m.density * c_l * u);
-    assert!(o("energy_error") < 0.01);
+    let mut hels: Vec<f64> = Vec::new();
+    for (level, a0) in [(0.0, 0.58e-6), (1.0, 100e-6)] {
+        let sim = scene_run(&[
+            ("plate_ceramic", level),
+            ("plate_rg_c3", 0.0),
+            ("impact_speed", 1000.0),
+            ("target_thickness", 8e-3),
+            ("cell", 2e-5),
+            ("end_time", 1.3e-6),
+        ]);
+        assert_eq!(sim.scene().get("plate_crack_size").unwrap(), a0);
+        let m = RajendranGrove {
+            c3: 0.0,
+            initial_crack_size: a0,
+            ..RajendranGrove::ad85()
+        };
+        let (hel, x) = m.hugoniot_elastic_limit();
+        let expected = 2.0 * (hel * (1.0 - (-x).exp()) / m.density).sqrt();
+        let o = |name: &str| sim.observable(name).unwrap();
+        let u = o("precursor_velocity");
+        let c_l = (m.longitudinal_modulus(m.density, m.initial_porosity) / m.density).sqrt();
+        eprintln!(
+            "a0 = {a0:e}: precursor {u:.3} m/s against {expected:.3} m/s; precursor_stress {:.4e} Pa, HEL {hel:.4e} Pa",
+            o("precursor_stress")
+        );
+        assert!((u / expected - 1.0).abs() < 0.005, "{u} {expected}");
+        assert_eq!(o("precursor_stress"), 0.5 * m.density * c_l * u);
+        assert!(o("energy_error") < 0.01);
+        hels.push(hel);
+    }
+    // The HEL of the constants is the matrix's: the initial cracks do not
+    // move it.
+    assert!((hels[0] / hels[1] - 1.0).abs() < 1e-3, "{hels:?}");
 }
 
-/// The symmetric spall experiment (AD85 2 mm on AD85 4 mm at 300 m/s):
-/// the release waves from the flyer's back and the target's free face meet
-/// 2 mm inside the target, where a ceramic with large flaws (a0 = 200 um)
-/// fails in tension; the free surface then shows a spall signal (it rises
-/// again before the pullback reaches the whole pulse), and the spall
-/// strength read from it lies between the static onset of crack growth
-/// K_IC sqrt(pi / (4 a0)) and the tension the pulse carries. With the
-/// seed's a0 (0.58 um) the cracks never grow and the target does not spall.
+/// The symmetric spall experiment (AD85 2 mm on AD85 4 mm at 300 m/s, the
+/// scene's defaults): the release waves from the flyer's back and the
+/// target's free face meet 2 mm inside the target, where the ceramic of
+/// `plate_ceramic = ad85_spall` (a0 = 100 µm, chosen by this measurement:
+/// the module documentation of `ceramic_block`) fails in tension; the free surface
+/// then shows a spall signal (it rises again before the pullback reaches
+/// the whole pulse: measured 234.1 of 301.6 m/s), and the spall strength
+/// read from it (2.65 GPa) lies between the static onset of crack growth
+/// K_IC sqrt(pi / (4 a0)) (0.29 GPa) and the tension the pulse carries
+/// (4.46 GPa). With the seed's a0 (0.58 µm, `ad85_seed`, the default) the
+/// cracks never grow and the target does not spall.
 #[test]
 fn a_spall_signal_mid_way_through_the_target() {
-    let a0 = 200e-6;
-    let sim = scene_run(&[("plate_crack_size", a0), ("end_time", 3e-6)]);
+    let sim = scene_run(&[("plate_ceramic", 1.0), ("end_time", 3e-6)]);
+    let a0 = sim.scene().get("plate_crack_size").unwrap();
+    assert_eq!(a0, 100e-6);
     let o = |name: &str| sim.observable(name).unwrap();
     let m = RajendranGrove::ad85();
     let onset = m.fracture_toughness * (std::f64::consts::PI / (4.0 * a0)).sqrt();
@@ -225,7 +243,7 @@ fn a_spall_signal_mid_way_through_the_target() {
         "{}",
         o("spall_depth")
     );
-    assert!(o("pullback_velocity") < 0.8 * o("peak_velocity"));
+    assert!(o("pullback_velocity") < 0.85 * o("peak_velocity"));
     assert!(onset < o("spall_strength") && o("spall_strength") < pulse);
     assert!(o("energy_error") < 0.01);
 

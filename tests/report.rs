@@ -253,6 +253,33 @@ fn quick_report_regenerates_and_meets_its_claims() {
     assert!(v.windows(2).all(|w| w[1] < w[0]), "{v:?}");
     assert!((v[3] / 1240.0 - 1.0).abs() < 0.2, "{v:?}");
 
+    // The ballistic-limit sweep at 3 across (quarter model), each shot to
+    // its outcome: 500 m/s stops, 1000 m/s perforates slowly (at 29.06 µs,
+    // 378.4 m/s: tests/penetration.rs::a_slow_perforation_is_not_called_stopped
+    // holds the same shot), 1500 m/s perforates; the report brackets the
+    // ballistic limit between the two.
+    let shots = read_csv(&dir.join("ballistic_limit.csv"));
+    let outcomes: Vec<(f64, &str)> = shots
+        .iter()
+        .map(|r| (num(r, "impact_speed_mps"), r["outcome"].as_str()))
+        .collect();
+    assert_eq!(
+        outcomes,
+        [
+            (500.0, "stopped"),
+            (1000.0, "perforated"),
+            (1500.0, "perforated")
+        ]
+    );
+    assert_eq!(num(&shots[0], "residual_velocity_mps"), 0.0);
+    let (slow, fast) = (
+        num(&shots[1], "residual_velocity_mps"),
+        num(&shots[2], "residual_velocity_mps"),
+    );
+    assert!(0.0 < slow && slow < fast && fast < 1500.0, "{slow} {fast}");
+    assert!(index.contains("**the ballistic limit lies between 500 and 1000 m/s**"));
+    assert!(index.contains("ballistic_limit.svg"));
+
     // The stability matrix: each case ends as expected, and no output of any
     // case holds a NaN or an infinity.
     let cases = read_csv(&dir.join("stability.csv"));

@@ -286,6 +286,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     stability::matrix(&plan, &mut doc)?;
     benchmarks::run(&plan, &mut doc)?;
     penetration::damage(&plan, &mut doc)?;
+    penetration::ballistic_limit(&plan, &mut doc)?;
     let wall_s = start.elapsed().as_secs_f64();
     let _ = writeln!(doc.text, "---\n\nWhole report: {wall_s:.1} s wall time.");
     let index = dir.join("index.md");

@@ -3,9 +3,11 @@
 //! the axis at 4, 8, 12 and 20 µs, and the projectile's velocity history.
 
 use super::plot::{self, Axes, Plane, Series};
-use super::runner::{Probe, run_case, scene};
+use super::runner::{Probe, run_case, run_parallel, scene};
 use super::{Doc, Plan, Table, sig};
 use meshless_impact::Result;
+use meshless_impact::internals::mlpg::damaged_threshold;
+use meshless_impact::materials::RajendranGrove;
 
 /// The seed's residual velocity (m/s).
 const SEED_RESIDUAL: f64 = 1240.0;
@@ -20,19 +22,17 @@ const HALF_WIDTH: f64 = 20e-3;
 /// Critical crack density of pulverization (the top of the colour scale).
 const PULVERIZED: f64 = 0.75;
 
-/// The crack density past which a node counts as damaged: 1 % of
-/// pulverization, as the observable `damaged_fraction` counts it.
-const DAMAGED: f64 = 0.01 * PULVERIZED;
-
 /// The half-angle from the axis (degrees) of the cone the damaged plate
 /// nodes fill (`points` (x, z) in m of the slice, `gamma` their crack
-/// densities): the damaged zone's largest distance from the axis in the
+/// densities, `damaged` the crack density past which a node counts as
+/// damaged, as the observable `damaged_fraction` counts it): the damaged zone's largest distance from the axis in the
 /// plate's back layer (z within one spacing of `-thickness`) less that in
 /// its top layer (z within one spacing of 0), over the thickness; `None`
 /// when either layer holds no damaged node.
 fn cone_half_angle(
     points: &[(f64, f64)],
     gamma: &[f64],
+    damaged: f64,
     thickness: f64,
     spacing: f64,
 ) -> Option<f64> {
@@ -40,7 +40,7 @@ fn cone_half_angle(
         points
             .iter()
             .zip(gamma)
-            .filter(|((_, z), g)| (z - z0).abs() < spacing && **g >= DAMAGED)
+            .filter(|((_, z), g)| (z - z0).abs() < spacing && **g >= damaged)
             .map(|((x, _), _)| x.abs())
             .reduce(f64::max)
     };
@@ -137,7 +137,14 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
     let thickness = param("plate_thickness");
     // The colour scale: log10 of the crack density, from the plate's
     // initial one to pulverization.
-    let gamma0 = param("plate_flaw_density") * param("plate_crack_size").powi(3);
+    let ceramic = RajendranGrove {
+        flaw_density: param("plate_flaw_density"),
+        initial_crack_size: param("plate_crack_size"),
+        critical_damage: param("plate_critical_damage"),
+        ..RajendranGrove::ad85()
+    };
+    let gamma0 = ceramic.crack_density(ceramic.initial_crack_size);
+    let damaged = damaged_threshold(&ceramic);
     let scale = (gamma0.log10().floor(), PULVERIZED.log10());
     let mut slices = Vec::new();
     for snap in &run.snapshots {
@@ -155,7 +162,7 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
                 values.push(gamma[i]);
             }
         }
-        let cone = cone_half_angle(&plate, &values, thickness, spacing);
+        let cone = cone_half_angle(&plate, &values, damaged, thickness, spacing);
         let t = snap.time;
         zones.push(vec![
             sig(t * 1e6, 4),
@@ -173,7 +180,7 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
          axis (x, z in mm; the plate's top face at z = 0), the projectile grey, from the \
          plate's initial γ0 = {} (log10 {:.0}) to γ = {PULVERIZED}, pulverized, so that \
          partial damage shows. The table's cone half-angle is measured from the axis: the \
-         damaged zone's (γ ≥ {DAMAGED}) reach from the axis in the back layer less that in \
+         damaged zone's (γ ≥ {}: 1 % of pulverization and twice γ0) reach from the axis in the back layer less that in \
          the top layer, over the thickness (\"none\" when a layer holds no damaged node); \
          the classical ceramic-armour models put it at 60-70° (Florence's a + 2h gives \
          63°). The fields at each time, `log10_damage` and `crack_size` among them, are in \
@@ -182,6 +189,7 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
         0.5e3 * spacing,
         sig(gamma0, 3),
         scale.0,
+        sig(damaged, 3),
     ));
     for (time, plate, gamma, projectile) in &slices {
         let mm = |q: &(f64, f64)| (q.0 * 1e3, q.1 * 1e3);
@@ -217,4 +225,127 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
     }
     doc.table(&zones)?;
     Ok(())
+}
+
+/// Speeds of the ballistic-limit sweep (m/s): the full plan's and the
+/// quick one's.
+const SWEEP: [f64; 12] = [
+    400.0, 500.0, 600.0, 700.0, 800.0, 900.0, 1000.0, 1100.0, 1200.0, 1300.0, 1400.0, 1500.0,
+];
+const QUICK_SWEEP: [f64; 3] = [500.0, 1000.0, 1500.0];
+
+/// The cap of a shot's run (s): `run_until = outcome` ends it earlier.
+const SWEEP_CAP: f64 = 6e-5;
+
+/// The ballistic-limit sweep: the seed's case at a row of impact speeds,
+/// each shot run until its outcome is decided (`run_until = outcome`,
+/// README, "Ballistic limit"), as a quarter model at 4 nodes across (3 in
+/// the quick plan). The table gives each shot's outcome and residual
+/// velocity, the plot the residual velocity against the impact speed, and
+/// the text the bracket of the ballistic limit (the fastest stopped shot
+/// below the slowest perforating one). The Lambert-Jonas fit of the
+/// shots, with its uncertainty, is `examples/ballistic_limit.py`'s
+/// (VALIDATION.md gives it at the default resolution).
+pub(super) fn ballistic_limit(plan: &Plan, doc: &mut Doc) -> Result<()> {
+    let (across, speeds): (f64, &[f64]) = if plan.quick {
+        (3.0, &QUICK_SWEEP)
+    } else {
+        (4.0, &SWEEP)
+    };
+    super::progress!(
+        "report: ballistic limit, {} shots at {across} nodes across",
+        speeds.len()
+    );
+    let scenes = speeds
+        .iter()
+        .map(|&v| {
+            scene(
+                "penetration",
+                &[
+                    ("particles_radial", across),
+                    ("symmetry", 1.0),
+                    ("impact_speed", v),
+                    ("run_until", 1.0),
+                    ("end_time", SWEEP_CAP),
+                ],
+            )
+        })
+        .collect();
+    let runs = run_parallel(scenes, f64::INFINITY);
+    let mut table = Table::new(
+        "ballistic_limit",
+        &[
+            "impact_speed_mps",
+            "outcome",
+            "residual_velocity_mps",
+            "decided_at_us",
+            "hole_radius_mm",
+            "energy_error",
+        ],
+    );
+    let (mut stopped, mut through) = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut curve = Vec::new();
+    for (&v, run) in speeds.iter().zip(&runs) {
+        let outcome = if !run.finished() {
+            run.outcome.label()
+        } else {
+            match run.get("shot_outcome") as u8 {
+                1 => "perforated",
+                2 => "stopped",
+                _ => "undecided at the cap",
+            }
+        };
+        let residual = match outcome {
+            "perforated" => run.get("projectile_velocity"),
+            "stopped" => 0.0,
+            _ => f64::NAN,
+        };
+        if outcome == "stopped" {
+            stopped = stopped.max(v);
+        }
+        if outcome == "perforated" {
+            through = through.min(v);
+        }
+        if residual.is_finite() {
+            curve.push((v, residual));
+        }
+        table.push(vec![
+            sig(v, 4),
+            outcome.to_string(),
+            if residual.is_finite() {
+                sig(residual, 5)
+            } else {
+                "—".into()
+            },
+            sig(run.time * 1e6, 4),
+            sig(run.get("hole_radius") * 1e3, 4),
+            sig(run.get("energy_error"), 3),
+        ]);
+    }
+    let bracket = if stopped < through && stopped.is_finite() && through.is_finite() {
+        format!("**the ballistic limit lies between {stopped} and {through} m/s**")
+    } else {
+        "the shots do not bracket the ballistic limit".to_string()
+    };
+    doc.para(&format!(
+        "## 8. Ballistic penetration: the ballistic limit\n\n\
+         The seed's case at each impact speed as a quarter model at {across} nodes across the \
+         projectile's radius, each shot run until its outcome is decided by the state \
+         (`run_until = outcome`, at most {:.0} µs; README, \"Ballistic limit\"); the plate's \
+         rim is free. A stopped shot's residual velocity is 0. At this resolution {bracket} \
+         (the fastest stopped shot and the slowest perforating one). The Lambert-Jonas fit \
+         and its uncertainty at the default resolution are in VALIDATION.md (\"The ballistic \
+         limit at the default resolution\"; `examples/ballistic_limit.py`).",
+        SWEEP_CAP * 1e6,
+    ));
+    doc.table(&table)?;
+    doc.lines(
+        "ballistic_limit.svg",
+        Axes::linear(
+            "Ballistic limit: residual velocity against impact speed",
+            "impact speed (m/s)",
+            "residual velocity (m/s)",
+        ),
+        &[Series::markers("shots", curve)],
+    )
 }

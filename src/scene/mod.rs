@@ -884,9 +884,10 @@ mod tests {
             }
         }
         // taylor's and taylor3d's schemes for each of four choices,
-        // penetration's scheme, its run_until and its plate_rim,
-        // plate_impact's two plate materials.
-        assert_eq!(seen, 13);
+        // penetration's scheme, its run_until, its plate_rim and its
+        // plate_ceramic, plate_impact's two plate materials and its
+        // plate_ceramic.
+        assert_eq!(seen, 15);
     }
 
     /// A scheme sets its knobs; a knob set by hand overrides it whichever
