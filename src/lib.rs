@@ -166,6 +166,7 @@ pub mod internals {
     pub use crate::lanes::W;
     pub use crate::msph::{Neighbourhood, Row2};
     pub use crate::neighbors::{cell_list, naive, padded_rows};
+    pub use crate::scene::reference;
     pub use crate::solver::axisymmetric::{SPACING_COLLAPSE_BOUND, TaylorSolver};
 }
 

@@ -51,6 +51,10 @@ enum Command {
         scene: String,
         #[command(flatten)]
         material: ChoiceArgs,
+        /// Print the scene's reference page in Markdown instead (as
+        /// docs/reference/SCENE.md): its parameters, observables and fields.
+        #[arg(long)]
+        markdown: bool,
     },
     /// List the observables of a scene.
     Observables {
@@ -244,7 +248,11 @@ fn try_main() -> Result<(), Stop> {
         Some(Command::Run(a)) => run(a)?,
         Some(Command::Sweep(a)) => sweep(a)?,
         Some(Command::Report { out, quick }) => report(out, quick)?,
-        Some(Command::Params { scene, material }) => params(&scene, &material)?,
+        Some(Command::Params {
+            scene,
+            material,
+            markdown,
+        }) => params(&scene, &material, markdown)?,
         Some(Command::Observables { scene }) => observables(&scene)?,
         Some(Command::Scenes) => scenes()?,
         Some(Command::Materials) => materials()?,
@@ -597,9 +605,16 @@ fn report(_out: PathBuf, _quick: bool) -> Result<(), Stop> {
     ))
 }
 
-fn params(scene: &str, material: &ChoiceArgs) -> Result<(), Stop> {
+/// `meshless-impact params`: the parameter table of a scene, or with
+/// `markdown` its reference page (`docs/reference/SCENE.md`).
+fn params(scene: &str, material: &ChoiceArgs, markdown: bool) -> Result<(), Stop> {
+    use meshless_impact::internals::reference;
     let mut s = Scene::builtin(scene)?;
     material.apply(&mut s)?;
+    if markdown {
+        let page = reference::page(scene, &s)?;
+        return write!(std::io::stdout(), "{page}").map_err(|e| Stop::write("stdout", e));
+    }
     outln!(
         "{:<24} {:<10} {:>12}  {:<28} meaning",
         "name",
@@ -608,19 +623,7 @@ fn params(scene: &str, material: &ChoiceArgs) -> Result<(), Stop> {
         "allowed"
     )?;
     for p in s.param_specs() {
-        let v = s.get(p.name)?;
-        let (value, allowed) = match p.level(v) {
-            Some(level) => (
-                level.name.to_string(),
-                p.levels
-                    .iter()
-                    .enumerate()
-                    .map(|(k, l)| format!("{k}={}", l.name))
-                    .collect::<Vec<_>>()
-                    .join(","),
-            ),
-            None => (v.to_string(), p.range.to_string()),
-        };
+        let (value, allowed) = reference::value_and_allowed(p, s.get(p.name)?);
         outln!(
             "{:<24} {:<10} {:>12}  {:<28} {}",
             p.name,

@@ -28,7 +28,7 @@ use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
 pub const DAMAGED_AT: f64 = 0.01;
 
 /// The crack density past which a plate node counts as damaged: its cracks
-/// have grown, to at least 1 % ([`DAMAGED_AT`]) of the crack density at
+/// have grown, to at least 1 % (`DAMAGED_AT`) of the crack density at
 /// pulverization and at least twice the initial crack density. (A plate
 /// whose initial cracks already pass 1 % of pulverization, as those of
 /// `plate_ceramic = ad85_spall` (a0 = 100 µm, γ0 = 0.0183) do, would

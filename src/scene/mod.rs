@@ -6,6 +6,7 @@ pub mod noh;
 pub mod params;
 pub mod penetration;
 pub mod plate_impact;
+pub mod reference;
 pub mod registry;
 pub mod table1;
 pub mod taylor;

@@ -2,10 +2,13 @@
 //!
 //! - `header`: regenerate `include/meshless_impact.h` with cbindgen;
 //! - `fmu`: build the release library and package the FMI 3.0 and 2.0 FMUs
-//!   into `target/fmu/`.
+//!   into `target/fmu/`;
+//! - `reference`: regenerate the reference pages of the user guide,
+//!   `docs/reference/`, from the scene registry.
 
 mod fmu;
 mod header;
+mod reference;
 
 use std::path::PathBuf;
 
@@ -22,7 +25,10 @@ fn main() {
     let result = match task.as_str() {
         "header" => header::run(),
         "fmu" => fmu::run(),
-        _ => Err(format!("unknown task `{task}`; tasks: header, fmu")),
+        "reference" => reference::run(),
+        _ => Err(format!(
+            "unknown task `{task}`; tasks: header, fmu, reference"
+        )),
     };
     if let Err(e) = result {
         eprintln!("xtask {task}: {e}");
