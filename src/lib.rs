@@ -85,6 +85,7 @@ mod msph;
 mod neighbors;
 mod observe;
 mod rod;
+mod run;
 mod scene;
 mod sim;
 mod solver;
@@ -101,6 +102,7 @@ pub use observe::{
     PLATE_IMPACT_OBSERVABLES, Snapshot, TAYLOR_OBSERVABLES, write_pvd,
 };
 pub use rod::{profile_deviation, profile_radius};
+pub use run::ENERGY_ERROR_BOUND;
 pub use scene::noh::NohParams;
 pub use scene::params::{Level, ParamSpec, Range};
 pub use scene::table1::Table1Row;
@@ -108,7 +110,6 @@ pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
 pub use scene::{Scene, SceneKind, builtin_names};
 pub use sim::{Progress, Simulation};
-pub use solver::axisymmetric::ENERGY_ERROR_BOUND;
 pub use uniaxial::{FreeSurfaceReading, Layer, PLATE_IMPACT_FIELDS, PlateImpact};
 
 /// Material models and their composition into a [`Material`](materials::Material):
@@ -166,8 +167,9 @@ pub mod internals {
     pub use crate::lanes::W;
     pub use crate::msph::{Neighbourhood, Row2};
     pub use crate::neighbors::{cell_list, naive, padded_rows};
+    pub use crate::run::SPACING_COLLAPSE_BOUND;
     pub use crate::scene::reference;
-    pub use crate::solver::axisymmetric::{SPACING_COLLAPSE_BOUND, TaylorSolver};
+    pub use crate::solver::axisymmetric::TaylorSolver;
 }
 
 /// The library version (the crate version).

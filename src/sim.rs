@@ -252,7 +252,7 @@ impl Simulation {
         scene.validate()?;
         let solver = (scene.kind().row().build)(&scene)?;
         let record_interval = solver.record_interval();
-        crate::solver::check_derived("record interval", record_interval, "")?;
+        crate::run::check_derived("record interval", record_interval, "")?;
         let mut sim = Simulation {
             history: History::new(scene.kind().observable_specs()),
             observed: Observed::new(scene.kind()),

@@ -74,11 +74,10 @@ use crate::material::tensor::{Full, SymTensor};
 use crate::material::{Loading, Material, MaterialState, Point};
 use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
 use crate::rod::{RodObservables, radius};
-use crate::solver::axisymmetric::{
+use crate::run::{
     ENERGY_ERROR_BOUND, QUIET_FRACTION, QUIET_TRANSITS, SHIFT_CAP, SHIFT_RANGE,
-    SPACING_COLLAPSE_BOUND,
+    SPACING_COLLAPSE_BOUND, above, below, check_derived, check_time_step,
 };
-use crate::solver::{above, below, check_derived, check_time_step};
 use rayon::prelude::*;
 
 /// Default damping ratio ζ at the highest frequency `ω_max` of the
@@ -2298,7 +2297,7 @@ impl Mlpg3d {
     /// first step, damping time, impact energy) must be the same bits, and
     /// every node field must have one finite value per node.
     pub(crate) fn check_restored(&self, fresh: &Mlpg3d) -> std::result::Result<(), String> {
-        use crate::solver::axisymmetric::json;
+        use crate::run::json;
         let fixed = |s: &Mlpg3d| {
             json(&(
                 &s.setup,
@@ -2382,7 +2381,7 @@ impl Mlpg3d {
             return Err("its damage variables are missing".into());
         }
         self.material_state.check_len(n)?;
-        crate::solver::check_restored_clock(
+        crate::run::check_restored_clock(
             self.time,
             self.dt,
             self.dt0,
@@ -2400,7 +2399,7 @@ impl Mlpg3d {
         )?;
         // Finite is not enough: a position of 1e300 overflows the search
         // of the supports, a velocity of 1e300 the energies.
-        let bounds = crate::solver::RestoreBounds::new(
+        let bounds = crate::run::RestoreBounds::new(
             &fresh.pos,
             fresh.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max) + fresh.wave_speed(),
             self.time,

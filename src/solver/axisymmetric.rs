@@ -31,6 +31,7 @@
 //!    Z = 0, release when sigma_ZZ turns tensile), traction-free stresses on
 //!    the free surfaces, next time step.
 
+use super::COURANT;
 use super::boundary::{Stress, Surface, corner_free, traction_free};
 use super::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
@@ -38,7 +39,6 @@ use super::pairs::{
 };
 use super::shift::{Candidates, Freedom, carry, leaving, shifts, surface_band};
 use super::team::{Chunks, Team};
-use super::{COURANT, above, below, check_derived, check_time_step};
 use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::kernel::SUPPORT;
@@ -48,22 +48,12 @@ use crate::material::{Damage, Loading, Material, MaterialState, Point};
 use crate::neighbors::padded_rows;
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{self, RodSets};
+use crate::run::{
+    ENERGY_ERROR_BOUND, QUIET_FRACTION, QUIET_TRANSITS, SHIFT_CAP, SHIFT_RANGE,
+    SPACING_COLLAPSE_BOUND, above, below, check_derived, check_time_step, json,
+};
 use crate::scene::taylor::TaylorParams;
 use crate::solver::scheme::{MsphScheme, SmoothingOrder};
-
-/// Smallest distance between two neighbouring particles (every pair, mirror
-/// images included), relative to the initial spacing, below which a run
-/// stops with [`Error::SpacingCollapse`]: particles that close no longer
-/// resolve the material between them.
-pub const SPACING_COLLAPSE_BOUND: f64 = 0.1;
-
-/// Longest shift of a particle in one step, relative to the initial
-/// spacing.
-pub const SHIFT_CAP: f64 = 0.05;
-
-/// Range of the shifting repulsion, relative to the initial spacing: pairs
-/// closer than this push each other apart.
-pub const SHIFT_RANGE: f64 = 0.5;
 
 /// Gap along the axis, relative to the initial spacing, below which an
 /// axis particle may leave the axis (src/solver/shift.rs, `leaving`).
@@ -78,13 +68,6 @@ pub const SURFACE_BAND: f64 = 1.0;
 /// leaving it is moved to: its mirror image is then twice that away, above
 /// [`SPACING_COLLAPSE_BOUND`].
 pub const AXIS_LEAVE: f64 = 0.1;
-
-/// Energy error past which a run stops with [`Error::EnergyDrift`], for
-/// every solver: 0.1, above the largest error met at any output of runs
-/// that finish (7.8 %, a 3-node-across rod's first steps) and below what
-/// diverging runs walk through before they stop (README, "Errors and exit
-/// status").
-pub const ENERGY_ERROR_BOUND: f64 = 0.1;
 
 /// State of a Taylor impact run.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -143,27 +126,11 @@ pub struct TaylorSolver {
     isa: Isa,
 }
 
-/// A value as JSON text, to compare restored state with a fresh build bit
-/// for bit (serde_json writes every f64 so that it reads back the same).
-pub(crate) fn json<T: serde::Serialize>(v: &T) -> String {
-    serde_json::to_string(v).unwrap_or_default()
-}
-
 /// Neighbour-list skin, in units of h: the candidate lists hold every pair
 /// within `(2 + SKIN) h` and are rebuilt once a particle has moved more than
 /// half the skin. Pairs outside the support contribute exactly nothing, so
 /// the result does not depend on when the lists were rebuilt.
 pub const SKIN: f64 = 0.3;
-
-/// The rod is quiet (at rest though still touching the anvil) once its
-/// kinetic energy has stayed at or below this fraction of the impact energy
-/// for [`QUIET_TRANSITS`] elastic transits.
-pub const QUIET_FRACTION: f64 = 0.01;
-
-/// Length of the quiet window in elastic transits `L0 / Ce`: two, the period
-/// of the rod's slowest (free-free) longitudinal mode, so the rod's own
-/// ringing cannot pass as rest.
-pub const QUIET_TRANSITS: f64 = 2.0;
 
 /// Smallest number of particles a thread takes at a time.
 const MIN_LEN: usize = 64;
@@ -635,7 +602,7 @@ impl TaylorSolver {
             "temperatures",
             self.temp.iter().all(|&x| x.is_finite() && x > 0.0),
         )?;
-        super::check_restored_clock(
+        crate::run::check_restored_clock(
             self.time,
             self.dt,
             self.dt0,
@@ -650,7 +617,7 @@ impl TaylorSolver {
         )?;
         // Finite is not enough: a velocity of 1e300 overflows the energies.
         let fastest = |v: &[f64; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
-        let bounds = super::RestoreBounds::new(
+        let bounds = crate::run::RestoreBounds::new(
             &fresh.pos,
             fresh.vel.iter().map(fastest).fold(0.0, f64::max) + fresh.wave_speed(),
             self.time,

@@ -36,15 +36,14 @@
 //! of 0.2 at t = 0.6. The density is not smoothed: it is the shell's mass over
 //! its volume.
 
-use super::{
-    COURANT, check_derived, check_time_step, first_degenerate, first_non_finite, rows_mut,
-};
+use super::{COURANT, first_degenerate, rows_mut};
 use crate::error::{Error, Result};
 use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
 use crate::msph::{Msph1Rows, Row1};
 use crate::neighbors::{NeighborList, cell_list};
 use crate::observe::{FieldSpec, NOH_OBSERVABLES};
+use crate::run::{check_derived, check_time_step, first_non_finite};
 use crate::scene::noh::{NohParams, POST_SHOCK_WINDOW, PRE_SHOCK_WINDOW};
 use rayon::prelude::*;
 
@@ -148,7 +147,7 @@ impl NohSolver {
     /// follows from the parameters must be the same bits, and every field
     /// one finite value per particle.
     pub(crate) fn check_restored(&self, fresh: &NohSolver) -> std::result::Result<(), String> {
-        use super::axisymmetric::json;
+        use crate::run::json;
         if json(&(
             &self.p,
             &self.gas,
