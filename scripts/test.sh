@@ -2,8 +2,22 @@
 # The whole test suite: formatting, lints, the doc links, Rust unit and
 # integration tests (release-optimised physics), the C examples and the fmpy
 # checks. Installs what it needs; run from anywhere.
+#
+# `bash scripts/test.sh --quick`: the fast tier for the edit-compile-test
+# loop (formatting, the unit tests, and the golden bits, saved states,
+# plate impact, the C ABI's boundary and the reference pages' drift), not a
+# substitute for the whole suite, which CI runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+if [ "${1:-}" = "--quick" ]; then
+  echo "== quick tier: cargo fmt --check, unit tests, golden, state, plate impact, capi, reference"
+  cargo fmt --all -- --check
+  cargo test --profile ci --lib
+  cargo test --profile ci --test golden --test state --test plate_impact --test capi --test reference
+  echo "== quick tier passed (the whole suite: bash scripts/test.sh)"
+  exit 0
+fi
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
