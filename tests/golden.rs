@@ -16,6 +16,11 @@
 //! checksum, which covers every observable, was re-recorded then, and its
 //! first twelve finals kept their bits.
 //!
+//! `plate_impact` was added on 2026-11-28 (its uniaxial solver has no
+//! compiled copies; the digest is the same in each), with the ceramic set
+//! whose target spalls, so that crack growth and pulverization in tension
+//! are pinned too.
+//!
 //! Each case is a digest: the bits of every final observable, and an FNV-1a
 //! checksum over the bits of every recorded time and value. Every case runs
 //! in each compiled copy of the hot loops this processor has (AVX-512,
@@ -202,6 +207,27 @@ fn cases() -> Vec<Golden> {
             ],
             history: 0x635f_d715_8818_dc4f,
             rows: 13,
+        },
+        Golden {
+            name: "plate_impact, AD85 on AD85 at 300 m/s with ad85_spall (the target spalls), to 2 us",
+            scene: "plate_impact",
+            sets: &[("plate_ceramic", 1.0)],
+            finals: &[
+                0x406c_a239_caa5_eeaa,
+                0x4072_d94f_b417_20f6,
+                0x41f0_a06a_5725_7d1b,
+                0x4072_d94f_b417_20f6,
+                0x406d_439d_a113_d638,
+                0x41e3_c0e6_286c_47e7,
+                0x3f60_57d1_782d_3848,
+                0x3fe8_0000_0000_0000,
+                0x4106_4df8_cc0e_30e1,
+                0x40fe_5fc8_dfb9_de7d,
+                0x4078_0c00_0000_0000,
+                0x3f4e_30f5_73c7_63fc,
+            ],
+            history: 0x262a_5676_72b5_9162,
+            rows: 401,
         },
     ]
 }
