@@ -25,10 +25,15 @@ const PULVERIZED: f64 = 0.75;
 /// The half-angle from the axis (degrees) of the cone the damaged plate
 /// nodes fill (`points` (x, z) in m of the slice, `gamma` their crack
 /// densities, `damaged` the crack density past which a node counts as
-/// damaged, as the observable `damaged_fraction` counts it): the damaged zone's largest distance from the axis in the
-/// plate's back layer (z within one spacing of `-thickness`) less that in
-/// its top layer (z within one spacing of 0), over the thickness; `None`
-/// when either layer holds no damaged node.
+/// damaged, as the observable `damaged_fraction` counts it): the reach of
+/// the damaged zone around the hole in the plate's back layer (z within
+/// half a spacing of `-thickness`) less that in its top layer (z within
+/// half a spacing of 0), over the thickness. A layer's reach is the
+/// distance from the axis of the last node of the unbroken run of damaged
+/// nodes that starts at the layer's innermost node, so that damage apart
+/// from the hole (rings where the waves reflected from the rim meet) does
+/// not count as the cone. `None` when either layer's innermost node is
+/// intact, or the layer is empty.
 fn cone_half_angle(
     points: &[(f64, f64)],
     gamma: &[f64],
@@ -37,12 +42,14 @@ fn cone_half_angle(
     spacing: f64,
 ) -> Option<f64> {
     let reach = |z0: f64| {
-        points
+        let mut layer: Vec<(f64, bool)> = points
             .iter()
             .zip(gamma)
-            .filter(|((_, z), g)| (z - z0).abs() < spacing && **g >= damaged)
-            .map(|((x, _), _)| x.abs())
-            .reduce(f64::max)
+            .filter(|((_, z), _)| (z - z0).abs() < 0.5 * spacing)
+            .map(|((x, _), g)| (x.abs(), *g >= damaged))
+            .collect();
+        layer.sort_by(|a, b| a.0.total_cmp(&b.0));
+        layer.iter().take_while(|(_, d)| *d).last().map(|(x, _)| *x)
     };
     let (top, back) = (reach(0.0)?, reach(-thickness)?);
     Some(((back - top) / thickness).atan().to_degrees())
@@ -180,8 +187,10 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
          axis (x, z in mm; the plate's top face at z = 0), the projectile grey, from the \
          plate's initial γ0 = {} (log10 {:.0}) to γ = {PULVERIZED}, pulverized, so that \
          partial damage shows. The table's cone half-angle is measured from the axis: the \
-         damaged zone's (γ ≥ {}: 1 % of pulverization and twice γ0) reach from the axis in the back layer less that in \
-         the top layer, over the thickness (\"none\" when a layer holds no damaged node); \
+         reach of the damaged zone (γ ≥ {}: 1 % of pulverization and twice γ0) around the \
+         hole, the unbroken run of damaged nodes from the layer's innermost one, in the back \
+         layer less that in the top layer, over the thickness (\"none\" when a layer's \
+         innermost node is intact); damage apart from the hole does not count. \
          the classical ceramic-armour models put it at 60-70° (Florence's a + 2h gives \
          63°). The fields at each time, `log10_damage` and `crack_size` among them, are in \
          the VTK snapshots of `meshless-impact run penetration --vtk-dir DIR --vtk-times \
@@ -348,4 +357,32 @@ pub(super) fn ballistic_limit(plan: &Plan, doc: &mut Doc) -> Result<()> {
         ),
         &[Series::markers("shots", curve)],
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cone_half_angle;
+
+    /// A slice with a damaged cone from 5 mm (top) to 15 mm (back) across
+    /// a 5 mm plate, plus a damaged ring at 30 mm in both layers that the
+    /// measure must not count: atan(10 / 5) = 63.4 degrees.
+    #[test]
+    fn the_cone_is_the_damaged_run_around_the_hole() {
+        let (h, t) = (1e-3, 5e-3);
+        let mut points = Vec::new();
+        let mut gamma = Vec::new();
+        for (z, edge) in [(0.0, 5e-3), (-t, 15e-3)] {
+            for k in 1..=40 {
+                let x = k as f64 * h;
+                points.push((x, z));
+                let ring = (x - 30e-3).abs() < 1.5e-3;
+                gamma.push(if x <= edge + 1e-9 || ring { 0.75 } else { 1e-5 });
+            }
+        }
+        let a = cone_half_angle(&points, &gamma, 0.0075, t, h).unwrap();
+        assert!((a - (2.0f64).atan().to_degrees()).abs() < 1e-9, "{a}");
+        // An intact innermost node in the top layer: no cone.
+        gamma[0] = 1e-5;
+        assert_eq!(cone_half_angle(&points, &gamma, 0.0075, t, h), None);
+    }
 }
