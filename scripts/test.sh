@@ -14,7 +14,7 @@ if [ "${1:-}" = "--quick" ]; then
   echo "== quick tier: cargo fmt --check, unit tests, golden, state, plate impact, capi, reference"
   cargo fmt --all -- --check
   cargo test --profile ci --lib
-  cargo test --profile ci --test golden --test state --test plate_impact --test capi --test reference
+  cargo test --profile ci --test suite -- golden:: state:: plate_impact:: capi:: reference::
   echo "== quick tier passed (the whole suite: bash scripts/test.sh)"
   exit 0
 fi
@@ -36,6 +36,10 @@ if grep -qw avx512f /proc/cpuinfo 2>/dev/null && grep -qw avx512vl /proc/cpuinfo
 fi
 cargo test --profile ci --all-targets
 cargo test --profile ci --doc
+# The C examples and the FMUs link the library of the same `ci` build (the
+# release optimisation without LTO: the same code, built once; what ships is
+# built with `release`).
+export MI_PROFILE=ci
 if [ -f examples_c/Makefile ]; then
   echo "== C examples"
   make -C examples_c test

@@ -25,11 +25,11 @@ step() {
   echo "== $*"
   "$@" || failed+=("$*")
 }
-step cargo test --release --test taylor -- --ignored --nocapture
-step cargo test --release --test taylor3d -- --ignored --nocapture
-step cargo test --release --test penetration the_seed_case_at_the_default_resolution -- --ignored --nocapture
+step cargo test --release --test suite taylor:: -- --ignored --nocapture
+step cargo test --release --test suite taylor3d:: -- --ignored --nocapture
+step cargo test --release --test suite penetration::the_seed_case_at_the_default_resolution -- --ignored --nocapture
 step cargo test --release --test boundary -- --ignored --nocapture
-step cargo test --release --test mlpg_solver the_staggered_wilkins_bar_under_refinement -- --ignored --nocapture
+step cargo test --release --test suite mlpg_solver::the_staggered_wilkins_bar_under_refinement -- --ignored --nocapture
 if [ ${#failed[@]} -gt 0 ]; then
   echo "== failed:"
   printf '  %s\n' "${failed[@]}"

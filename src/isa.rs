@@ -7,7 +7,7 @@
 //! copy its processor has ([`Isa::best`]) unless told otherwise
 //! ([`crate::Simulation::set_isa`]). Every copy performs the same IEEE
 //! operations in the same order, so they give the same bits; the golden test
-//! (`tests/golden.rs`) runs each one this processor has.
+//! (`tests/suite/golden.rs`) runs each one this processor has.
 //!
 //! An [`Isa`] can only be obtained for a copy this processor runs, which is
 //! what makes calling the AVX copies sound.

@@ -6,7 +6,7 @@
 //! [`SCENES`] or [`STOPS`]; cbindgen copies it into the header as
 //! ` * @SCENES@`, and [`expand_header`] replaces that line by the list, each
 //! line with the placeholder's prefix. `cargo xtask header` writes the
-//! expanded text, and `tests/capi.rs` compares the committed header with it.
+//! expanded text, and `tests/suite/capi.rs` compares the committed header with it.
 
 use super::error::RESULTS;
 use crate::scene::registry;

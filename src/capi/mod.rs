@@ -6,7 +6,7 @@
 //! (`cargo xtask header`, settings in `cbindgen.toml`), and [`expand_header`]
 //! fills in the lists that come from the library's tables (the built-in
 //! scenes, the stop codes) where a doc comment holds a placeholder line;
-//! `tests/capi.rs` fails when the committed header differs from that output.
+//! `tests/suite/capi.rs` fails when the committed header differs from that output.
 //!
 //! Rules every entry point follows:
 //!

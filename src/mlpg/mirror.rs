@@ -34,7 +34,7 @@
 //!
 //! So the quarter model is the full model restricted to a quarter, up to the
 //! order of the sums and of the contact's Gauss-Seidel sweep; it costs a
-//! quarter of the rows (`tests/penetration.rs` compares the two).
+//! quarter of the rows (`tests/suite/penetration.rs` compares the two).
 
 /// Bit of a node on, or an image across, the plane `x = 0`.
 pub const X: u8 = 1;

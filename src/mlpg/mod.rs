@@ -24,7 +24,7 @@
 //!
 //! The pieces together integrate a free elastic bar's fundamental mode to
 //! within 0.8 % (2 rings) and 0.2 % (3 rings) of its period
-//! (`tests/mlpg.rs`), but the plain scheme is not stable over long runs:
+//! (`tests/suite/mlpg.rs`), but the plain scheme is not stable over long runs:
 //! see [`sphere::ALPHA`]. The time loop with materials, the anvil contact
 //! and the scene are the solver's, built on these pieces.
 

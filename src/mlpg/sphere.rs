@@ -323,7 +323,7 @@ pub fn test_radii(nearest: &[f64], boundary_distance: &[f64], alpha: f64) -> Vec
 }
 
 /// The test-size factor α of eq. (12), chosen by measurement on the free
-/// elastic bar of `tests/mlpg.rs` (`alpha_table`: fundamental mode, 5
+/// elastic bar of `tests/suite/mlpg.rs` (`alpha_table`: fundamental mode, 5
 /// periods at a third of the stable step; κ of `mlpg::step`):
 ///
 /// | α | κ | period error, 2 / 3 rings | energy error, 2 / 3 rings |

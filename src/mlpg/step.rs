@@ -8,7 +8,7 @@
 //! `c_p = √((K + 4G/3)/ρ)` over the smallest node distance, times the
 //! factor [`OMEGA_FACTOR`] of the discrete MLPG operator, measured by power
 //! iteration ([`largest_eigenvalue`]) on the linear elastic operator of a
-//! free bar on the ring lattice (`tests/mlpg.rs`,
+//! free bar on the ring lattice (`tests/suite/mlpg.rs`,
 //! `highest_frequency_of_the_elastic_operator`): κ = 1.448 at 2 and 1.451
 //! at 3 rings across the radius (α = 0.9, k = 10, factor 1.5); κ grows as
 //! α shrinks (2.01 at α = 0.5), as the cut spheres of the boundary nodes

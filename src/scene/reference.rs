@@ -2,7 +2,7 @@
 //! Markdown page per built-in scene (its parameters, observables and
 //! particle fields), rendered from the scene registry and never written by
 //! hand. `meshless-impact params SCENE --markdown` prints one page, `cargo
-//! xtask reference` writes them all, and `tests/reference.rs` fails when a
+//! xtask reference` writes them all, and `tests/suite/reference.rs` fails when a
 //! committed page differs from its rendering.
 
 use super::Scene;
@@ -219,7 +219,7 @@ pub fn index() -> Result<String> {
         "One page per built-in scene: its parameters (units, defaults, allowed values), \
          observables and particle fields. The pages are generated from the scene registry \
          (`cargo xtask reference`; `meshless-impact params SCENE --markdown` prints one), \
-         and `tests/reference.rs` fails when one is stale.\n"
+         and `tests/suite/reference.rs` fails when one is stale.\n"
     );
     for name in crate::builtin_names() {
         let title = Scene::builtin(&name)?.title;

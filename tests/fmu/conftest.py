@@ -3,6 +3,7 @@ see run.sh), extracted once, and helpers that drive them through fmpy's
 low-level classes."""
 
 import json
+import os
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -15,7 +16,8 @@ from fmpy.validation import validate_fmu
 ROOT = Path(__file__).resolve().parents[2]
 FMU3 = ROOT / "target" / "fmu" / "TaylorImpact.fmu"
 FMU2 = ROOT / "target" / "fmu" / "TaylorImpact_fmi2.fmu"
-CLI = ROOT / "target" / "release" / "meshless-impact"
+# The program of the same build as the FMUs (`MI_PROFILE`, default release).
+CLI = ROOT / "target" / os.environ.get("MI_PROFILE", "release") / "meshless-impact"
 
 # Coarse resolution for every test except the one CLI equality check at the
 # defaults: about 1 s per run instead of about 25 s.

@@ -127,7 +127,7 @@ def test_sweep_on_a_local_dask_cluster_leaves_unsettled_shots_out(tmp_path, tmp_
 
 def test_the_status_is_the_scenes_outcome():
     """The status is the scene's shot_outcome, decided from the state
-    (tests/penetration.rs::a_slow_perforation_is_not_called_stopped holds
+    (tests/suite/penetration.rs::a_slow_perforation_is_not_called_stopped holds
     the physics): 1 through with its velocity as V_r, 2 stopped with V_r 0,
     0 unsettled at the cap, and an error stays an error. The 900 m/s shot of
     the 6-across sweep of 2026-11-26 (VALIDATION.md, "The ballistic limit at

@@ -30,10 +30,13 @@ pub fn run() -> Result<(), String> {
     if !(cfg!(target_os = "linux") && cfg!(target_arch = "x86_64")) {
         return Err("packaging is implemented for x86_64 Linux only".into());
     }
+    // The cargo profile of the library: `release` (what ships) unless
+    // `MI_PROFILE` names another; the test command packages its `ci` build.
+    let profile = std::env::var("MI_PROFILE").unwrap_or_else(|_| "release".into());
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
         .current_dir(&root)
-        .args(["build", "--release", "-p", "meshless-impact"])
+        .args(["build", "--profile", &profile, "-p", "meshless-impact"])
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
@@ -42,7 +45,7 @@ pub fn run() -> Result<(), String> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("target"));
-    let lib = target.join("release").join("libmeshless_impact.so");
+    let lib = target.join(&profile).join("libmeshless_impact.so");
     let binary = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
     let out_dir = target.join("fmu");
     std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;

@@ -1,7 +1,7 @@
 //! `cargo xtask header`: regenerate the C header `include/meshless_impact.h`
 //! from `src/capi/` with the settings of `cbindgen.toml`, then fill in the
 //! lists that come from the library's tables (the built-in scenes, the stop
-//! codes: `meshless_impact::internals::capi::expand_header`). `tests/capi.rs`
+//! codes: `meshless_impact::internals::capi::expand_header`). `tests/suite/capi.rs`
 //! generates it the same way and fails when the committed file differs.
 
 use meshless_impact::internals::capi::expand_header;

@@ -1,8 +1,8 @@
 //! Project tasks, run as `cargo xtask <task>`:
 //!
 //! - `header`: regenerate `include/meshless_impact.h` with cbindgen;
-//! - `fmu`: build the release library and package the FMI 3.0 and 2.0 FMUs
-//!   into `target/fmu/`;
+//! - `fmu`: build the release library (or the profile `MI_PROFILE` names)
+//!   and package the FMI 3.0 and 2.0 FMUs into `target/fmu/`;
 //! - `reference`: regenerate the reference pages of the user guide,
 //!   `docs/reference/`, from the scene registry.
 

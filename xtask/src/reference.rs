@@ -3,7 +3,7 @@
 //! built-in scene, from the scene registry
 //! (`meshless_impact::internals::reference`, the renderer of `meshless-impact
 //! params SCENE --markdown`). Pages of scenes that no longer exist are
-//! removed. `tests/reference.rs` renders them the same way and fails when a
+//! removed. `tests/suite/reference.rs` renders them the same way and fails when a
 //! committed page differs.
 
 use meshless_impact::internals::reference::{DIR, files};

@@ -1,7 +1,7 @@
 //! Taylor impact against the experiments of House et al. (1995) as tabulated by
 //! Batra & Zhang (2008).
 
-mod common;
+use crate::common;
 use common::{pct, run, tail_slowdown_time};
 use meshless_impact::{Scene, Simulation, Table1Row};
 use rayon::prelude::*;

@@ -4,7 +4,7 @@
 //! to three, the 3-D stress with its six), bit for bit (the arrays are
 //! written as binary).
 
-mod common;
+use crate::common;
 
 use meshless_impact::{Field, Scene, Simulation, Snapshot};
 use std::path::Path;
@@ -43,7 +43,7 @@ fn snapshot_round_trips_through_the_vtk_reader() {
     let vtu = read_vtu(&path);
     std::fs::remove_dir_all(&dir).ok();
     // (The XML format keeps no title or time: the time goes into the `.pvd`
-    // collection, tests/cli.rs.)
+    // collection, tests/suite/cli.rs.)
     let expect: Vec<f64> = positions.iter().flatten().copied().collect();
     assert_eq!(vtu.points, expect);
     assert_eq!(vtu.arrays.len(), 2);

@@ -4,7 +4,7 @@
 //! against its 3-D finite-element references, run through the scene
 //! registry and `Simulation`.
 
-mod common;
+use crate::common;
 
 use common::{pct, run};
 use meshless_impact::Scene;

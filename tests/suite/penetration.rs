@@ -2,7 +2,7 @@
 //! AD85 plate by the 3-D MLPG mixed method, through the scene registry and
 //! `Simulation`, and its solver directly for the explorations.
 
-mod common;
+use crate::common;
 
 use meshless_impact::{Scene, Simulation};
 
@@ -64,7 +64,7 @@ fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
 /// `MI_DIAGNOSE=e`, the nodes that gain the most kinetic energy in the
 /// first three steps past the energy error `e`; at a stop, the closest
 /// pair of one body.
-/// `MI_RINGS=4 cargo test --release --test penetration -- --ignored --nocapture explore`
+/// `MI_RINGS=4 cargo test --release --test suite penetration:: -- --ignored --nocapture explore`
 #[test]
 #[ignore]
 fn explore_seed_case() {

@@ -2,7 +2,7 @@
 //! way a new scene with the same values would be refused; an unedited state
 //! is accepted and resumes (issue: forged saved states are accepted).
 
-mod common;
+use crate::common;
 
 use meshless_impact::{Scene, Simulation};
 use serde_json::{Value, json};

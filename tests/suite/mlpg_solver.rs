@@ -2,7 +2,7 @@
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
-mod common;
+use crate::common;
 
 use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup, WeakForm};
 use meshless_impact::materials::{Bilinear, Damage, Eos, LinearEos, Material, Strength};

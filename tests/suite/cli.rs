@@ -1,6 +1,6 @@
 //! The command-line program: errors, outputs and the documented JSON keys.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

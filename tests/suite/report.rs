@@ -230,7 +230,7 @@ fn quick_report_regenerates_and_meets_its_claims() {
     // The seed's penetration case at 4 across: pictures at 4, 8, 12 and
     // 20 µs; the pulverized zone only grows (pulverization is final); the
     // projectile slows and leaves within 20 % of the seed's 1240 m/s
-    // (measured 1059.5 m/s; tests/penetration.rs).
+    // (measured 1059.5 m/s; tests/suite/penetration.rs).
     let zones = read_csv(&dir.join("penetration_zones.csv"));
     let times: Vec<f64> = zones.iter().map(|r| num(r, "time_us")).collect();
     assert_eq!(times.len(), 4, "{times:?}");
@@ -255,7 +255,7 @@ fn quick_report_regenerates_and_meets_its_claims() {
 
     // The ballistic-limit sweep at 3 across (quarter model), each shot to
     // its outcome: 500 m/s stops, 1000 m/s perforates slowly (at 29.06 µs,
-    // 378.4 m/s: tests/penetration.rs::a_slow_perforation_is_not_called_stopped
+    // 378.4 m/s: tests/suite/penetration.rs::a_slow_perforation_is_not_called_stopped
     // holds the same shot), 1500 m/s perforates; the report brackets the
     // ballistic limit between the two.
     let shots = read_csv(&dir.join("ballistic_limit.csv"));
