@@ -677,6 +677,7 @@ fn the_wilkins_bar_in_3d_comes_to_rest_as_close_as_the_axisymmetric_one() {
 /// the 2 % (measured 1.4 %; 4.4 % with the plain nodal form), and
 /// the energy balance holds within 5 % (measured 0.13 %).
 #[test]
+#[ignore = "heavy: about 1 minute on two cores; scripts/validate.sh"]
 fn conforming_gradients_bring_the_wilkins_bar_to_the_axisymmetric_solver() {
     let scene = wilkins3d(&[
         ("weak_form", 2.0),
@@ -767,6 +768,7 @@ fn staggered_wilkins_bar(particles_radial: f64) -> (f64, f64) {
 /// 7.41 mm with a spread of 2.4 %, and stop with `EnergyDrift` at 28.3 µs
 /// at 8 across (VALIDATION.md, "The staggered lattice").
 #[test]
+#[ignore = "heavy: about 1.5 minutes on two cores; scripts/validate.sh"]
 fn the_wilkins_bar_in_3d_meets_its_references_on_the_staggered_lattice() {
     let scene = wilkins3d(&[]);
     for (name, value) in [
