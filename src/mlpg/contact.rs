@@ -106,7 +106,7 @@ pub fn loose_pairs(
 /// of what the impulse removes is the approach that this step's internal
 /// forces gave two surface nodes pressed together: the contact's reaction
 /// on nodes that do not move relative to each other does no work, as the
-/// anvil's on a node held at rest (`src/mlpg/solver.rs`), and that motion
+/// anvil's on a node held at rest (`src/mlpg/solver/step.rs`), and that motion
 /// never happened.
 pub fn resolve(
     pairs: &[(usize, usize)],

@@ -1,4 +1,4 @@
-//! The 3-D MLPG solver's time loop (`src/mlpg/solver.rs`): elastic waves
+//! The 3-D MLPG solver's time loop (`src/mlpg/solver/`): elastic waves
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
