@@ -56,8 +56,25 @@
 //! anvil has the anvil's normal. An interior node's test radius is shrunk
 //! (eq. 12) to its distance from the tangent planes of the boundary nodes
 //! it names.
+//!
+//! # Files
+//!
+//! - this file: the run's state ([`Mlpg3d`]) and its assembly;
+//! - `setup.rs`: [`RodSetup`], [`WeakForm`], [`Body`] and the defaults;
+//! - `step.rs`: the step in order, with the forces (step 1), the geometry
+//!   following the body (step 4) and the checks (step 6);
+//! - `motion.rs`: the passes of steps 2-3 (velocities, smoothing, contact,
+//!   clamp, positions), functions over the node fields;
+//! - `update.rs`: the material pass of step 5 and the step's sums;
+//! - `shifting.rs`: node shifting and the carry of the moved nodes' fields;
+//! - `geometry.rs` and `spheres.rs`: the supports, shapes, operator and
+//!   test spheres of a build;
+//! - `scratch.rs`: the step's named buffers;
+//! - `observe.rs`: what a run reports; `restore.rs`: the checks of a
+//!   restored run; `util.rs`: small shared helpers.
 
 mod geometry;
+mod motion;
 mod observe;
 mod restore;
 mod scratch;
@@ -67,6 +84,7 @@ mod spheres;
 mod step;
 #[cfg(test)]
 mod tests;
+mod update;
 mod util;
 
 use super::conform::{CONFORM_TOLERANCE, conform};

@@ -144,21 +144,7 @@ impl Mlpg3d {
             + b(&l.sets.face)
             + b(&l.sets.mantle)
             + self.particles() * std::mem::size_of::<crate::material::PointState>();
-        let k = &self.scratch;
-        let scratch = b(&k.total)
-            + b(&k.force)
-            + b(&k.kicked)
-            + b(&k.smooth)
-            + b(&k.defect)
-            + b(&k.pass)
-            + b(&k.moved)
-            + b(&k.grad)
-            + b(&k.volume)
-            + b(&k.results)
-            + b(&k.shift)
-            + b(&k.free)
-            + b(&k.carried)
-            + b(&k.carried_out);
+        let scratch = self.scratch.bytes();
         let (mut supports, mut shapes, mut spheres, mut op) = (0, 0, 0, 0);
         if let Some(g) = &self.geometry {
             if let Some(s) = &g.supports {

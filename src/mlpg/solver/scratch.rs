@@ -3,43 +3,74 @@
 
 use super::*;
 
-/// The buffers of a step, reused from step to step (not saved).
+/// The buffers of a step, reused from step to step (not saved), one group
+/// per pass.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scratch {
-    pub(super) total: Vec<[f64; 6]>,
-    pub(super) force: Vec<[f64; 3]>,
-    pub(super) kicked: Vec<(f64, Option<f64>)>,
-    pub(super) smooth: Vec<[f64; 3]>,
-    /// The smoothing's defect `H v` (order 2: `Hᵀ M H v`) and, with
-    /// order 2, the mass-weighted defect `M H v`.
-    pub(super) defect: Vec<[f64; 3]>,
-    pub(super) pass: Vec<[f64; 3]>,
-    pub(super) moved: Vec<(f64, f64, Option<f64>, Option<f64>)>,
+    /// The forces (step 1).
+    pub(super) forces: ForceBuffers,
+    /// What the velocity update saw at each node (step 2).
+    pub(super) kicks: Vec<Kick>,
+    /// The velocity smoothing's buffers.
+    pub(super) smoothing: SmoothingBuffers,
+    /// The contact's buffers.
+    pub(super) contact: ContactBuffers,
+    /// What the position update did at each node (step 3).
+    pub(super) moves: Vec<Move>,
+    /// The collocated velocity gradients (step 5).
     pub(super) grad: Vec<[[f64; 3]; 3]>,
+    /// Each node's sums of the material pass, or its error.
+    pub(super) results: Vec<std::result::Result<Tally, (usize, Error)>>,
+    /// The shifting's buffers (sized only with `shifting > 0`).
+    pub(super) shifting: ShiftBuffers,
+    /// The quarter model's fields extended by the mirror images.
+    pub(super) images: ImageBuffers,
+}
+
+/// The buffers of the forces.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ForceBuffers {
+    /// The total stress `σ + σ_v` at each node.
+    pub(super) total: Vec<[f64; 6]>,
+    /// The nodal forces (the real nodes', then the images' to fold).
+    pub(super) force: Vec<[f64; 3]>,
     /// The nodal volumes `m / ρ` (the nodal form).
     pub(super) volume: Vec<f64>,
-    pub(super) results: Vec<std::result::Result<Tally, (usize, Error)>>,
-    /// The shifts and the carried fields (sized only with `shifting > 0`).
-    pub(super) shift: Vec<[f64; 3]>,
-    pub(super) free: Vec<Freedom>,
-    pub(super) carried: Vec<[f64; CARRIED]>,
-    pub(super) carried_out: Vec<[f64; CARRIED]>,
-    /// The node pairs of different bodies in contact.
+}
+
+/// The buffers of the velocity smoothing.
+#[derive(Debug, Clone, Default)]
+pub(super) struct SmoothingBuffers {
+    /// The smoothed velocities (swapped with the nodes').
+    pub(super) smooth: Vec<[f64; 3]>,
+    /// The smoothing's defect `H v` (order 2: `Hᵀ M H v`).
+    pub(super) defect: Vec<[f64; 3]>,
+    /// With order 2, the mass-weighted defect `M H v`.
+    pub(super) pass: Vec<[f64; 3]>,
+}
+
+/// The buffers of the contact between bodies and between pulverized nodes.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ContactBuffers {
+    /// The node pairs in contact.
     pub(super) pairs: Vec<(usize, usize)>,
-    /// The velocities before the step's forces (runs of several bodies).
+    /// The velocities before the step's forces (runs of several bodies or
+    /// with damage).
     pub(super) before: Vec<[f64; 3]>,
     /// Whether each node is pulverized (runs with damage).
     pub(super) loose: Vec<bool>,
-    /// The quarter model's fields extended by the mirror images.
-    pub(super) ext_pos: Vec<[f64; 3]>,
-    pub(super) ext_built: Vec<[f64; 3]>,
-    pub(super) ext_vel: Vec<[f64; 3]>,
-    pub(super) ext_before: Vec<[f64; 3]>,
-    pub(super) ext_total: Vec<[f64; 6]>,
-    pub(super) ext_mass: Vec<f64>,
-    pub(super) ext_group: Vec<u8>,
-    pub(super) ext_loose: Vec<bool>,
-    pub(super) ext_carried: Vec<[f64; CARRIED]>,
+}
+
+/// The buffers of the node shifting.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ShiftBuffers {
+    /// Each node's shift.
+    pub(super) shift: Vec<[f64; 3]>,
+    /// How each node may move.
+    pub(super) free: Vec<Freedom>,
+    /// The carried fields ([`CARRIED`]) before and after the carry.
+    pub(super) carried: Vec<[f64; CARRIED]>,
+    pub(super) carried_out: Vec<[f64; CARRIED]>,
     /// The change of each node's momentum in the conservative carry
     /// (images after the real nodes).
     pub(super) momentum: Vec<[f64; 3]>,
@@ -47,27 +78,88 @@ pub(super) struct Scratch {
     pub(super) share: Vec<Option<[f64; 3]>>,
 }
 
+/// The quarter model's fields extended by the mirror images (each the
+/// real nodes' values, then the images').
+#[derive(Debug, Clone, Default)]
+pub(super) struct ImageBuffers {
+    pub(super) pos: Vec<[f64; 3]>,
+    pub(super) built: Vec<[f64; 3]>,
+    pub(super) vel: Vec<[f64; 3]>,
+    pub(super) before: Vec<[f64; 3]>,
+    pub(super) total: Vec<[f64; 6]>,
+    pub(super) mass: Vec<f64>,
+    pub(super) group: Vec<u8>,
+    pub(super) loose: Vec<bool>,
+    pub(super) carried: Vec<[f64; CARRIED]>,
+}
+
+/// What the velocity update saw at a node.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Kick {
+    /// The kinetic energy a node held on the anvil lost toward it (J).
+    pub(super) held: f64,
+    /// The time of its release from the anvil in this step, if it let go.
+    pub(super) released: Option<f64>,
+}
+
+/// What the position update did at a node.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Move {
+    /// [`Kick::held`].
+    pub(super) held: f64,
+    /// The kinetic energy toward the anvil it lost on reaching it (J).
+    pub(super) lost: f64,
+    /// [`Kick::released`].
+    pub(super) released: Option<f64>,
+    /// Its height when it passed the anvil by more than half a spacing.
+    pub(super) through: Option<f64>,
+}
+
 impl Scratch {
     /// Every buffer at `n` entries (allocates only when `n` grows).
     pub(super) fn fit(&mut self, n: usize) {
-        self.total.resize(n, [0.0; 6]);
-        self.force.resize(n, [0.0; 3]);
-        self.kicked.resize(n, (0.0, None));
-        self.smooth.resize(n, [0.0; 3]);
-        self.defect.resize(n, [0.0; 3]);
-        self.pass.resize(n, [0.0; 3]);
-        self.moved.resize(n, (0.0, 0.0, None, None));
+        self.forces.total.resize(n, [0.0; 6]);
+        self.forces.force.resize(n, [0.0; 3]);
+        self.kicks.resize(n, Kick::default());
+        self.smoothing.smooth.resize(n, [0.0; 3]);
+        self.smoothing.defect.resize(n, [0.0; 3]);
+        self.smoothing.pass.resize(n, [0.0; 3]);
+        self.moves.resize(n, Move::default());
         self.grad.resize(n, [[0.0; 3]; 3]);
-        self.volume.resize(n, 0.0);
+        self.forces.volume.resize(n, 0.0);
         self.results.resize(n, Ok(Tally::default()));
     }
 
     /// The shifting buffers at `n` entries.
     pub(super) fn fit_shift(&mut self, n: usize) {
-        self.shift.resize(n, [0.0; 3]);
-        self.free.resize(n, Freedom::Fixed);
-        self.carried.resize(n, [0.0; CARRIED]);
-        self.carried_out.resize(n, [0.0; CARRIED]);
+        let s = &mut self.shifting;
+        s.shift.resize(n, [0.0; 3]);
+        s.free.resize(n, Freedom::Fixed);
+        s.carried.resize(n, [0.0; CARRIED]);
+        s.carried_out.resize(n, [0.0; CARRIED]);
+    }
+
+    /// The heap bytes of the buffers counted per node in the memory by
+    /// part ([`Mlpg3d::memory`]; capacities, not lengths).
+    pub(super) fn bytes(&self) -> usize {
+        fn b<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let (f, s, h) = (&self.forces, &self.smoothing, &self.shifting);
+        b(&f.total)
+            + b(&f.force)
+            + b(&self.kicks)
+            + b(&s.smooth)
+            + b(&s.defect)
+            + b(&s.pass)
+            + b(&self.moves)
+            + b(&self.grad)
+            + b(&f.volume)
+            + b(&self.results)
+            + b(&h.shift)
+            + b(&h.free)
+            + b(&h.carried)
+            + b(&h.carried_out)
     }
 }
 

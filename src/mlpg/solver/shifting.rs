@@ -35,53 +35,59 @@ impl Mlpg3d {
         let reference = extended(
             images,
             &self.reference,
-            &mut scratch.ext_built,
+            &mut scratch.images.built,
             mirror::vector,
         );
         let points = self.material_state.points();
-        scratch.free.par_iter_mut().enumerate().for_each(|(i, f)| {
-            // A pulverized node stays put: its ceramic state (pulverized,
-            // its porosity) is not carried, so carrying its neighbours'
-            // stress and density to it created energy (the penetration at
-            // 4 across: energy error 18.8 % against 0.46 % with it fixed;
-            // README, "Ballistic penetration"); the contact of pulverized
-            // nodes keeps them apart.
-            let pulverized = points.get(i).is_some_and(|p| p.is_pulverized());
-            *f = if pulverized {
-                Freedom::Fixed
-            } else if !anvil {
-                Freedom::Unbounded
-            } else if nodal && surf[i] == Surfaces(Surfaces::MANTLE) {
-                // F⁻¹ = ∂X/∂x at this node only (eq. 4 on the reference places).
-                let finv = shapes.gradient(i, reference);
-                Freedom::InPlane(nanson(&finv, radial(reference[i])))
-            } else if nodal && surf[i] == Surfaces(Surfaces::FACE) && contact[i] {
-                Freedom::InPlane([0.0, 0.0, 1.0])
-            } else if !surf[i].interior() {
-                Freedom::Fixed
-            } else if contact[i] {
-                Freedom::InPlane([0.0, 0.0, 1.0])
-            } else {
-                Freedom::Free
-            };
-        });
-        let pos = extended(images, &self.pos, &mut scratch.ext_pos, mirror::vector);
+        scratch
+            .shifting
+            .free
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, f)| {
+                // A pulverized node stays put: its ceramic state (pulverized,
+                // its porosity) is not carried, so carrying its neighbours'
+                // stress and density to it created energy (the penetration at
+                // 4 across: energy error 18.8 % against 0.46 % with it fixed;
+                // README, "Ballistic penetration"); the contact of pulverized
+                // nodes keeps them apart.
+                let pulverized = points.get(i).is_some_and(|p| p.is_pulverized());
+                *f = if pulverized {
+                    Freedom::Fixed
+                } else if !anvil {
+                    Freedom::Unbounded
+                } else if nodal && surf[i] == Surfaces(Surfaces::MANTLE) {
+                    // F⁻¹ = ∂X/∂x at this node only (eq. 4 on the reference places).
+                    let finv = shapes.gradient(i, reference);
+                    Freedom::InPlane(nanson(&finv, radial(reference[i])))
+                } else if nodal && surf[i] == Surfaces(Surfaces::FACE) && contact[i] {
+                    Freedom::InPlane([0.0, 0.0, 1.0])
+                } else if !surf[i].interior() {
+                    Freedom::Fixed
+                } else if contact[i] {
+                    Freedom::InPlane([0.0, 0.0, 1.0])
+                } else {
+                    Freedom::Free
+                };
+            });
+        let pos = extended(images, &self.pos, &mut scratch.images.pos, mirror::vector);
         let step_scale = self.setup.step_scale();
         shifts(
             pos,
             &g.shapes,
-            &scratch.free,
+            &scratch.shifting.free,
             spacing,
             SHIFT_RANGE * spacing,
             self.setup.shifting * step_scale,
             SHIFT_CAP * spacing * step_scale,
-            &mut scratch.shift,
+            &mut scratch.shifting.shift,
         );
         // A node on a symmetry plane moves in it; a held node stays.
-        for (d, &on) in scratch.shift.iter_mut().zip(&self.plane) {
+        for (d, &on) in scratch.shifting.shift.iter_mut().zip(&self.plane) {
             pin(d, on);
         }
         for (d, _) in scratch
+            .shifting
             .shift
             .iter_mut()
             .zip(&self.held)
@@ -89,11 +95,12 @@ impl Mlpg3d {
         {
             *d = [0.0; 3];
         }
-        let d = &scratch.shift;
+        let d = &scratch.shifting.shift;
         if d.iter().all(|d| *d == [0.0; 3]) {
             return Ok(());
         }
         scratch
+            .shifting
             .carried
             .par_iter_mut()
             .enumerate()
@@ -119,27 +126,33 @@ impl Mlpg3d {
             });
         let carried = extended(
             images,
-            &scratch.carried,
-            &mut scratch.ext_carried,
+            &scratch.shifting.carried,
+            &mut scratch.images.carried,
             reflect_carried,
         );
-        carry(&g.shapes, carried, d, &mut scratch.carried_out);
+        carry(&g.shapes, carried, d, &mut scratch.shifting.carried_out);
         let conservative = self.setup.conservative_carry;
         let mut ke = [0.0; 2];
         if conservative {
             ke[0] = kinetic(&self.vel, &self.mass);
-            let vel = extended(images, &self.vel, &mut scratch.ext_vel, mirror::vector);
-            let mass = extended(images, &self.mass, &mut scratch.ext_mass, mirror::same);
+            let vel = extended(images, &self.vel, &mut scratch.images.vel, mirror::vector);
+            let mass = extended(images, &self.mass, &mut scratch.images.mass, mirror::same);
             exchange(
                 &g.shapes,
                 vel,
                 mass,
                 d,
-                &mut scratch.share,
-                &mut scratch.momentum,
+                &mut scratch.shifting.share,
+                &mut scratch.shifting.momentum,
             );
-            images.fold(self.pos.len(), &mut scratch.momentum);
-            for (i, p) in scratch.momentum.iter().enumerate().take(self.pos.len()) {
+            images.fold(self.pos.len(), &mut scratch.shifting.momentum);
+            for (i, p) in scratch
+                .shifting
+                .momentum
+                .iter()
+                .enumerate()
+                .take(self.pos.len())
+            {
                 if *p == [0.0; 3] {
                     continue;
                 }
@@ -155,7 +168,7 @@ impl Mlpg3d {
                 }
             }
         }
-        for (i, (f, di)) in scratch.carried_out.iter().zip(d).enumerate() {
+        for (i, (f, di)) in scratch.shifting.carried_out.iter().zip(d).enumerate() {
             if *di == [0.0; 3] {
                 continue;
             }
