@@ -66,7 +66,8 @@
 //! - `motion.rs`: the passes of steps 2-3 (velocities, smoothing, contact,
 //!   clamp, positions), functions over the node fields;
 //! - `update.rs`: the material pass of step 5 and the step's sums;
-//! - `shifting.rs`: node shifting and the carry of the moved nodes' fields;
+//! - `shifting.rs`: node shifting and the carry of the moved nodes' fields,
+//!   functions over the node fields;
 //! - `geometry.rs` and `spheres.rs`: the supports, shapes, operator and
 //!   test spheres of a build;
 //! - `scratch.rs`: the step's named buffers;
@@ -422,12 +423,6 @@ impl Mlpg3d {
         std::iter::once(&self.material)
             .chain(self.others.iter().map(|b| &b.material))
             .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)))
-    }
-
-    /// The material of node `i`.
-    #[inline]
-    fn material_of(&self, i: usize) -> &Material {
-        material_of(&self.material, &self.others, &self.group, i)
     }
 
     fn energy_error_with(&self, kinetic: f64) -> f64 {
