@@ -34,9 +34,17 @@ pub fn run() -> Result<(), String> {
     // `MI_PROFILE` names another; the test command packages its `ci` build.
     let profile = std::env::var("MI_PROFILE").unwrap_or_else(|_| "release".into());
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
+    let mut build = Command::new(cargo);
+    build
         .current_dir(&root)
-        .args(["build", "--profile", &profile, "-p", "meshless-impact"])
+        .args(["build", "--profile", &profile, "-p", "meshless-impact"]);
+    // After the test command's `cargo test --all-targets`: the features of
+    // the tests' build, so that its library is reused, not compiled again
+    // (`examples_c/Makefile`, MI_WITH_TESTS).
+    if std::env::var_os("MI_WITH_TESTS").is_some_and(|v| !v.is_empty()) {
+        build.arg("--tests");
+    }
+    let status = build
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
