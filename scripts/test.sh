@@ -21,12 +21,14 @@ fi
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
+# Every step builds with the profile of the tests (`ci`), so that the build
+# scripts and procedural macros are compiled once for all of them.
 echo "== cargo clippy"
-cargo clippy --all-targets --release -- -D warnings
+cargo clippy --all-targets --profile ci -- -D warnings
 # The library and the program without the report (cargo feature `report`).
-cargo clippy --all-targets --release --no-default-features -- -D warnings
+cargo clippy --all-targets --profile ci --no-default-features -- -D warnings
 echo "== cargo doc (broken or private links fail)"
-RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --profile ci
 echo "== cargo test (profile ci: release optimisation, fast build)"
 # Where the processor has AVX-512, the tests that compare its copy of the hot
 # loops with the portable one fail rather than skip if they cannot run it.
@@ -34,8 +36,21 @@ if grep -qw avx512f /proc/cpuinfo 2>/dev/null && grep -qw avx512vl /proc/cpuinfo
   export MI_REQUIRE_AVX512=1
   echo "(AVX-512 here: MI_REQUIRE_AVX512=1)"
 fi
-cargo test --profile ci --all-targets
+# The fuzzer runs for a fixed time (MI_FUZZ_SECONDS, default 60) on about
+# one core: it runs below beside the C and FMU steps, not here.
+cargo test --profile ci --all-targets -- --skip fuzz_the_boundaries
 cargo test --profile ci --doc
+fuzz_bin=$(cargo test --profile ci --test fuzz --no-run --message-format=json |
+  python3 -c 'import json, sys
+for line in sys.stdin:
+    m = json.loads(line)
+    if m.get("reason") == "compiler-artifact" and m.get("executable") and m["target"]["name"] == "fuzz":
+        print(m["executable"])')
+fuzz_log=$(mktemp)
+echo "== fuzzer (beside the C and FMU steps; its log at the end)"
+"$fuzz_bin" --nocapture > "$fuzz_log" 2>&1 &
+fuzz_pid=$!
+trap 'kill $fuzz_pid 2>/dev/null || true' EXIT
 # The C examples and the FMUs link the library of the same `ci` build (the
 # release optimisation without LTO: the same code, built once; what ships is
 # built with `release`).
@@ -47,10 +62,18 @@ export MI_PROFILE=ci
 export MI_WITH_TESTS=1
 if [ -f examples_c/Makefile ]; then
   echo "== C examples"
-  make -C examples_c test
+  make -j2 -C examples_c test
 fi
 if [ -f tests/fmu/run.sh ]; then
   echo "== FMU checks (fmpy)"
   bash tests/fmu/run.sh
 fi
+echo "== fuzzer"
+if ! wait $fuzz_pid; then
+  cat "$fuzz_log"
+  echo "== the fuzzer failed"
+  exit 1
+fi
+trap - EXIT
+tail -n 5 "$fuzz_log"
 echo "== all tests passed"
