@@ -323,7 +323,8 @@ pub fn test_radii(nearest: &[f64], boundary_distance: &[f64], alpha: f64) -> Vec
 }
 
 /// The test-size factor α of eq. (12), chosen by measurement on the free
-/// elastic bar of `tests/suite/mlpg.rs` (`alpha_table`: fundamental mode, 5
+/// elastic bar of `tests/suite/mlpg/bar.rs` (`cargo run --release --example
+/// explore -- alpha_table`: fundamental mode, 5
 /// periods at a third of the stable step; κ of `mlpg::step`):
 ///
 /// | α | κ | period error, 2 / 3 rings | energy error, 2 / 3 rings |
@@ -339,7 +340,7 @@ pub fn test_radii(nearest: &[f64], boundary_distance: &[f64], alpha: f64) -> Vec
 /// (the same growth per unit time at safety 0.3, 0.1 and 0.9): a spatial
 /// instability of the semi-discrete operator, not of the integrator. The
 /// operator `ü = −K u` of the local weak form is not symmetric, and its
-/// spectrum (dense, `unstable_modes_of_the_bar`) has complex pairs
+/// spectrum (dense, the exploration `unstable_modes_of_the_bar`) has complex pairs
 /// `λ = ω²`, whose `|Im √λ|` is a growth rate: 588 of 1197 eigenvalues,
 /// fastest growth 4.4 e-folds per fundamental period, at α = 0.5 (2
 /// rings); 396 of 1197 and 2.0 at α = 0.9; 1355 of 3441 and 1.6 at α = 0.9
