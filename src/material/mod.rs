@@ -27,7 +27,7 @@ pub mod rajendran_grove;
 pub mod tensor;
 
 use crate::error::Result;
-use crate::scene::params::Range;
+use crate::params::Range;
 use bilinear::Bilinear;
 use eos::LinearEos;
 use ideal_gas::IdealGas;

@@ -75,7 +75,7 @@ use super::Loading;
 use super::mie_gruneisen::check;
 use super::tensor::{Full, SymTensor, radial_return};
 use crate::error::Result;
-use crate::scene::params::Range;
+use crate::params::Range;
 use std::f64::consts::PI;
 
 /// The constants of the Rajendran-Grove model (seed 004, Table 1).
