@@ -93,12 +93,13 @@ pub enum Strength {
     Bilinear(Bilinear),
 }
 
-/// Damage model: acts on a particle's state after the strength model and
-/// the equation of state, with what a damage law needs (pressure, stress,
-/// strain rate, plastic strain and its increment, time step).
+/// Damage model, which also says how a point is updated: without damage,
+/// by the equation of state and the strength model (a J2 update); with the
+/// ceramic, by the ceramic alone.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Damage {
-    /// No damage: the state is left as it is.
+    /// No damage: the J2 update of the equation of state and the strength
+    /// model.
     None,
     /// The Rajendran-Grove ceramic (seed 004, section 4; the module
     /// `rajendran_grove`): micro-cracks, pores and pulverization. Its
@@ -108,27 +109,6 @@ pub enum Damage {
     /// Gurson and Mohr-Coulomb strengths (eqs. 21, 25) for the strength
     /// model. Build it with [`Material::ceramic`].
     RajendranGrove(RajendranGrove),
-}
-
-impl Damage {
-    /// Applies the damage law to the particle state `point` (in place),
-    /// after a step of `load` that added `plastic_increment` to its plastic
-    /// strain; the damage variables live in `state`.
-    #[inline]
-    pub(crate) fn apply<T: SymTensor>(
-        &self,
-        load: &Loading<T>,
-        plastic_increment: f64,
-        point: &mut Point<T>,
-        state: &mut PointState,
-    ) {
-        let _ = (load, plastic_increment, point, state);
-        match self {
-            // The ceramic's damage is part of its own update
-            // (`Material::update_ceramic`).
-            Damage::None | Damage::RajendranGrove(_) => {}
-        }
-    }
 }
 
 /// A material: equation of state, strength and damage models, with the
@@ -216,6 +196,14 @@ impl Default for PointState {
 }
 
 impl PointState {
+    /// The state of a ceramic point with variables `vars` (empty caches).
+    pub(crate) fn with_ceramic(vars: CeramicVars) -> Self {
+        PointState {
+            damage: Some(vars),
+            ..PointState::default()
+        }
+    }
+
     /// The ceramic variables of the point, if its material has them and it
     /// has taken a step.
     pub fn ceramic(&self) -> Option<&CeramicVars> {
@@ -485,11 +473,13 @@ impl Material {
         }
     }
 
-    /// One step of a particle: the Jaumann-rate trial deviator, the J2
-    /// radial return on the strength model's flow stress, heating by the
-    /// Taylor-Quinney fraction of the plastic work, the pressure at the new
-    /// density and temperature, then the damage model. Returns the new
-    /// state, or the compression limit of the equation of state.
+    /// One step of a particle, by the update its material has: the J2
+    /// update of the equation of state and the strength model
+    /// ([`Damage::None`]), or the ceramic's own update
+    /// ([`Damage::RajendranGrove`]), whose porous pressure takes the heat
+    /// `c (T - T_ref)` of the point's temperature at the start of the step
+    /// as its specific internal energy. Returns the new state, or the
+    /// compression limit of the equation of state.
     #[inline]
     pub(crate) fn update<T: SymTensor>(
         &self,
@@ -497,9 +487,46 @@ impl Material {
         old: &Point<T>,
         state: &mut PointState,
     ) -> std::result::Result<Point<T>, CompressionLimit> {
-        if let Damage::RajendranGrove(c) = &self.damage {
-            return Ok(self.update_ceramic(c, load, old, state));
+        match &self.damage {
+            Damage::None => self.update_j2(load, old, state),
+            Damage::RajendranGrove(c) => {
+                Ok(self.update_ceramic(c, load, old, self.energy(old.temperature), state))
+            }
         }
+    }
+
+    /// [`Material::update`] for a solver that keeps each point's specific
+    /// internal energy `energy` (J/kg, from the reference state) at the
+    /// start of the step, as the plate-impact cells do (the work of their
+    /// total stress, artificial viscosity included): the ceramic's porous
+    /// pressure takes it instead of the heat of the temperature. The J2
+    /// update is the same as [`Material::update`]'s: its pressure is at the
+    /// point's new temperature.
+    #[inline]
+    pub(crate) fn update_with_energy<T: SymTensor>(
+        &self,
+        load: &Loading<T>,
+        old: &Point<T>,
+        energy: f64,
+        state: &mut PointState,
+    ) -> std::result::Result<Point<T>, CompressionLimit> {
+        match &self.damage {
+            Damage::None => self.update_j2(load, old, state),
+            Damage::RajendranGrove(c) => Ok(self.update_ceramic(c, load, old, energy, state)),
+        }
+    }
+
+    /// One step of a point of a material without damage: the Jaumann-rate
+    /// trial deviator, the J2 radial return on the strength model's flow
+    /// stress, heating by the Taylor-Quinney fraction of the plastic work,
+    /// then the pressure at the new density and temperature.
+    #[inline]
+    fn update_j2<T: SymTensor>(
+        &self,
+        load: &Loading<T>,
+        old: &Point<T>,
+        state: &mut PointState,
+    ) -> std::result::Result<Point<T>, CompressionLimit> {
         let mu = self.shear_modulus;
         let trial = old
             .deviator
@@ -528,24 +555,25 @@ impl Material {
         };
         let temperature = old.temperature
             + self.taylor_quinney * ret.plastic_work / (load.density * self.specific_heat);
-        let mut new = Point {
+        Ok(Point {
             deviator: ret.stress,
             pressure: self.pressure(load.density, temperature)?,
             plastic_strain: old.plastic_strain + ret.plastic_strain,
             temperature,
-        };
-        self.damage.apply(load, ret.plastic_strain, &mut new, state);
-        Ok(new)
+        })
     }
 
-    /// One step of a ceramic point ([`RajendranGrove`]'s update, in 3-D
-    /// components whatever the solver's form), heated by the Taylor-Quinney
-    /// fraction of its plastic work.
+    /// One step of a ceramic point at specific internal energy `energy`
+    /// ([`RajendranGrove`]'s update, in 3-D components whatever the
+    /// solver's form; its damage variables in `state`, the intact ones
+    /// before its first step), heated by the Taylor-Quinney fraction of its
+    /// plastic work.
     fn update_ceramic<T: SymTensor>(
         &self,
         c: &RajendranGrove,
         load: &Loading<T>,
         old: &Point<T>,
+        energy: f64,
         state: &mut PointState,
     ) -> Point<T> {
         let full = Loading::<Full> {
@@ -555,16 +583,13 @@ impl Material {
             density: load.density,
         };
         let vars = state.damage.unwrap_or_else(|| c.initial_point().vars());
-        let mut point = CeramicPoint {
-            elastic_strain: vars.elastic_strain,
-            deviator: old.deviator.to_full(),
-            pressure: old.pressure,
-            plastic_strain: old.plastic_strain,
-            crack_size: vars.crack_size,
-            porosity: vars.porosity,
-            pulverized: vars.pulverized,
-        };
-        let work = c.update(&full, self.energy(old.temperature), &mut point);
+        let mut point = CeramicPoint::of(
+            &vars,
+            old.deviator.to_full(),
+            old.pressure,
+            old.plastic_strain,
+        );
+        let work = c.update(&full, energy, &mut point);
         state.damage = Some(point.vars());
         Point {
             deviator: T::from_full(&point.deviator),
