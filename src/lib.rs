@@ -84,6 +84,7 @@ mod model;
 mod msph;
 mod neighbors;
 mod observe;
+mod params;
 mod rod;
 mod run;
 mod scene;
@@ -101,10 +102,10 @@ pub use observe::{
     Field, FieldSpec, History, LOG10_NO_CRACKS, NOH_OBSERVABLES, ObservableSpec,
     PLATE_IMPACT_OBSERVABLES, Snapshot, TAYLOR_OBSERVABLES, write_pvd,
 };
+pub use params::{Level, ParamSpec, Range};
 pub use rod::{profile_deviation, profile_radius};
 pub use run::ENERGY_ERROR_BOUND;
 pub use scene::noh::NohParams;
-pub use scene::params::{Level, ParamSpec, Range};
 pub use scene::table1::Table1Row;
 pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};

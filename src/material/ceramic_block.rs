@@ -73,7 +73,7 @@
 use super::Material;
 use super::rajendran_grove::RajendranGrove;
 use crate::error::{Error, Result};
-use crate::scene::params::{Level, ParamSpec, Range, levels_spec, spec as row};
+use crate::params::{Level, ParamSpec, Range, levels_spec, spec as row};
 
 /// AD85, the source of the defaults.
 const AD85: RajendranGrove = RajendranGrove::ad85();

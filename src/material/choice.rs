@@ -38,7 +38,7 @@ use super::johnson_cook::JohnsonCook;
 use super::mie_gruneisen::MieGruneisen;
 use super::{Damage, Eos, Material, Strength};
 use crate::error::{Error, Result};
-use crate::scene::params::{ParamSpec, Range};
+use crate::params::{ParamSpec, Range};
 
 /// A strength model, by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]

@@ -34,7 +34,7 @@
 //! [`CompressionLimit`], never an infinite or NaN pressure.
 
 use crate::error::{Error, Result};
-use crate::scene::params::Range;
+use crate::params::Range;
 
 /// Mie-Grüneisen equation of state (`U_s`-`u_p` reference curve).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

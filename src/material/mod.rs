@@ -24,16 +24,19 @@ pub mod johnson_cook;
 pub mod mie_gruneisen;
 pub mod presets;
 pub mod rajendran_grove;
+mod state;
 pub mod tensor;
 
 use crate::error::Result;
-use crate::scene::params::Range;
+use crate::params::Range;
 use bilinear::Bilinear;
 use eos::LinearEos;
 use ideal_gas::IdealGas;
 use johnson_cook::JohnsonCook;
 use mie_gruneisen::{CompressionLimit, MieGruneisen, check};
-use rajendran_grove::{CeramicPoint, CeramicVars, RajendranGrove};
+use rajendran_grove::{CeramicPoint, RajendranGrove};
+use state::Memo;
+pub use state::{MaterialState, PointState};
 use tensor::{Full, SymTensor, radial_return};
 
 /// Equation of state: the pressure from the density and the specific
@@ -93,12 +96,13 @@ pub enum Strength {
     Bilinear(Bilinear),
 }
 
-/// Damage model: acts on a particle's state after the strength model and
-/// the equation of state, with what a damage law needs (pressure, stress,
-/// strain rate, plastic strain and its increment, time step).
+/// Damage model, which also says how a point is updated: without damage,
+/// by the equation of state and the strength model (a J2 update); with the
+/// ceramic, by the ceramic alone.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Damage {
-    /// No damage: the state is left as it is.
+    /// No damage: the J2 update of the equation of state and the strength
+    /// model.
     None,
     /// The Rajendran-Grove ceramic (seed 004, section 4; the module
     /// `rajendran_grove`): micro-cracks, pores and pulverization. Its
@@ -108,27 +112,6 @@ pub enum Damage {
     /// Gurson and Mohr-Coulomb strengths (eqs. 21, 25) for the strength
     /// model. Build it with [`Material::ceramic`].
     RajendranGrove(RajendranGrove),
-}
-
-impl Damage {
-    /// Applies the damage law to the particle state `point` (in place),
-    /// after a step of `load` that added `plastic_increment` to its plastic
-    /// strain; the damage variables live in `state`.
-    #[inline]
-    pub(crate) fn apply<T: SymTensor>(
-        &self,
-        load: &Loading<T>,
-        plastic_increment: f64,
-        point: &mut Point<T>,
-        state: &mut PointState,
-    ) {
-        let _ = (load, plastic_increment, point, state);
-        match self {
-            // The ceramic's damage is part of its own update
-            // (`Material::update_ceramic`).
-            Damage::None | Damage::RajendranGrove(_) => {}
-        }
-    }
 }
 
 /// A material: equation of state, strength and damage models, with the
@@ -176,191 +159,6 @@ pub struct Point<T> {
     pub plastic_strain: f64,
     /// Temperature (K).
     pub temperature: f64,
-}
-
-/// Per-particle state of the models, kept from step to step.
-#[derive(Debug, Clone, Copy)]
-pub struct PointState {
-    /// Johnson-Cook hardening and thermal factors with the plastic strain
-    /// and temperature they were computed for: reused while both stay the
-    /// same (a particle that does not yield), which spares two `powf` and
-    /// gives the same bits.
-    memo: Memo,
-    /// The damage model's variables: `None` for a material without damage,
-    /// and for a ceramic point before its first step (it then starts from
-    /// the intact state, [`RajendranGrove::initial_point`]).
-    damage: Option<CeramicVars>,
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Memo {
-    eps_p: f64,
-    temp: f64,
-    hardening: f64,
-    thermal: f64,
-}
-
-impl Default for PointState {
-    /// Matches no state (NaN equals nothing).
-    fn default() -> Self {
-        PointState {
-            memo: Memo {
-                eps_p: f64::NAN,
-                temp: f64::NAN,
-                hardening: 0.0,
-                thermal: 0.0,
-            },
-            damage: None,
-        }
-    }
-}
-
-impl PointState {
-    /// The ceramic variables of the point, if its material has them and it
-    /// has taken a step.
-    pub fn ceramic(&self) -> Option<&CeramicVars> {
-        self.damage.as_ref()
-    }
-
-    /// Whether the point is a pulverized ceramic (its material has the
-    /// Rajendran-Grove model and the point has reached pulverization).
-    pub fn is_pulverized(&self) -> bool {
-        self.ceramic().is_some_and(|v| v.pulverized.is_some())
-    }
-}
-
-/// Per-particle state of a material's models, owned next to the material:
-/// caches (the Johnson-Cook memo) and, for a material with damage, the
-/// damage variables, which are physical state.
-///
-/// **Saved form.** A solver saves this state with its run: serde writes
-/// only the damage variables, as `Option<Vec<Option<CeramicVars>>>`, one
-/// entry per particle (`None` for a point that has none yet), and writes
-/// `None` when no point has any (a run without damage: one byte in
-/// postcard, `null` in JSON). The caches are not saved; they come back
-/// empty and are rebuilt at the next step with the same bits. A restored
-/// state must be checked against the run's particle count
-/// ([`MaterialState::check_len`]).
-#[derive(Debug, Clone, Default)]
-pub struct MaterialState {
-    points: Vec<PointState>,
-}
-
-impl MaterialState {
-    /// Sizes the state for `n` particles (new ones start empty).
-    pub fn fit(&mut self, n: usize) {
-        self.points.resize(n, PointState::default());
-    }
-
-    /// The particles' states, to be cut into chunks.
-    pub fn points_mut(&mut self) -> &mut [PointState] {
-        &mut self.points
-    }
-
-    /// Whether some point holds damage variables.
-    pub fn has_damage(&self) -> bool {
-        self.points.iter().any(|p| p.damage.is_some())
-    }
-
-    /// Checks a restored state for a run of `n` particles (the message
-    /// says what is wrong): it holds no damage variables, or one entry per
-    /// particle, each finite and physical (porosity in [0, 1), a positive
-    /// crack radius, positive frozen moduli once pulverized). A state that
-    /// passes cannot leave a particle without its damage variables, give it
-    /// another's, or feed NaN into a step.
-    pub fn check_len(&self, n: usize) -> std::result::Result<(), String> {
-        if !self.has_damage() {
-            return Ok(());
-        }
-        let len = self.points.len();
-        if len != n {
-            return Err(format!("it holds {len} damage states for {n} particles"));
-        }
-        match self
-            .points
-            .iter()
-            .position(|p| p.damage.is_some_and(|v| !physical(&v)))
-        {
-            Some(i) => Err(format!(
-                "its damage variables are not all finite and in range (particle {i})"
-            )),
-            None => Ok(()),
-        }
-    }
-}
-
-impl MaterialState {
-    /// Refuses a crack larger than `extent`, the bodies' size: no running
-    /// model grows one (a forged state's 1e300 would make every
-    /// observable infinite).
-    pub fn check_cracks(&self, extent: f64) -> std::result::Result<(), String> {
-        match self.points.iter().position(|p| {
-            p.damage
-                .is_some_and(|v| v.crack_size.is_nan() || v.crack_size > extent)
-        }) {
-            Some(i) => Err(format!(
-                "its crack at particle {i} is larger than the bodies ({} m)",
-                crate::error::number(extent)
-            )),
-            None => Ok(()),
-        }
-    }
-}
-
-/// Whether the variables of a ceramic point are finite and physical.
-fn physical(v: &CeramicVars) -> bool {
-    v.elastic_strain.iter().all(|x| x.is_finite())
-        && v.crack_size.is_finite()
-        && v.crack_size > 0.0
-        && (0.0..1.0).contains(&v.porosity)
-        && v.pulverized.is_none_or(|p| {
-            p.bulk_modulus.is_finite()
-                && p.bulk_modulus > 0.0
-                && p.shear_modulus.is_finite()
-                && p.shear_modulus > 0.0
-                && p.volumetric_strain.is_finite()
-        })
-}
-
-/// The saved form: the damage variables only, `None` when no point has any.
-impl serde::Serialize for MaterialState {
-    fn serialize<S: serde::Serializer>(
-        &self,
-        serializer: S,
-    ) -> std::result::Result<S::Ok, S::Error> {
-        struct Damage<'a>(&'a [PointState]);
-        impl serde::Serialize for Damage<'_> {
-            fn serialize<S: serde::Serializer>(
-                &self,
-                serializer: S,
-            ) -> std::result::Result<S::Ok, S::Error> {
-                serializer.collect_seq(self.0.iter().map(|p| p.damage.as_ref()))
-            }
-        }
-        self.has_damage()
-            .then_some(Damage(&self.points))
-            .serialize(serializer)
-    }
-}
-
-/// Reads the saved form back: the damage variables, with empty caches (not
-/// yet checked: [`MaterialState::check_len`]).
-impl<'de> serde::Deserialize<'de> for MaterialState {
-    fn deserialize<D: serde::Deserializer<'de>>(
-        deserializer: D,
-    ) -> std::result::Result<Self, D::Error> {
-        let damage = Option::<Vec<Option<CeramicVars>>>::deserialize(deserializer)?;
-        Ok(MaterialState {
-            points: damage
-                .unwrap_or_default()
-                .into_iter()
-                .map(|damage| PointState {
-                    damage,
-                    ..PointState::default()
-                })
-                .collect(),
-        })
-    }
 }
 
 impl Material {
@@ -485,11 +283,13 @@ impl Material {
         }
     }
 
-    /// One step of a particle: the Jaumann-rate trial deviator, the J2
-    /// radial return on the strength model's flow stress, heating by the
-    /// Taylor-Quinney fraction of the plastic work, the pressure at the new
-    /// density and temperature, then the damage model. Returns the new
-    /// state, or the compression limit of the equation of state.
+    /// One step of a particle, by the update its material has: the J2
+    /// update of the equation of state and the strength model
+    /// ([`Damage::None`]), or the ceramic's own update
+    /// ([`Damage::RajendranGrove`]), whose porous pressure takes the heat
+    /// `c (T - T_ref)` of the point's temperature at the start of the step
+    /// as its specific internal energy. Returns the new state, or the
+    /// compression limit of the equation of state.
     #[inline]
     pub(crate) fn update<T: SymTensor>(
         &self,
@@ -497,9 +297,46 @@ impl Material {
         old: &Point<T>,
         state: &mut PointState,
     ) -> std::result::Result<Point<T>, CompressionLimit> {
-        if let Damage::RajendranGrove(c) = &self.damage {
-            return Ok(self.update_ceramic(c, load, old, state));
+        match &self.damage {
+            Damage::None => self.update_j2(load, old, state),
+            Damage::RajendranGrove(c) => {
+                Ok(self.update_ceramic(c, load, old, self.energy(old.temperature), state))
+            }
         }
+    }
+
+    /// [`Material::update`] for a solver that keeps each point's specific
+    /// internal energy `energy` (J/kg, from the reference state) at the
+    /// start of the step, as the plate-impact cells do (the work of their
+    /// total stress, artificial viscosity included): the ceramic's porous
+    /// pressure takes it instead of the heat of the temperature. The J2
+    /// update is the same as [`Material::update`]'s: its pressure is at the
+    /// point's new temperature.
+    #[inline]
+    pub(crate) fn update_with_energy<T: SymTensor>(
+        &self,
+        load: &Loading<T>,
+        old: &Point<T>,
+        energy: f64,
+        state: &mut PointState,
+    ) -> std::result::Result<Point<T>, CompressionLimit> {
+        match &self.damage {
+            Damage::None => self.update_j2(load, old, state),
+            Damage::RajendranGrove(c) => Ok(self.update_ceramic(c, load, old, energy, state)),
+        }
+    }
+
+    /// One step of a point of a material without damage: the Jaumann-rate
+    /// trial deviator, the J2 radial return on the strength model's flow
+    /// stress, heating by the Taylor-Quinney fraction of the plastic work,
+    /// then the pressure at the new density and temperature.
+    #[inline]
+    fn update_j2<T: SymTensor>(
+        &self,
+        load: &Loading<T>,
+        old: &Point<T>,
+        state: &mut PointState,
+    ) -> std::result::Result<Point<T>, CompressionLimit> {
         let mu = self.shear_modulus;
         let trial = old
             .deviator
@@ -528,24 +365,25 @@ impl Material {
         };
         let temperature = old.temperature
             + self.taylor_quinney * ret.plastic_work / (load.density * self.specific_heat);
-        let mut new = Point {
+        Ok(Point {
             deviator: ret.stress,
             pressure: self.pressure(load.density, temperature)?,
             plastic_strain: old.plastic_strain + ret.plastic_strain,
             temperature,
-        };
-        self.damage.apply(load, ret.plastic_strain, &mut new, state);
-        Ok(new)
+        })
     }
 
-    /// One step of a ceramic point ([`RajendranGrove`]'s update, in 3-D
-    /// components whatever the solver's form), heated by the Taylor-Quinney
-    /// fraction of its plastic work.
+    /// One step of a ceramic point at specific internal energy `energy`
+    /// ([`RajendranGrove`]'s update, in 3-D components whatever the
+    /// solver's form; its damage variables in `state`, the intact ones
+    /// before its first step), heated by the Taylor-Quinney fraction of its
+    /// plastic work.
     fn update_ceramic<T: SymTensor>(
         &self,
         c: &RajendranGrove,
         load: &Loading<T>,
         old: &Point<T>,
+        energy: f64,
         state: &mut PointState,
     ) -> Point<T> {
         let full = Loading::<Full> {
@@ -555,16 +393,13 @@ impl Material {
             density: load.density,
         };
         let vars = state.damage.unwrap_or_else(|| c.initial_point().vars());
-        let mut point = CeramicPoint {
-            elastic_strain: vars.elastic_strain,
-            deviator: old.deviator.to_full(),
-            pressure: old.pressure,
-            plastic_strain: old.plastic_strain,
-            crack_size: vars.crack_size,
-            porosity: vars.porosity,
-            pulverized: vars.pulverized,
-        };
-        let work = c.update(&full, self.energy(old.temperature), &mut point);
+        let mut point = CeramicPoint::of(
+            &vars,
+            old.deviator.to_full(),
+            old.pressure,
+            old.plastic_strain,
+        );
+        let work = c.update(&full, energy, &mut point);
         state.damage = Some(point.vars());
         Point {
             deviator: T::from_full(&point.deviator),
@@ -576,16 +411,10 @@ impl Material {
     }
 }
 
-impl MaterialState {
-    /// The particles' states (empty before the first step).
-    pub fn points(&self) -> &[PointState] {
-        &self.points
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rajendran_grove::CeramicVars;
     use tensor::Axisymmetric;
 
     fn steel(strength: Strength, eos: Eos) -> Material {

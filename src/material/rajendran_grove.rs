@@ -75,7 +75,7 @@ use super::Loading;
 use super::mie_gruneisen::check;
 use super::tensor::{Full, SymTensor, radial_return};
 use crate::error::Result;
-use crate::scene::params::Range;
+use crate::params::Range;
 use std::f64::consts::PI;
 
 /// The constants of the Rajendran-Grove model (seed 004, Table 1).
@@ -553,6 +553,26 @@ pub struct CeramicVars {
 }
 
 impl CeramicPoint {
+    /// The point of variables `vars` with the deviator, pressure and
+    /// plastic strain that the solver's fields hold: the inverse of
+    /// [`CeramicPoint::vars`].
+    pub(crate) fn of(
+        vars: &CeramicVars,
+        deviator: Full,
+        pressure: f64,
+        plastic_strain: f64,
+    ) -> Self {
+        CeramicPoint {
+            elastic_strain: vars.elastic_strain,
+            deviator,
+            pressure,
+            plastic_strain,
+            crack_size: vars.crack_size,
+            porosity: vars.porosity,
+            pulverized: vars.pulverized,
+        }
+    }
+
     /// The point's variables that the solver's fields do not hold.
     pub fn vars(&self) -> CeramicVars {
         CeramicVars {

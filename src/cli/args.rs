@@ -1,0 +1,182 @@
+//! The command line: the subcommands and their arguments, and how the
+//! choices and `--set`s apply to a scene.
+
+use clap::{Args, Parser, Subcommand};
+use meshless_impact::{Error, Scene};
+use std::path::PathBuf;
+
+/// Meshless (MSPH) solver for high-speed impact of solids.
+///
+/// With no subcommand it runs the default scene, `taylor` (House et al. test
+/// 7), and prints the final observables beside the experiment.
+#[derive(Parser)]
+#[command(version, about, long_about = None)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Command {
+    /// Run one scene to its end condition.
+    Run(RunArgs),
+    /// Run a family of scenes in parallel: `table1` is the twelve tests of Table 1.
+    Sweep(SweepArgs),
+    /// Regenerate the verification report (error against run time,
+    /// sensitivity, Table 1, figures, stability matrix) as DIR/index.md with
+    /// CSV tables and SVG figures.
+    Report {
+        /// Output directory.
+        #[arg(long, value_name = "DIR", default_value = "report")]
+        out: PathBuf,
+        /// Coarse resolutions and a reduced stability matrix (about a minute).
+        #[arg(long)]
+        quick: bool,
+    },
+    /// List the parameters of a scene with units, defaults and allowed
+    /// ranges: only those of its material models (see --strength, --eos,
+    /// --preset).
+    Params {
+        /// Scene name.
+        #[arg(default_value = "taylor")]
+        scene: String,
+        #[command(flatten)]
+        material: ChoiceArgs,
+        /// Print the scene's reference page in Markdown instead (as
+        /// docs/reference/SCENE.md): its parameters, observables and fields.
+        #[arg(long)]
+        markdown: bool,
+    },
+    /// List the observables of a scene.
+    Observables {
+        /// Scene name.
+        #[arg(default_value = "taylor")]
+        scene: String,
+    },
+    /// Print a built-in scene as a TOML scene file.
+    Scene {
+        /// Scene name (`meshless-impact scenes` lists them).
+        name: String,
+        #[command(flatten)]
+        material: ChoiceArgs,
+    },
+    /// List the built-in scenes with their titles.
+    Scenes,
+    /// List the material presets: name, models, constants and source
+    /// (`[material] preset = "NAME"` in a scene file, `--preset NAME`).
+    Materials,
+}
+
+/// The choice of the material models, as a scene file's `[material]` table
+/// makes it, and of the numerical scheme.
+#[derive(Args, Default)]
+pub(crate) struct ChoiceArgs {
+    /// Numerical scheme by name (`meshless-impact params SCENE` lists the
+    /// scene's schemes and what each sets); --set may override its knobs.
+    #[arg(long, value_name = "NAME")]
+    pub(crate) scheme: Option<String>,
+    /// Strength model: johnson_cook or bilinear.
+    #[arg(long, value_name = "MODEL")]
+    pub(crate) strength: Option<String>,
+    /// Equation of state: linear or mie_gruneisen.
+    #[arg(long, value_name = "EOS")]
+    pub(crate) eos: Option<String>,
+    /// A material preset (`meshless-impact materials` lists them): its
+    /// models and constants; --set may override its constants.
+    #[arg(long, value_name = "NAME")]
+    pub(crate) preset: Option<String>,
+}
+
+impl ChoiceArgs {
+    /// Applies the choices to `scene`, if any is made.
+    pub(crate) fn apply(&self, scene: &mut Scene) -> Result<(), Error> {
+        if let Some(name) = &self.scheme {
+            scene.set_str("scheme", name)?;
+        }
+        if self.strength.is_none() && self.eos.is_none() && self.preset.is_none() {
+            return Ok(());
+        }
+        scene.choose_material(
+            self.strength.as_deref(),
+            self.eos.as_deref(),
+            self.preset.as_deref(),
+        )
+    }
+}
+
+#[derive(Args, Default)]
+pub(crate) struct RunArgs {
+    /// Built-in scene (`meshless-impact scenes` lists them).
+    #[arg(default_value = "taylor", conflicts_with = "scene_file")]
+    pub(crate) scene: String,
+    /// Read the scene from a TOML file instead.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) scene_file: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) material: ChoiceArgs,
+    /// Override a parameter, e.g. `--set impact_speed=200` (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub(crate) set: Vec<String>,
+    /// Write the final observables as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) json: Option<PathBuf>,
+    /// Write the observable time histories as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Write the rod's final outline as CSV: axial position and radius (m) of
+    /// one generator of the mantle, from the impact face to the free end
+    /// (scenes with a rod).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) profile: Option<PathBuf>,
+    /// Directory for VTK (.vtu) particle snapshots.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) vtk_dir: Option<PathBuf>,
+    /// Times (s) of the snapshots, comma-separated, from 0 to the scene's end_time;
+    /// the final state is always written when --vtk-dir is given.
+    // Values may start with `-`, so that `--vtk-times -1e-6` reaches the range
+    // check and its error instead of being taken for an option.
+    #[arg(
+        long,
+        value_name = "T1,T2,...",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub(crate) vtk_times: Vec<f64>,
+    /// Compiled copy of the hot loops: avx512, avx2+fma or baseline (default:
+    /// the best this processor runs). Every copy gives the same bits; this is
+    /// for measuring them.
+    #[arg(long, value_name = "COPY")]
+    pub(crate) isa: Option<String>,
+    /// No progress bar and no table on stdout (errors are still reported).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(Args)]
+pub(crate) struct SweepArgs {
+    /// The sweep to run: `table1`.
+    pub(crate) name: String,
+    /// CSV file for the results table.
+    #[arg(long, default_value = "table1_sweep.csv")]
+    pub(crate) out: PathBuf,
+    /// Override a parameter in every case, e.g. `--set particles_radial=10`.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub(crate) set: Vec<String>,
+}
+
+/// Applies `--set NAME=VALUE`s: a scheme first (`--set scheme=paper`),
+/// then the other parameters, which override its knobs.
+pub(crate) fn apply_sets(scene: &mut Scene, sets: &[String]) -> Result<(), Error> {
+    let mut pairs = Vec::with_capacity(sets.len());
+    for s in sets {
+        let (name, value) = s.split_once('=').ok_or_else(|| Error::ParseValue {
+            name: s.clone(),
+            text: "expected NAME=VALUE".into(),
+        })?;
+        pairs.push((name.trim(), value));
+    }
+    for (name, value) in scene.schemes_first(pairs) {
+        scene.set_str(name, value)?;
+    }
+    scene.validate()
+}

@@ -1,0 +1,12 @@
+//! The program's modules, one job each: the command line (`args`), how
+//! the program stops (`stop`), the files it writes (`output`), and one
+//! module per command or family of commands (`run`, `sweep`, `listing`,
+//! `report`).
+
+pub(crate) mod args;
+pub(crate) mod listing;
+pub(crate) mod output;
+pub(crate) mod report;
+pub(crate) mod run;
+pub(crate) mod stop;
+pub(crate) mod sweep;

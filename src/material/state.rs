@@ -1,0 +1,206 @@
+//! The per-particle state of a material's models: a point's caches and
+//! damage variables ([`PointState`]), and the state of every particle of a
+//! run with its saved form ([`MaterialState`]).
+
+use super::rajendran_grove::CeramicVars;
+
+/// Per-particle state of the models, kept from step to step.
+#[derive(Debug, Clone, Copy)]
+pub struct PointState {
+    /// Johnson-Cook hardening and thermal factors with the plastic strain
+    /// and temperature they were computed for: reused while both stay the
+    /// same (a particle that does not yield), which spares two `powf` and
+    /// gives the same bits.
+    pub(super) memo: Memo,
+    /// The damage model's variables: `None` for a material without damage,
+    /// and for a ceramic point before its first step (it then starts from
+    /// the intact state, [`RajendranGrove::initial_point`](super::rajendran_grove::RajendranGrove::initial_point)).
+    pub(super) damage: Option<CeramicVars>,
+}
+
+/// The Johnson-Cook factors of a point ([`PointState`]'s memo).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Memo {
+    pub(super) eps_p: f64,
+    pub(super) temp: f64,
+    pub(super) hardening: f64,
+    pub(super) thermal: f64,
+}
+
+impl Default for PointState {
+    /// Matches no state (NaN equals nothing).
+    fn default() -> Self {
+        PointState {
+            memo: Memo {
+                eps_p: f64::NAN,
+                temp: f64::NAN,
+                hardening: 0.0,
+                thermal: 0.0,
+            },
+            damage: None,
+        }
+    }
+}
+
+impl PointState {
+    /// The state of a ceramic point with variables `vars` (empty caches).
+    pub(crate) fn with_ceramic(vars: CeramicVars) -> Self {
+        PointState {
+            damage: Some(vars),
+            ..PointState::default()
+        }
+    }
+
+    /// The ceramic variables of the point, if its material has them and it
+    /// has taken a step.
+    pub fn ceramic(&self) -> Option<&CeramicVars> {
+        self.damage.as_ref()
+    }
+
+    /// Whether the point is a pulverized ceramic (its material has the
+    /// Rajendran-Grove model and the point has reached pulverization).
+    pub fn is_pulverized(&self) -> bool {
+        self.ceramic().is_some_and(|v| v.pulverized.is_some())
+    }
+}
+
+/// Per-particle state of a material's models, owned next to the material:
+/// caches (the Johnson-Cook memo) and, for a material with damage, the
+/// damage variables, which are physical state.
+///
+/// **Saved form.** A solver saves this state with its run: serde writes
+/// only the damage variables, as `Option<Vec<Option<CeramicVars>>>`, one
+/// entry per particle (`None` for a point that has none yet), and writes
+/// `None` when no point has any (a run without damage: one byte in
+/// postcard, `null` in JSON). The caches are not saved; they come back
+/// empty and are rebuilt at the next step with the same bits. A restored
+/// state must be checked against the run's particle count
+/// ([`MaterialState::check_len`]).
+#[derive(Debug, Clone, Default)]
+pub struct MaterialState {
+    pub(super) points: Vec<PointState>,
+}
+
+impl MaterialState {
+    /// Sizes the state for `n` particles (new ones start empty).
+    pub fn fit(&mut self, n: usize) {
+        self.points.resize(n, PointState::default());
+    }
+
+    /// The particles' states, to be cut into chunks.
+    pub fn points_mut(&mut self) -> &mut [PointState] {
+        &mut self.points
+    }
+
+    /// Whether some point holds damage variables.
+    pub fn has_damage(&self) -> bool {
+        self.points.iter().any(|p| p.damage.is_some())
+    }
+
+    /// Checks a restored state for a run of `n` particles (the message
+    /// says what is wrong): it holds no damage variables, or one entry per
+    /// particle, each finite and physical (porosity in [0, 1), a positive
+    /// crack radius, positive frozen moduli once pulverized). A state that
+    /// passes cannot leave a particle without its damage variables, give it
+    /// another's, or feed NaN into a step.
+    pub fn check_len(&self, n: usize) -> std::result::Result<(), String> {
+        if !self.has_damage() {
+            return Ok(());
+        }
+        let len = self.points.len();
+        if len != n {
+            return Err(format!("it holds {len} damage states for {n} particles"));
+        }
+        match self
+            .points
+            .iter()
+            .position(|p| p.damage.is_some_and(|v| !physical(&v)))
+        {
+            Some(i) => Err(format!(
+                "its damage variables are not all finite and in range (particle {i})"
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+impl MaterialState {
+    /// Refuses a crack larger than `extent`, the bodies' size: no running
+    /// model grows one (a forged state's 1e300 would make every
+    /// observable infinite).
+    pub fn check_cracks(&self, extent: f64) -> std::result::Result<(), String> {
+        match self.points.iter().position(|p| {
+            p.damage
+                .is_some_and(|v| v.crack_size.is_nan() || v.crack_size > extent)
+        }) {
+            Some(i) => Err(format!(
+                "its crack at particle {i} is larger than the bodies ({} m)",
+                crate::error::number(extent)
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Whether the variables of a ceramic point are finite and physical.
+fn physical(v: &CeramicVars) -> bool {
+    v.elastic_strain.iter().all(|x| x.is_finite())
+        && v.crack_size.is_finite()
+        && v.crack_size > 0.0
+        && (0.0..1.0).contains(&v.porosity)
+        && v.pulverized.is_none_or(|p| {
+            p.bulk_modulus.is_finite()
+                && p.bulk_modulus > 0.0
+                && p.shear_modulus.is_finite()
+                && p.shear_modulus > 0.0
+                && p.volumetric_strain.is_finite()
+        })
+}
+
+/// The saved form: the damage variables only, `None` when no point has any.
+impl serde::Serialize for MaterialState {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        struct Damage<'a>(&'a [PointState]);
+        impl serde::Serialize for Damage<'_> {
+            fn serialize<S: serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> std::result::Result<S::Ok, S::Error> {
+                serializer.collect_seq(self.0.iter().map(|p| p.damage.as_ref()))
+            }
+        }
+        self.has_damage()
+            .then_some(Damage(&self.points))
+            .serialize(serializer)
+    }
+}
+
+/// Reads the saved form back: the damage variables, with empty caches (not
+/// yet checked: [`MaterialState::check_len`]).
+impl<'de> serde::Deserialize<'de> for MaterialState {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        let damage = Option::<Vec<Option<CeramicVars>>>::deserialize(deserializer)?;
+        Ok(MaterialState {
+            points: damage
+                .unwrap_or_default()
+                .into_iter()
+                .map(|damage| PointState {
+                    damage,
+                    ..PointState::default()
+                })
+                .collect(),
+        })
+    }
+}
+
+impl MaterialState {
+    /// The particles' states (empty before the first step).
+    pub fn points(&self) -> &[PointState] {
+        &self.points
+    }
+}

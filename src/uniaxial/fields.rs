@@ -1,0 +1,174 @@
+//! What a plate-impact run reports: its observables and its fields, one
+//! value per cell.
+
+use super::PlateImpact;
+use super::layer::{CellState, Layer};
+use crate::observe::{FieldSpec, LOG10_NO_CRACKS};
+
+/// The fields of a plate-impact run, one value per cell (a material point
+/// at the cell's centre), flyer cells first.
+pub const PLATE_IMPACT_FIELDS: &[FieldSpec] = &[
+    FieldSpec {
+        name: "position",
+        unit: "m",
+        components: &["x"],
+    },
+    FieldSpec {
+        name: "velocity",
+        unit: "m/s",
+        components: &["v"],
+    },
+    FieldSpec {
+        name: "density",
+        unit: "kg/m3",
+        components: &["rho"],
+    },
+    FieldSpec {
+        name: "stress",
+        unit: "Pa",
+        components: &["sigma_xx"],
+    },
+    FieldSpec {
+        name: "pressure",
+        unit: "Pa",
+        components: &["P"],
+    },
+    FieldSpec {
+        name: "plastic_strain",
+        unit: "1",
+        components: &["eps_p"],
+    },
+    FieldSpec {
+        name: "crack_size",
+        unit: "m",
+        components: &["a"],
+    },
+    FieldSpec {
+        name: "log10_crack_density",
+        unit: "1",
+        components: &["log10_gamma"],
+    },
+    FieldSpec {
+        name: "porosity",
+        unit: "1",
+        components: &["f"],
+    },
+    FieldSpec {
+        name: "pulverized",
+        unit: "bool",
+        components: &["pulverized"],
+    },
+];
+
+impl PlateImpact {
+    /// Cells (the material points).
+    pub fn particles(&self) -> usize {
+        self.state.len()
+    }
+
+    /// The observables of [`crate::observe::PLATE_IMPACT_OBSERVABLES`], in
+    /// order.
+    pub fn observables(&self) -> Vec<f64> {
+        let target = self.layers[1];
+        let rho0 = target.density().unwrap_or(f64::NAN);
+        let (c_l, c_b) = target.sound_speeds().unwrap_or((f64::NAN, f64::NAN));
+        let r = self.reading;
+        let precursor = r.precursor.unwrap_or(0.0);
+        let pullback = r.peak - r.pullback_minimum;
+        let spall_strength = if self.spall.is_some() {
+            0.5 * rho0 * c_b * pullback
+        } else {
+            0.0
+        };
+        let max_damage = match &self.layers[1] {
+            Layer::Ceramic(m) => self
+                .target_ceramic()
+                .iter()
+                .map(|p| m.crack_density(p.crack_size))
+                .fold(0.0, f64::max),
+            Layer::Solid(_) => 0.0,
+        };
+        let [kinetic, internal, contact] = self.energies();
+        vec![
+            self.free_surface_velocity(),
+            precursor,
+            0.5 * rho0 * c_l * precursor,
+            r.peak,
+            pullback,
+            spall_strength,
+            self.spall.map_or(0.0, |s| s.0),
+            max_damage,
+            kinetic,
+            internal,
+            contact,
+            self.energy_error(),
+        ]
+    }
+
+    /// The values of the field `name` ([`PLATE_IMPACT_FIELDS`]), one per
+    /// cell, or `None` for another name.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        let cells = 0..self.state.len();
+        let ceramic = |c: usize| match (&self.state[c], self.layer(c)) {
+            (CellState::Ceramic(p), Layer::Ceramic(m)) => Some((p, m)),
+            _ => None,
+        };
+        let values: Vec<f64> = match name {
+            "position" => cells
+                .map(|c| {
+                    let (a, b) = self.nodes(c);
+                    0.5 * (self.x[a] + self.x[b])
+                })
+                .collect(),
+            "velocity" => cells
+                .map(|c| {
+                    let (a, b) = self.nodes(c);
+                    0.5 * (self.v[a] + self.v[b])
+                })
+                .collect(),
+            "density" => cells
+                .map(|c| {
+                    let (a, b) = self.nodes(c);
+                    self.density0[c] * self.length0[c] / (self.x[b] - self.x[a])
+                })
+                .collect(),
+            "stress" => self.stress.clone(),
+            "pressure" => self
+                .state
+                .iter()
+                .map(|s| match s {
+                    CellState::Ceramic(p) => p.pressure,
+                    CellState::Solid(p, _) => p.pressure,
+                })
+                .collect(),
+            "plastic_strain" => self
+                .state
+                .iter()
+                .map(|s| match s {
+                    CellState::Ceramic(p) => p.plastic_strain,
+                    CellState::Solid(p, _) => p.plastic_strain,
+                })
+                .collect(),
+            "crack_size" => cells
+                .map(|c| ceramic(c).map_or(0.0, |(p, _)| p.crack_size))
+                .collect(),
+            "log10_crack_density" => cells
+                .map(|c| {
+                    ceramic(c).map_or(LOG10_NO_CRACKS, |(p, m)| {
+                        m.crack_density(p.crack_size).log10().max(LOG10_NO_CRACKS)
+                    })
+                })
+                .collect(),
+            "porosity" => cells
+                .map(|c| ceramic(c).map_or(0.0, |(p, _)| p.porosity))
+                .collect(),
+            "pulverized" => cells
+                .map(|c| {
+                    ceramic(c).map_or(0.0, |(p, _)| f64::from(u8::from(p.pulverized.is_some())))
+                })
+                .collect(),
+            _ => return None,
+        };
+        Some(values)
+    }
+}

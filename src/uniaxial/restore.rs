@@ -1,0 +1,117 @@
+//! The check of a restored plate-impact run.
+
+use super::PlateImpact;
+use super::layer::{CellState, Layer};
+
+impl PlateImpact {
+    /// Checks a restored run against `fresh`, a new run of the same
+    /// parameters: the same layers, cells, masses and end time, finite
+    /// fields, cells of positive length, speeds and cracks a run can reach,
+    /// and a clock within the run.
+    pub fn check_restored(&self, fresh: &PlateImpact) -> std::result::Result<(), String> {
+        let same = self.layers == fresh.layers
+            && self.flyer_cells == fresh.flyer_cells
+            && self.impact_speed.to_bits() == fresh.impact_speed.to_bits()
+            && self.mass == fresh.mass
+            && self.length0 == fresh.length0
+            && self.density0 == fresh.density0
+            && self.end_time.to_bits() == fresh.end_time.to_bits()
+            && self.initial_kinetic.to_bits() == fresh.initial_kinetic.to_bits();
+        if !same {
+            return Err("its plates, cells or masses do not follow from its parameters".into());
+        }
+        let (nodes, cells) = (fresh.x.len(), fresh.state.len());
+        for (what, f, n) in [
+            ("positions", &self.x, nodes),
+            ("velocities", &self.v, nodes),
+            ("stresses", &self.stress, cells),
+            ("specific energies", &self.energy, cells),
+        ] {
+            if f.len() != n || !f.iter().all(|x| x.is_finite()) {
+                return Err(format!("its {what} are not {n} finite numbers"));
+            }
+        }
+        if self.state.len() != cells {
+            return Err(format!(
+                "it holds {} cell states for {cells} cells",
+                self.state.len()
+            ));
+        }
+        // The fastest a run can move: the impact speed plus twice the
+        // fastest wave, with room.
+        let c_max = self
+            .layers
+            .iter()
+            .filter_map(|l| l.sound_speeds().ok())
+            .map(|(c, _)| c)
+            .fold(0.0, f64::max);
+        let bound = 10.0 * (self.impact_speed.abs() + c_max);
+        if self.v.iter().any(|v| v.abs() > bound) {
+            return Err(format!("a node moves faster than {bound} m/s"));
+        }
+        let thickness: f64 = fresh.length0.iter().sum();
+        for c in 0..cells {
+            let (a, b) = self.nodes(c);
+            let length = self.x[b] - self.x[a];
+            // NaN fails the range (the positions are finite, checked above).
+            if !(length > 0.0 && length <= 100.0 * self.length0[c]) {
+                return Err(format!("its cell {c} has an impossible length"));
+            }
+            let ok = match (&self.state[c], self.layer(c)) {
+                (CellState::Ceramic(p), Layer::Ceramic(_)) => {
+                    p.crack_size.is_finite()
+                        && p.crack_size > 0.0
+                        && p.crack_size <= thickness
+                        && (0.0..1.0).contains(&p.porosity)
+                        && p.pressure.is_finite()
+                        && p.plastic_strain.is_finite()
+                        && p.deviator
+                            .iter()
+                            .chain(&p.elastic_strain)
+                            .all(|x| x.is_finite())
+                }
+                (CellState::Solid(p, _), Layer::Solid(_)) => {
+                    p.pressure.is_finite()
+                        && p.plastic_strain.is_finite()
+                        && p.temperature.is_finite()
+                        && p.deviator.iter().all(|x| x.is_finite())
+                }
+                _ => false,
+            };
+            if !ok {
+                return Err(format!(
+                    "its cell {c}'s material state is not one a run can reach"
+                ));
+            }
+        }
+        let clock = self.time.is_finite()
+            && self.time >= 0.0
+            && self.time <= self.end_time
+            && ((self.steps == 0) == (self.time == 0.0));
+        if !clock {
+            return Err(format!(
+                "its clock (t = {}, {} steps) is not valid",
+                self.time, self.steps
+            ));
+        }
+        let r = self.reading;
+        let finite = r.peak.is_finite()
+            && r.pullback_minimum.is_finite()
+            && r.last.abs() <= bound
+            && r.phase <= 2
+            && r.arrival.is_none_or(|t| t.is_finite() && t <= self.time)
+            && r.precursor
+                .is_none_or(|u| u.is_finite() && u.abs() <= bound)
+            && r.peak.abs() <= bound
+            && r.pullback_minimum.abs() <= bound
+            && self.contact_loss.is_finite()
+            && self.contact_loss >= 0.0
+            && self
+                .spall
+                .is_none_or(|(d, t)| d >= 0.0 && d <= thickness && t >= 0.0 && t <= self.time);
+        if !finite {
+            return Err("its free-surface reading or spall is not one a run can reach".into());
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,155 @@
+//! The central-difference step of the plates and its stable size.
+
+use super::PlateImpact;
+use super::layer::Layer;
+use crate::error::{Error, Result};
+use crate::material::Loading;
+use crate::material::tensor::Full;
+
+/// Artificial viscosity coefficients (quadratic, linear).
+const VISCOSITY: (f64, f64) = (1.5, 0.06);
+
+/// Fraction of the stable step taken.
+const COURANT: f64 = 0.5;
+
+impl PlateImpact {
+    /// Runs to `end_time` (s).
+    pub fn run(&mut self, end_time: f64) -> Result<()> {
+        while self.time < end_time {
+            let dt = self.stable_step().min(end_time - self.time);
+            self.step(dt)?;
+        }
+        Ok(())
+    }
+
+    /// One stable step, ending at the end time at the latest.
+    pub fn advance(&mut self) -> Result<()> {
+        let dt = self.stable_step().min(self.end_time - self.time);
+        self.step(dt)
+    }
+
+    /// The stable time step of the cells now (s).
+    pub fn stable_step(&self) -> f64 {
+        (0..self.state.len())
+            .map(|c| {
+                let (a, b) = self.nodes(c);
+                let len = self.x[b] - self.x[a];
+                let rho = self.density0[c] * self.length0[c] / len;
+                COURANT * len / self.layer(c).wave_speed(rho, &self.state[c])
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// One central-difference step of `dt`.
+    pub fn step(&mut self, dt: f64) -> Result<()> {
+        let n = self.state.len();
+        let (f, t) = (self.flyer_cells, self.flyer_cells + 1);
+        let closing = self.v[f] - self.v[t];
+        let materials = self.layers.map(|l| l.material());
+        // Each cell pulls its two nodes (tension positive).
+        for c in 0..n {
+            let (a, b) = self.nodes(c);
+            self.v[a] += self.stress[c] / self.mass[a] * dt;
+            self.v[b] -= self.stress[c] / self.mass[b] * dt;
+        }
+        // The contact pair moves as one node while pressed together. Pairs
+        // that met with different velocities collide inelastically: the
+        // kinetic energy of their relative motion is lost.
+        let gap = (self.x[t] + self.v[t] * dt) - (self.x[f] + self.v[f] * dt);
+        if gap < 0.0 {
+            let (mf, mt) = (self.mass[f], self.mass[t]);
+            let common = (mf * self.v[f] + mt * self.v[t]) / (mf + mt);
+            self.v[f] = common;
+            self.v[t] = common;
+            self.contact_loss += 0.5 * mf * mt / (mf + mt) * closing * closing;
+        }
+        for i in 0..self.x.len() {
+            self.x[i] += self.v[i] * dt;
+        }
+        self.time += dt;
+        for c in 0..n {
+            let (a, b) = self.nodes(c);
+            let len = self.x[b] - self.x[a];
+            if len.is_nan() || len <= 0.0 {
+                return Err(Error::ThroughBoundary {
+                    particle: c,
+                    boundary: "neighbouring node (cell inverted)",
+                    time: self.time,
+                    position: self.x[a],
+                });
+            }
+            // The length at the middle of the step: the cell grew by
+            // (v_b - v_a) dt.
+            let d = (self.v[b] - self.v[a]) / (len - 0.5 * (self.v[b] - self.v[a]) * dt);
+            let rho = self.density0[c] * self.length0[c] / len;
+            let load = Loading::<Full> {
+                dt,
+                rate: [d, 0.0, 0.0, 0.0, 0.0, 0.0],
+                spin: [0.0; 3],
+                density: rho,
+            };
+            let k = usize::from(c >= self.flyer_cells);
+            let layer = self.layers[k];
+            let (old, mut point_state) = self.state[c].point();
+            let new = match layer {
+                // The ceramic's porous pressure takes the cell's specific
+                // internal energy.
+                Layer::Ceramic(_) => {
+                    materials[k].update_with_energy(&load, &old, self.energy[c], &mut point_state)
+                }
+                // A metal's pressure is at its temperature, as in the other
+                // solvers.
+                Layer::Solid(_) => materials[k].update(&load, &old, &mut point_state),
+            }
+            .map_err(|e| Error::CompressionLimit {
+                particle: c,
+                time: self.time,
+                compression: e.compression,
+                limit: e.limit,
+            })?;
+            self.state[c].set(new, point_state);
+            // The first target cell pulverized in tension (its elastic
+            // volumetric strain at pulverization, which the pulverized
+            // state keeps, an expansion): the spall.
+            if self.spall.is_none()
+                && k == 1
+                && matches!(layer, Layer::Ceramic(_))
+                && point_state
+                    .ceramic()
+                    .and_then(|v| v.pulverized)
+                    .is_some_and(|z| z.volumetric_strain > 0.0)
+            {
+                let depth = (c - self.flyer_cells) as f64;
+                self.spall = Some(((depth + 0.5) * self.length0[c], self.time));
+            }
+            let material = new.deviator[0] - new.pressure;
+            let q = if d < 0.0 {
+                let c_l = layer.wave_speed(rho, &self.state[c]);
+                let (cq, cl) = VISCOSITY;
+                rho * (cq * cq * len * len * d * d - cl * c_l * len * d)
+            } else {
+                0.0
+            };
+            let stress = material - q;
+            if !stress.is_finite() {
+                return Err(Error::NonFinite {
+                    field: "stress",
+                    particle: c,
+                    time: self.time,
+                });
+            }
+            self.energy[c] += 0.5 * (self.stress[c] + stress) * d * dt / rho;
+            self.stress[c] = stress;
+        }
+        if let Some(i) = self.v.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                field: "velocity",
+                particle: i,
+                time: self.time,
+            });
+        }
+        self.steps += 1;
+        self.record();
+        Ok(())
+    }
+}
