@@ -299,7 +299,7 @@ unsafe fn no_strings(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { get_fmu_state(c, "fmi2GetFMUstate", state) as c_int }
+    unsafe { get_fmu_state(c, "fmi2GetFMUstate", state) }
 }
 
 /// `fmi2SetFMUstate`.
@@ -309,7 +309,7 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) 
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { set_fmu_state(c, "fmi2SetFMUstate", state) as c_int }
+    unsafe { set_fmu_state(c, "fmi2SetFMUstate", state) }
 }
 
 /// `fmi2FreeFMUstate`.
@@ -319,7 +319,7 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> Fm
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { free_fmu_state(c, state) as c_int }
+    unsafe { free_fmu_state(c, state) }
 }
 
 /// `fmi2SerializedFMUstateSize`.
@@ -333,7 +333,7 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     size: *mut usize,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", state, size) as c_int }
+    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", state, size) }
 }
 
 /// `fmi2SerializeFMUstate`.
@@ -348,7 +348,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: usize,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { serialize(c, "fmi2SerializeFMUstate", state, bytes, size) as c_int }
+    unsafe { serialize(c, "fmi2SerializeFMUstate", state, bytes, size) }
 }
 
 /// `fmi2DeSerializeFMUstate`.
@@ -363,7 +363,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     state: *mut *mut c_void,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, state) as c_int }
+    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, state) }
 }
 
 /// # Safety

@@ -493,7 +493,7 @@ pub unsafe extern "C" fn fmi3GetFMUState(
     state: *mut *mut c_void,
 ) -> Fmi3Status {
     // SAFETY: FMI 3.0 contract.
-    unsafe { state::get_fmu_state(instance, "fmi3GetFMUState", state) as c_int }
+    unsafe { state::get_fmu_state(instance, "fmi3GetFMUState", state) }
 }
 
 /// `fmi3SetFMUState`: restores a state from `fmi3GetFMUState` or
@@ -504,7 +504,7 @@ pub unsafe extern "C" fn fmi3GetFMUState(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SetFMUState(instance: Instance3, state: *mut c_void) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { state::set_fmu_state(instance, "fmi3SetFMUState", state) as c_int }
+    unsafe { state::set_fmu_state(instance, "fmi3SetFMUState", state) }
 }
 
 /// `fmi3FreeFMUState`.
@@ -517,7 +517,7 @@ pub unsafe extern "C" fn fmi3FreeFMUState(
     state: *mut *mut c_void,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { state::free_fmu_state(instance, state) as c_int }
+    unsafe { state::free_fmu_state(instance, state) }
 }
 
 /// `fmi3SerializedFMUStateSize`.
@@ -531,7 +531,7 @@ pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
     size: *mut usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { state::serialized_size(instance, "fmi3SerializedFMUStateSize", state, size) as c_int }
+    unsafe { state::serialized_size(instance, "fmi3SerializedFMUStateSize", state, size) }
 }
 
 /// `fmi3SerializeFMUState`.
@@ -546,7 +546,7 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(
     size: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { state::serialize(instance, "fmi3SerializeFMUState", state, bytes, size) as c_int }
+    unsafe { state::serialize(instance, "fmi3SerializeFMUState", state, bytes, size) }
 }
 
 /// `fmi3DeserializeFMUState`.
@@ -561,7 +561,7 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(
     state: *mut *mut c_void,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { state::deserialize(instance, "fmi3DeserializeFMUState", bytes, size, state) as c_int }
+    unsafe { state::deserialize(instance, "fmi3DeserializeFMUState", bytes, size, state) }
 }
 
 #[cfg(test)]

@@ -6,12 +6,12 @@
 use super::fmu::Fmu;
 use super::instance::{
     ANY_STATE, INITIALIZATION_MODE, INSTANTIATED, Instance, STEP_DISCARDED, STEP_MODE, Status,
-    experiment_error, mask, with_instance,
+    call, experiment_error, mask, with_instance,
 };
 use super::log::CAT_EVENTS;
 use crate::ffi::{slice, slice_mut};
 use crate::{Scene, Simulation};
-use std::ffi::c_void;
+use std::ffi::{c_int, c_void};
 
 /// The part of an instance that a host saves and restores (FMU state).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -218,7 +218,26 @@ impl Saved {
     }
 }
 
-/// Shared by FMI 3 and FMI 2.
+/// Puts `saved` where the host's `*state` points: a new state when
+/// `*state` is NULL, else in place of the state there.
+///
+/// # Safety
+/// `state` writable and not NULL; a non-null `*state` a state this FMU
+/// handed out and has not freed.
+unsafe fn hand_out(state: *mut *mut c_void, saved: Saved) {
+    // SAFETY: by the contract, `state` is writable and a non-null `*state`
+    // is a live `Box<Saved>`.
+    unsafe {
+        if (*state).is_null() {
+            *state = Box::into_raw(Box::new(saved)) as *mut c_void;
+        } else {
+            *(*state as *mut Saved) = saved;
+        }
+    }
+}
+
+/// `fmi3GetFMUState` / `fmi2GetFMUstate`: a copy of the instance's state
+/// (a new one, or overwriting `*state` when it is not NULL).
 ///
 /// # Safety
 /// `state` writable; `*state` NULL or a state of this FMU.
@@ -226,33 +245,23 @@ pub(crate) unsafe fn get_fmu_state(
     instance: *mut c_void,
     function: &str,
     state: *mut *mut c_void,
-) -> Status {
+) -> c_int {
     // SAFETY: forwarded contract.
     unsafe {
-        with_instance(instance, |inst| {
-            if let Err(s) = inst.check_state(function, mask::FMU_STATE) {
-                return s;
-            }
+        call(instance, function, mask::FMU_STATE, |inst| {
             if state.is_null() {
                 return inst.fail(&format!("{function}: FMUState is NULL"));
             }
             if let Some(Err(e)) = inst.sim.as_ref().map(|s| s.check_savable()) {
                 return inst.fail(&format!("{function}: the run has no state to save: {e}"));
             }
-            let saved = inst.save();
-            // SAFETY: `state` is writable; a non-null `*state` is a
-            // `Box<Saved>` this FMU handed out and has not freed.
-            if (*state).is_null() {
-                *state = Box::into_raw(Box::new(saved)) as *mut c_void;
-            } else {
-                *(*state as *mut Saved) = saved;
-            }
+            hand_out(state, inst.save());
             Status::Ok
         })
     }
 }
 
-/// Shared by FMI 3 and FMI 2.
+/// `fmi3SetFMUState` / `fmi2SetFMUstate`: restores a state.
 ///
 /// # Safety
 /// `state` NULL or a live state of this FMU.
@@ -260,13 +269,10 @@ pub(crate) unsafe fn set_fmu_state(
     instance: *mut c_void,
     function: &str,
     state: *mut c_void,
-) -> Status {
+) -> c_int {
     // SAFETY: forwarded contract.
     unsafe {
-        with_instance(instance, |inst| {
-            if let Err(s) = inst.check_state(function, mask::FMU_STATE) {
-                return s;
-            }
+        call(instance, function, mask::FMU_STATE, |inst| {
             if state.is_null() {
                 return inst.fail(&format!("{function}: FMUState is NULL"));
             }
@@ -278,13 +284,14 @@ pub(crate) unsafe fn set_fmu_state(
     }
 }
 
-/// Shared by FMI 3 and FMI 2: frees `*state` and sets it to NULL.
+/// `fmi3FreeFMUState` / `fmi2FreeFMUstate`: frees `*state` and sets it to
+/// NULL.
 ///
 /// # Safety
 /// `state` NULL or writable; `*state` NULL or a live state of this FMU.
-pub(crate) unsafe fn free_fmu_state(instance: *mut c_void, state: *mut *mut c_void) -> Status {
+pub(crate) unsafe fn free_fmu_state(instance: *mut c_void, state: *mut *mut c_void) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe {
+    (unsafe {
         with_instance(instance, |_inst| {
             if !state.is_null() && !(*state).is_null() {
                 // SAFETY: a `Box<Saved>` from `get_fmu_state`, freed once.
@@ -293,10 +300,10 @@ pub(crate) unsafe fn free_fmu_state(instance: *mut c_void, state: *mut *mut c_vo
             }
             Status::Ok
         })
-    }
+    }) as c_int
 }
 
-/// Shared by FMI 3 and FMI 2.
+/// `fmi3SerializedFMUStateSize` / `fmi2SerializedFMUstateSize`.
 ///
 /// # Safety
 /// `state` a live state of this FMU; `size` writable.
@@ -305,9 +312,9 @@ pub(crate) unsafe fn serialized_size(
     function: &str,
     state: *mut c_void,
     size: *mut usize,
-) -> Status {
+) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe {
+    (unsafe {
         with_instance(instance, |inst| {
             if state.is_null() || size.is_null() {
                 return inst.fail(&format!("{function}: FMUState or size is NULL"));
@@ -316,10 +323,10 @@ pub(crate) unsafe fn serialized_size(
             *size = (*(state as *const Saved)).serialized_len(inst.fmu);
             Status::Ok
         })
-    }
+    }) as c_int
 }
 
-/// Shared by FMI 3 and FMI 2.
+/// `fmi3SerializeFMUState` / `fmi2SerializeFMUstate`.
 ///
 /// # Safety
 /// `state` a live state; `bytes` has room for `size` bytes.
@@ -329,9 +336,9 @@ pub(crate) unsafe fn serialize(
     state: *mut c_void,
     bytes: *mut u8,
     size: usize,
-) -> Status {
+) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe {
+    (unsafe {
         with_instance(instance, |inst| {
             if state.is_null() {
                 return inst.fail(&format!("{function}: FMUState is NULL"));
@@ -346,10 +353,11 @@ pub(crate) unsafe fn serialize(
                 Err(e) => inst.fail(&format!("{function}: {e}")),
             }
         })
-    }
+    }) as c_int
 }
 
-/// Shared by FMI 3 and FMI 2.
+/// `fmi3DeserializeFMUState` / `fmi2DeSerializeFMUstate`: a state from
+/// bytes of `Saved::serialize`, checked.
 ///
 /// # Safety
 /// `bytes` holds `size` bytes; `state` writable.
@@ -359,9 +367,9 @@ pub(crate) unsafe fn deserialize(
     bytes: *const u8,
     size: usize,
     state: *mut *mut c_void,
-) -> Status {
+) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe {
+    (unsafe {
         with_instance(instance, |inst| {
             let Some(data) = slice(bytes, size) else {
                 return inst.fail(&format!("{function}: serializedState is NULL"));
@@ -371,18 +379,13 @@ pub(crate) unsafe fn deserialize(
             }
             match Saved::deserialize(inst.fmu, data) {
                 Ok(saved) => {
-                    // SAFETY: writable; a non-null `*state` is a live `Box<Saved>`.
-                    if (*state).is_null() {
-                        *state = Box::into_raw(Box::new(saved)) as *mut c_void;
-                    } else {
-                        *(*state as *mut Saved) = saved;
-                    }
+                    hand_out(state, saved);
                     Status::Ok
                 }
                 Err(e) => inst.fail(&format!("{function}: {e}")),
             }
         })
-    }
+    }) as c_int
 }
 
 #[cfg(test)]
