@@ -69,10 +69,13 @@
 #![allow(clippy::needless_range_loop)]
 
 mod budget;
-// The C ABI and the FMI glue are the only places with unsafe code.
+// The C ABI, the FMI glue and the pointer and panic helpers they share are
+// the only places with unsafe code.
 #[allow(unsafe_code)]
 mod capi;
 mod error;
+#[allow(unsafe_code)]
+mod ffi;
 #[allow(unsafe_code)]
 mod fmi;
 mod isa;

@@ -5,6 +5,7 @@ use super::error::{Fail, mi_result};
 use super::handle::{FieldMeta, index_error, mi_sim};
 use super::panic::with_sim;
 use super::ptr::{check_buf, copy_out, need_out, put, room_for, text};
+use crate::ffi::slice;
 use crate::sim::Simulation;
 use std::ffi::{CString, c_char};
 
@@ -444,7 +445,7 @@ pub unsafe extern "C" fn mi_sim_state_load(
             return Err(super::ptr::null("buf"));
         }
         // SAFETY: `buf` is non-NULL and, by the contract, valid for `len` bytes.
-        let bytes = unsafe { std::slice::from_raw_parts(buf, len) };
+        let bytes = unsafe { slice(buf, len) }.unwrap_or_default();
         let restored = Simulation::deserialize_state(bytes)?;
         if restored.kind() != s.kind() {
             return Err(Fail::new(

@@ -1,6 +1,6 @@
 //! The stable C ABI (`mi_*`): opaque handles, fixed result codes, a panic
-//! boundary on every entry point. The only module besides [`crate::fmi`] with
-//! unsafe code.
+//! boundary on every entry point. With [`crate::fmi`] and the helpers both
+//! share ([`crate::ffi`]), the only module with unsafe code.
 //!
 //! cbindgen generates `include/meshless_impact.h` from this module
 //! (`cargo xtask header`, settings in `cbindgen.toml`), and [`expand_header`]

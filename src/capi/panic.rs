@@ -1,27 +1,18 @@
 //! The panic boundary: every entry point runs its body inside
-//! [`std::panic::catch_unwind`], so that no panic unwinds into C. A panic
+//! [`std::panic::catch_unwind`] (through [`crate::ffi`]), so that no panic
+//! unwinds into C. A panic
 //! becomes `MI_PANIC`; a handle that panicked is marked poisoned and refuses
 //! further work, since its state may be half-updated.
 
 use super::error::{Fail, mi_result};
 use super::handle::mi_sim;
+use crate::ffi::panic_text;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Runs `f`, turning a panic into `MI_PANIC` (for entry points without a
 /// handle).
 pub(crate) fn guard(f: impl FnOnce() -> mi_result) -> mi_result {
-    catch_unwind(AssertUnwindSafe(f)).unwrap_or(mi_result::MI_PANIC)
-}
-
-/// The text of a panic payload.
-fn payload_text(p: &(dyn std::any::Any + Send)) -> String {
-    if let Some(s) = p.downcast_ref::<&str>() {
-        s.to_string()
-    } else if let Some(s) = p.downcast_ref::<String>() {
-        s.clone()
-    } else {
-        "unknown panic payload".into()
-    }
+    crate::ffi::guard(mi_result::MI_PANIC, f)
 }
 
 /// Runs `f` on the handle behind `sim`: NULL gives `MI_NULL_POINTER`, a
@@ -50,7 +41,7 @@ pub(crate) fn with_sim(
                 s.poisoned = true;
                 s.set_error(format!(
                     "panic inside meshless-impact (handle now unusable): {}",
-                    payload_text(payload.as_ref())
+                    panic_text(payload.as_ref())
                 ));
                 mi_result::MI_PANIC
             }

@@ -1,5 +1,6 @@
 //! Reading C arguments and writing C outputs, with the checks every entry
-//! point shares: NULL pointers, UTF-8, and the buffer convention.
+//! point shares: NULL pointers, UTF-8, and the buffer convention. The
+//! pointer reading itself is [`crate::ffi`]'s, shared with the FMI glue.
 //!
 //! Buffer convention: a function that copies an array (or a string) takes
 //! `buf`, `len` (in elements; for strings in bytes, the terminating NUL
@@ -10,7 +11,8 @@
 //! `MI_BUFFER_TOO_SMALL` and leaves `buf` untouched.
 
 use super::error::{Fail, mi_result};
-use std::ffi::{CStr, c_char};
+use crate::ffi::c_str;
+use std::ffi::c_char;
 
 /// The UTF-8 text of a C string argument called `what`.
 ///
@@ -18,12 +20,9 @@ use std::ffi::{CStr, c_char};
 /// `p` must be NULL or point to a NUL-terminated string that stays valid and
 /// unchanged for `'a`.
 pub(crate) unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, Fail> {
-    if p.is_null() {
-        return Err(null(what));
-    }
-    // SAFETY: `p` is non-NULL and, by this function's contract, NUL-terminated
-    // and valid for 'a.
-    let c = unsafe { CStr::from_ptr(p) };
+    // SAFETY: by this function's contract, NULL or NUL-terminated and valid
+    // for 'a.
+    let c = unsafe { c_str(p) }.ok_or_else(|| null(what))?;
     c.to_str().map_err(|_| {
         Fail::new(
             mi_result::MI_INVALID_UTF8,

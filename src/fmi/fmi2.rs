@@ -7,11 +7,15 @@
 //! `fmi2GetRealStatus(fmi2LastSuccessfulTime)` is the time the run ended
 //! (at most the end of the step).
 
-use super::fmi3::{
+use super::fmu::Fmu;
+use super::instance::{Instance, STEP_DISCARDED, Standard, Status, call, mask, with_instance};
+use super::log::{Fmi2Logger, LogSink};
+use super::ops::values_of_type;
+use super::state::{
     deserialize, free_fmu_state, get_fmu_state, serialize, serialized_size, set_fmu_state,
 };
-use super::*;
-use std::ffi::{c_char, c_void};
+use crate::ffi::{c_string_lossy, guard};
+use std::ffi::{c_char, c_int, c_void};
 
 type Fmi2Status = c_int;
 type Component = *mut c_void;
@@ -41,23 +45,6 @@ pub struct CallbackFunctions {
     pub component_environment: *mut c_void,
 }
 
-/// # Safety
-/// `c` null or a live instance of this library.
-unsafe fn call(
-    c: Component,
-    function: &str,
-    mask: u32,
-    f: impl FnOnce(&mut Instance) -> Status,
-) -> Fmi2Status {
-    // SAFETY: forwarded contract.
-    (unsafe {
-        with_instance(c, |inst| match inst.check_state(function, mask) {
-            Ok(()) => f(inst),
-            Err(s) => s,
-        })
-    }) as c_int
-}
-
 /// `fmi2GetTypesPlatform`: "default".
 #[unsafe(no_mangle)]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
@@ -81,14 +68,11 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     n_categories: usize,
     categories: *const *const c_char,
 ) -> Fmi2Status {
+    let function = "fmi2SetDebugLogging";
     // SAFETY: FMI 2.0 contract.
     unsafe {
-        call(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
-            let Some(cats) = slice(categories, n_categories) else {
-                return inst.fail("fmi2SetDebugLogging: categories is NULL");
-            };
-            let names: Vec<String> = cats.iter().map(|&p| c_str(p).unwrap_or_default()).collect();
-            inst.set_debug_logging(logging_on != 0, &names)
+        call(c, function, mask::SET_DEBUG_LOGGING, |inst| {
+            inst.set_debug_logging(function, logging_on != 0, categories, n_categories)
         })
     }
 }
@@ -111,11 +95,11 @@ pub unsafe extern "C" fn fmi2Instantiate(
 ) -> Component {
     guard(std::ptr::null_mut(), || {
         // SAFETY: NUL-terminated or NULL by the FMI contract.
-        let guid = unsafe { c_str(fmu_guid) };
+        let guid = unsafe { c_string_lossy(fmu_guid) };
         let found = Fmu::for_instantiation("fmi2Instantiate", guid.as_deref());
         let fmu = found.clone().unwrap_or_else(|_| Fmu::all()[0]);
         // SAFETY: as above.
-        let name = unsafe { c_str(instance_name) }
+        let name = unsafe { c_string_lossy(instance_name) }
             .unwrap_or_else(|| fmu.identity().model_identifier.into());
         // SAFETY: `functions` is NULL or a valid struct by the contract.
         let log = match unsafe { functions.as_ref() } {
@@ -238,116 +222,20 @@ pub unsafe extern "C" fn fmi2Reset(c: Component) -> Fmi2Status {
     unsafe { call(c, "fmi2Reset", mask::RESET, |inst| inst.reset()) }
 }
 
-/// # Safety
-/// `vrs` holds `nvr` references; `values` has room for `nvr` values.
-unsafe fn get_values<T>(
-    c: Component,
-    function: &str,
-    ty: VarType,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *mut T,
-    convert: impl Fn(f64) -> T,
-) -> Fmi2Status {
-    // SAFETY: FMI 2.0 contract.
-    (unsafe {
-        with_instance(c, |inst| {
-            let Some(vrs) = slice(vrs, nvr) else {
-                return inst.fail(&format!("{function}: vr is NULL"));
-            };
-            let Some(out) = slice_mut(values, nvr) else {
-                return inst.fail(&format!("{function}: value is NULL"));
-            };
-            match inst.get(function, vrs, ty) {
-                Ok(v) => {
-                    for (o, x) in out.iter_mut().zip(v) {
-                        *o = convert(x);
-                    }
-                    Status::Ok
-                }
-                Err(s) => s,
-            }
-        })
-    }) as c_int
-}
-
-/// # Safety
-/// `vrs` and `values` hold `nvr` elements.
-unsafe fn set_values<T: Copy>(
-    c: Component,
-    function: &str,
-    ty: VarType,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *const T,
-    convert: impl Fn(T) -> f64,
-) -> Fmi2Status {
-    // SAFETY: FMI 2.0 contract.
-    (unsafe {
-        with_instance(c, |inst| {
-            let Some(vrs) = slice(vrs, nvr) else {
-                return inst.fail(&format!("{function}: vr is NULL"));
-            };
-            let Some(vals) = slice(values, nvr) else {
-                return inst.fail(&format!("{function}: value is NULL"));
-            };
-            let vals: Vec<f64> = vals.iter().map(|&x| convert(x)).collect();
-            inst.set(function, vrs, &vals, ty)
-        })
-    }) as c_int
-}
-
-/// `fmi2GetReal`: Real parameters and outputs.
-///
-/// # Safety
-/// FMI 2.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetReal(
-    c: Component,
-    vr: *const Vr,
-    nvr: usize,
-    value: *mut f64,
-) -> Fmi2Status {
-    // SAFETY: forwarded.
-    unsafe { get_values(c, "fmi2GetReal", VarType::Float64, vr, nvr, value, |x| x) }
-}
-
-/// `fmi2GetInteger`: `particles_radial`.
-///
-/// # Safety
-/// FMI 2.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetInteger(
-    c: Component,
-    vr: *const Vr,
-    nvr: usize,
-    value: *mut c_int,
-) -> Fmi2Status {
-    // SAFETY: forwarded.
-    unsafe {
-        get_values(c, "fmi2GetInteger", VarType::Int32, vr, nvr, value, |x| {
-            x as c_int
-        })
-    }
-}
-
-/// `fmi2GetBoolean`: `at_rest`.
-///
-/// # Safety
-/// FMI 2.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBoolean(
-    c: Component,
-    vr: *const Vr,
-    nvr: usize,
-    value: *mut c_int,
-) -> Fmi2Status {
-    // SAFETY: forwarded.
-    unsafe {
-        get_values(c, "fmi2GetBoolean", VarType::Boolean, vr, nvr, value, |x| {
-            (x != 0.0) as c_int
-        })
-    }
+values_of_type! {
+    " FMI 2.0 contract.", [];
+    /// `fmi2GetReal`: Real parameters and outputs.
+    fmi2GetReal, f64, mut, Float64, get_values, |x| x;
+    /// `fmi2GetInteger`: `particles_radial`.
+    fmi2GetInteger, c_int, mut, Int32, get_values, |x| x as c_int;
+    /// `fmi2GetBoolean`: `at_rest`.
+    fmi2GetBoolean, c_int, mut, Boolean, get_values, |x| (x != 0.0) as c_int;
+    /// `fmi2SetReal`: Real parameters, before the end of initialization.
+    fmi2SetReal, f64, const, Float64, set_values, |x| x;
+    /// `fmi2SetInteger`: `particles_radial`, before the end of initialization.
+    fmi2SetInteger, c_int, const, Int32, set_values, |x| x as f64;
+    /// `fmi2SetBoolean`: no Boolean parameters (the only Boolean is an output).
+    fmi2SetBoolean, c_int, const, Boolean, set_values, |x| (x != 0) as u8 as f64;
 }
 
 /// `fmi2GetString`: there are no String variables.
@@ -363,59 +251,6 @@ pub unsafe extern "C" fn fmi2GetString(
 ) -> Fmi2Status {
     // SAFETY: forwarded.
     unsafe { no_strings(c, "fmi2GetString", mask::GET, vr, nvr) }
-}
-
-/// `fmi2SetReal`: Real parameters, before the end of initialization.
-///
-/// # Safety
-/// FMI 2.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetReal(
-    c: Component,
-    vr: *const Vr,
-    nvr: usize,
-    value: *const f64,
-) -> Fmi2Status {
-    // SAFETY: forwarded.
-    unsafe { set_values(c, "fmi2SetReal", VarType::Float64, vr, nvr, value, |x| x) }
-}
-
-/// `fmi2SetInteger`: `particles_radial`, before the end of initialization.
-///
-/// # Safety
-/// FMI 2.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetInteger(
-    c: Component,
-    vr: *const Vr,
-    nvr: usize,
-    value: *const c_int,
-) -> Fmi2Status {
-    // SAFETY: forwarded.
-    unsafe {
-        set_values(c, "fmi2SetInteger", VarType::Int32, vr, nvr, value, |x| {
-            x as f64
-        })
-    }
-}
-
-/// `fmi2SetBoolean`: no Boolean parameters (the only Boolean is an output).
-///
-/// # Safety
-/// FMI 2.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetBoolean(
-    c: Component,
-    vr: *const Vr,
-    nvr: usize,
-    value: *const c_int,
-) -> Fmi2Status {
-    // SAFETY: forwarded.
-    unsafe {
-        set_values(c, "fmi2SetBoolean", VarType::Boolean, vr, nvr, value, |x| {
-            (x != 0) as u8 as f64
-        })
-    }
 }
 
 /// `fmi2SetString`: there are no String variables.
@@ -450,7 +285,7 @@ unsafe fn no_strings(
             inst.no_variables(
                 function,
                 mask,
-                slice(vr, nvr),
+                (vr, nvr),
                 "a String variable (this FMU has none)",
             )
         })
@@ -464,7 +299,7 @@ unsafe fn no_strings(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { get_fmu_state(c, "fmi2GetFMUstate", state) as c_int }
+    unsafe { get_fmu_state(c, "fmi2GetFMUstate", state) }
 }
 
 /// `fmi2SetFMUstate`.
@@ -474,7 +309,7 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) 
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { set_fmu_state(c, "fmi2SetFMUstate", state) as c_int }
+    unsafe { set_fmu_state(c, "fmi2SetFMUstate", state) }
 }
 
 /// `fmi2FreeFMUstate`.
@@ -484,7 +319,7 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> Fm
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { free_fmu_state(c, state) as c_int }
+    unsafe { free_fmu_state(c, state) }
 }
 
 /// `fmi2SerializedFMUstateSize`.
@@ -498,7 +333,7 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     size: *mut usize,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", state, size) as c_int }
+    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", state, size) }
 }
 
 /// `fmi2SerializeFMUstate`.
@@ -513,7 +348,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: usize,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { serialize(c, "fmi2SerializeFMUstate", state, bytes, size) as c_int }
+    unsafe { serialize(c, "fmi2SerializeFMUstate", state, bytes, size) }
 }
 
 /// `fmi2DeSerializeFMUstate`.
@@ -528,7 +363,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     state: *mut *mut c_void,
 ) -> Fmi2Status {
     // SAFETY: forwarded.
-    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, state) as c_int }
+    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, state) }
 }
 
 /// # Safety
@@ -771,6 +606,7 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
 
 #[cfg(test)]
 mod tests {
+    use super::super::taylor_fmu;
     use super::*;
 
     /// A new Co-Simulation instance with the right GUID and no logger.

@@ -7,33 +7,19 @@
 //! end of the communication step and the host allowed early return,
 //! `earlyReturn = true` and `lastSuccessfulTime` is the time the run ended.
 
-use super::*;
-use std::ffi::{c_char, c_void};
+use super::fmu::Fmu;
+use super::instance::{Instance, Standard, Status, call, mask, with_instance};
+use super::log::{Fmi3Logger, LogSink};
+use super::ops::values_of_type;
+use super::state;
+use crate::ffi::{c_string_lossy, guard};
+use std::ffi::{c_char, c_int, c_void};
 
 type Fmi3Status = c_int;
 type Instance3 = *mut c_void;
 type Vr = u32;
 
 const VERSION: &[u8] = b"3.0\0";
-
-/// Runs `f` on an instance with the state check of `function`.
-///
-/// # Safety
-/// `instance` must be null or a live instance of this library.
-unsafe fn call(
-    instance: Instance3,
-    function: &str,
-    mask: u32,
-    f: impl FnOnce(&mut Instance) -> Status,
-) -> Fmi3Status {
-    // SAFETY: forwarded contract.
-    (unsafe {
-        with_instance(instance, |inst| match inst.check_state(function, mask) {
-            Ok(()) => f(inst),
-            Err(s) => s,
-        })
-    }) as c_int
-}
 
 /// `fmi3GetVersion`: "3.0".
 #[unsafe(no_mangle)]
@@ -52,21 +38,12 @@ pub unsafe extern "C" fn fmi3SetDebugLogging(
     n_categories: usize,
     categories: *const *const c_char,
 ) -> Fmi3Status {
+    let function = "fmi3SetDebugLogging";
     // SAFETY: FMI 3.0 contract (see above).
     unsafe {
-        call(
-            instance,
-            "fmi3SetDebugLogging",
-            mask::SET_DEBUG_LOGGING,
-            |inst| {
-                let Some(cats) = slice(categories, n_categories) else {
-                    return inst.fail("fmi3SetDebugLogging: categories is NULL");
-                };
-                let names: Vec<String> =
-                    cats.iter().map(|&c| c_str(c).unwrap_or_default()).collect();
-                inst.set_debug_logging(logging_on != 0, &names)
-            },
-        )
+        call(instance, function, mask::SET_DEBUG_LOGGING, |inst| {
+            inst.set_debug_logging(function, logging_on != 0, categories, n_categories)
+        })
     }
 }
 
@@ -124,11 +101,11 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 ) -> Instance3 {
     guard(std::ptr::null_mut(), || {
         // SAFETY: NUL-terminated or NULL by the FMI contract.
-        let token = unsafe { c_str(instantiation_token) };
+        let token = unsafe { c_string_lossy(instantiation_token) };
         let found = Fmu::for_instantiation("fmi3InstantiateCoSimulation", token.as_deref());
         let fmu = found.clone().unwrap_or_else(|_| Fmu::all()[0]);
         // SAFETY: as above.
-        let name = unsafe { c_str(instance_name) }
+        let name = unsafe { c_string_lossy(instance_name) }
             .unwrap_or_else(|| fmu.identity().model_identifier.into());
         let log = match log_message {
             Some(callback) => LogSink::Fmi3 {
@@ -236,299 +213,26 @@ pub unsafe extern "C" fn fmi3Reset(instance: Instance3) -> Fmi3Status {
     unsafe { call(instance, "fmi3Reset", mask::RESET, |inst| inst.reset()) }
 }
 
-/// Shared body of the getters.
-#[allow(clippy::too_many_arguments)]
-///
-/// # Safety
-/// `vrs` holds `nvr` references, `values` has room for `n_values`.
-unsafe fn get_values<T: Copy>(
-    instance: Instance3,
-    function: &str,
-    ty: VarType,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *mut T,
-    n_values: usize,
-    convert: impl Fn(f64) -> T,
-) -> Fmi3Status {
-    // SAFETY: FMI 3.0 contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            if nvr != n_values {
-                return inst.fail(&format!(
-                    "{function}: nValues = {n_values} but nValueReferences = {nvr}"
-                ));
-            }
-            let Some(vrs) = slice(vrs, nvr) else {
-                return inst.fail(&format!("{function}: valueReferences is NULL"));
-            };
-            let Some(out) = slice_mut(values, n_values) else {
-                return inst.fail(&format!("{function}: values is NULL"));
-            };
-            match inst.get(function, vrs, ty) {
-                Ok(v) => {
-                    for (o, x) in out.iter_mut().zip(v) {
-                        *o = convert(x);
-                    }
-                    Status::Ok
-                }
-                Err(s) => s,
-            }
-        }) as c_int
-    }
-}
-
-/// Shared body of the setters.
-#[allow(clippy::too_many_arguments)]
-///
-/// # Safety
-/// `vrs` holds `nvr` references, `values` holds `n_values` values.
-unsafe fn set_values<T: Copy>(
-    instance: Instance3,
-    function: &str,
-    ty: VarType,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *const T,
-    n_values: usize,
-    convert: impl Fn(T) -> f64,
-) -> Fmi3Status {
-    // SAFETY: FMI 3.0 contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            if nvr != n_values {
-                return inst.fail(&format!(
-                    "{function}: nValues = {n_values} but nValueReferences = {nvr}"
-                ));
-            }
-            let Some(vrs) = slice(vrs, nvr) else {
-                return inst.fail(&format!("{function}: valueReferences is NULL"));
-            };
-            let Some(vals) = slice(values, n_values) else {
-                return inst.fail(&format!("{function}: values is NULL"));
-            };
-            let vals: Vec<f64> = vals.iter().map(|&x| convert(x)).collect();
-            inst.set(function, vrs, &vals, ty)
-        }) as c_int
-    }
-}
-
-/// `fmi3GetFloat64`: `time`, the Float64 parameters and outputs.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetFloat64(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *mut f64,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        get_values(
-            instance,
-            "fmi3GetFloat64",
-            VarType::Float64,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| x,
-        )
-    }
-}
-
-/// `fmi3GetInt32`: `particles_radial`.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetInt32(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *mut i32,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        get_values(
-            instance,
-            "fmi3GetInt32",
-            VarType::Int32,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| x as i32,
-        )
-    }
-}
-
-/// `fmi3GetBoolean`: `at_rest`.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetBoolean(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *mut u8,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        get_values(
-            instance,
-            "fmi3GetBoolean",
-            VarType::Boolean,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| (x != 0.0) as u8,
-        )
-    }
-}
-
-/// `fmi3SetFloat64`: Float64 parameters, before the end of initialization.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetFloat64(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *const f64,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        set_values(
-            instance,
-            "fmi3SetFloat64",
-            VarType::Float64,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| x,
-        )
-    }
-}
-
-/// `fmi3SetInt32`: `particles_radial`, before the end of initialization.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetInt32(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *const i32,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        set_values(
-            instance,
-            "fmi3SetInt32",
-            VarType::Int32,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| x as f64,
-        )
-    }
-}
-
-/// `fmi3GetInt64`: the Enumeration parameters (the `scheme`; FMI 3.0 reads
-/// and writes enumerations as Int64).
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetInt64(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *mut i64,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        get_values(
-            instance,
-            "fmi3GetInt64",
-            VarType::Enumeration,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| x as i64,
-        )
-    }
-}
-
-/// `fmi3SetInt64`: the Enumeration parameters (the `scheme`), by the value
-/// of an item.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetInt64(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *const i64,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        set_values(
-            instance,
-            "fmi3SetInt64",
-            VarType::Enumeration,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| x as f64,
-        )
-    }
-}
-
-/// `fmi3SetBoolean`: there are no Boolean inputs or parameters.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetBoolean(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    values: *const u8,
-    n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe {
-        set_values(
-            instance,
-            "fmi3SetBoolean",
-            VarType::Boolean,
-            vrs,
-            nvr,
-            values,
-            n_values,
-            |x| (x != 0) as u8 as f64,
-        )
-    }
+values_of_type! {
+    " FMI 3.0 contract.", [n_values];
+    /// `fmi3GetFloat64`: `time`, the Float64 parameters and outputs.
+    fmi3GetFloat64, f64, mut, Float64, get_values, |x| x;
+    /// `fmi3GetInt32`: `particles_radial`.
+    fmi3GetInt32, i32, mut, Int32, get_values, |x| x as i32;
+    /// `fmi3GetBoolean`: `at_rest`.
+    fmi3GetBoolean, u8, mut, Boolean, get_values, |x| (x != 0.0) as u8;
+    /// `fmi3SetFloat64`: Float64 parameters, before the end of initialization.
+    fmi3SetFloat64, f64, const, Float64, set_values, |x| x;
+    /// `fmi3SetInt32`: `particles_radial`, before the end of initialization.
+    fmi3SetInt32, i32, const, Int32, set_values, |x| x as f64;
+    /// `fmi3GetInt64`: the Enumeration parameters (the `scheme`; FMI 3.0 reads
+    /// and writes enumerations as Int64).
+    fmi3GetInt64, i64, mut, Enumeration, get_values, |x| x as i64;
+    /// `fmi3SetInt64`: the Enumeration parameters (the `scheme`), by the value
+    /// of an item.
+    fmi3SetInt64, i64, const, Enumeration, set_values, |x| x as f64;
+    /// `fmi3SetBoolean`: there are no Boolean inputs or parameters.
+    fmi3SetBoolean, u8, const, Boolean, set_values, |x| (x != 0) as u8 as f64;
 }
 
 /// Getters and setters of types this FMU has no variables of: OK for an
@@ -571,7 +275,7 @@ unsafe fn no_such_type(
             inst.no_variables(
                 function,
                 mask,
-                slice(vrs, nvr),
+                (vrs, nvr),
                 "a variable of this type (this FMU has Float64, Int32, Boolean and Enumeration (Int64) variables)",
             )
         }) as c_int
@@ -789,174 +493,7 @@ pub unsafe extern "C" fn fmi3GetFMUState(
     state: *mut *mut c_void,
 ) -> Fmi3Status {
     // SAFETY: FMI 3.0 contract.
-    unsafe { get_fmu_state(instance, "fmi3GetFMUState", state) as c_int }
-}
-
-/// Shared by FMI 3 and FMI 2.
-///
-/// # Safety
-/// `state` writable; `*state` NULL or a state of this FMU.
-pub(crate) unsafe fn get_fmu_state(
-    instance: *mut c_void,
-    function: &str,
-    state: *mut *mut c_void,
-) -> Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            if let Err(s) = inst.check_state(function, mask::FMU_STATE) {
-                return s;
-            }
-            if state.is_null() {
-                return inst.fail(&format!("{function}: FMUState is NULL"));
-            }
-            if let Some(Err(e)) = inst.sim.as_ref().map(|s| s.check_savable()) {
-                return inst.fail(&format!("{function}: the run has no state to save: {e}"));
-            }
-            let saved = inst.save();
-            // SAFETY: `state` is writable; a non-null `*state` is a
-            // `Box<Saved>` this FMU handed out and has not freed.
-            if (*state).is_null() {
-                *state = Box::into_raw(Box::new(saved)) as *mut c_void;
-            } else {
-                *(*state as *mut Saved) = saved;
-            }
-            Status::Ok
-        })
-    }
-}
-
-/// Shared by FMI 3 and FMI 2.
-///
-/// # Safety
-/// `state` NULL or a live state of this FMU.
-pub(crate) unsafe fn set_fmu_state(
-    instance: *mut c_void,
-    function: &str,
-    state: *mut c_void,
-) -> Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            if let Err(s) = inst.check_state(function, mask::FMU_STATE) {
-                return s;
-            }
-            if state.is_null() {
-                return inst.fail(&format!("{function}: FMUState is NULL"));
-            }
-            // SAFETY: a live `Box<Saved>` of this FMU by the contract.
-            let saved = &*(state as *const Saved);
-            inst.restore(saved);
-            Status::Ok
-        })
-    }
-}
-
-/// Shared by FMI 3 and FMI 2: frees `*state` and sets it to NULL.
-///
-/// # Safety
-/// `state` NULL or writable; `*state` NULL or a live state of this FMU.
-pub(crate) unsafe fn free_fmu_state(instance: *mut c_void, state: *mut *mut c_void) -> Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        with_instance(instance, |_inst| {
-            if !state.is_null() && !(*state).is_null() {
-                // SAFETY: a `Box<Saved>` from `get_fmu_state`, freed once.
-                drop(Box::from_raw(*state as *mut Saved));
-                *state = std::ptr::null_mut();
-            }
-            Status::Ok
-        })
-    }
-}
-
-/// Shared by FMI 3 and FMI 2.
-///
-/// # Safety
-/// `state` a live state of this FMU; `size` writable.
-pub(crate) unsafe fn serialized_size(
-    instance: *mut c_void,
-    function: &str,
-    state: *mut c_void,
-    size: *mut usize,
-) -> Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            if state.is_null() || size.is_null() {
-                return inst.fail(&format!("{function}: FMUState or size is NULL"));
-            }
-            // SAFETY: a live `Box<Saved>`; `size` writable.
-            *size = (*(state as *const Saved)).serialized_len(inst.fmu);
-            Status::Ok
-        })
-    }
-}
-
-/// Shared by FMI 3 and FMI 2.
-///
-/// # Safety
-/// `state` a live state; `bytes` has room for `size` bytes.
-pub(crate) unsafe fn serialize(
-    instance: *mut c_void,
-    function: &str,
-    state: *mut c_void,
-    bytes: *mut u8,
-    size: usize,
-) -> Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            if state.is_null() {
-                return inst.fail(&format!("{function}: FMUState is NULL"));
-            }
-            // SAFETY: a live `Box<Saved>`.
-            let saved = &*(state as *const Saved);
-            let Some(out) = slice_mut(bytes, size) else {
-                return inst.fail(&format!("{function}: serializedState is NULL"));
-            };
-            match saved.serialize_into(inst.fmu, out) {
-                Ok(()) => Status::Ok,
-                Err(e) => inst.fail(&format!("{function}: {e}")),
-            }
-        })
-    }
-}
-
-/// Shared by FMI 3 and FMI 2.
-///
-/// # Safety
-/// `bytes` holds `size` bytes; `state` writable.
-pub(crate) unsafe fn deserialize(
-    instance: *mut c_void,
-    function: &str,
-    bytes: *const u8,
-    size: usize,
-    state: *mut *mut c_void,
-) -> Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        with_instance(instance, |inst| {
-            let Some(data) = slice(bytes, size) else {
-                return inst.fail(&format!("{function}: serializedState is NULL"));
-            };
-            if state.is_null() {
-                return inst.fail(&format!("{function}: FMUState is NULL"));
-            }
-            match Saved::deserialize(inst.fmu, data) {
-                Ok(saved) => {
-                    // SAFETY: writable; a non-null `*state` is a live `Box<Saved>`.
-                    if (*state).is_null() {
-                        *state = Box::into_raw(Box::new(saved)) as *mut c_void;
-                    } else {
-                        *(*state as *mut Saved) = saved;
-                    }
-                    Status::Ok
-                }
-                Err(e) => inst.fail(&format!("{function}: {e}")),
-            }
-        })
-    }
+    unsafe { state::get_fmu_state(instance, "fmi3GetFMUState", state) }
 }
 
 /// `fmi3SetFMUState`: restores a state from `fmi3GetFMUState` or
@@ -967,7 +504,7 @@ pub(crate) unsafe fn deserialize(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SetFMUState(instance: Instance3, state: *mut c_void) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { set_fmu_state(instance, "fmi3SetFMUState", state) as c_int }
+    unsafe { state::set_fmu_state(instance, "fmi3SetFMUState", state) }
 }
 
 /// `fmi3FreeFMUState`.
@@ -980,7 +517,7 @@ pub unsafe extern "C" fn fmi3FreeFMUState(
     state: *mut *mut c_void,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { free_fmu_state(instance, state) as c_int }
+    unsafe { state::free_fmu_state(instance, state) }
 }
 
 /// `fmi3SerializedFMUStateSize`.
@@ -994,7 +531,7 @@ pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
     size: *mut usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { serialized_size(instance, "fmi3SerializedFMUStateSize", state, size) as c_int }
+    unsafe { state::serialized_size(instance, "fmi3SerializedFMUStateSize", state, size) }
 }
 
 /// `fmi3SerializeFMUState`.
@@ -1009,7 +546,7 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(
     size: usize,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { serialize(instance, "fmi3SerializeFMUState", state, bytes, size) as c_int }
+    unsafe { state::serialize(instance, "fmi3SerializeFMUState", state, bytes, size) }
 }
 
 /// `fmi3DeserializeFMUState`.
@@ -1024,11 +561,12 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(
     state: *mut *mut c_void,
 ) -> Fmi3Status {
     // SAFETY: forwarded.
-    unsafe { deserialize(instance, "fmi3DeserializeFMUState", bytes, size, state) as c_int }
+    unsafe { state::deserialize(instance, "fmi3DeserializeFMUState", bytes, size, state) }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::{VR_TIME, taylor_fmu};
     use super::*;
 
     /// A new instance with the right token and no logger.

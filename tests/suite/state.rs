@@ -234,7 +234,7 @@ fn bits(s: &Simulation) -> Vec<u64> {
 /// (`Simulation::serialize_state`, the solver's `ModelState::save`) and as
 /// a copy (`ModelState::boxed_clone`), restored and run to rest, gives the
 /// bits of the run that was not interrupted: clock, observables, every 3-D
-/// field and the histories. (The FMU state, postcard: src/fmi/mod.rs and
+/// field and the histories. (The FMU state, postcard: src/fmi/state.rs and
 /// tests/fmu/test_taylor3d.py.)
 #[test]
 fn a_taylor3d_run_saved_mid_way_resumes_to_the_bits_of_the_whole_run() {
