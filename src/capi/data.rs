@@ -3,7 +3,7 @@
 
 use super::error::{Fail, mi_result};
 use super::handle::{FieldMeta, index_error, mi_sim};
-use super::panic::with_sim;
+use super::panic::{get_into, with_sim};
 use super::ptr::{check_buf, copy_out, need_out, put, room_for, text};
 use crate::ffi::slice;
 use crate::sim::Simulation;
@@ -15,12 +15,8 @@ use std::ffi::{CString, c_char};
 /// `sim` must be NULL or a live handle; `time` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_time(sim: *mut mi_sim, time: *mut f64) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(time, "time")?;
-        let t = s.sim()?.time();
-        // SAFETY: forwarded contract on `time`.
-        unsafe { put(time, t, "time") }
-    })
+    // SAFETY: forwarded contract on `time`.
+    unsafe { get_into(sim, time, "time", |s| Ok(s.sim()?.time())) }
 }
 
 /// Writes the latest time the run may reach (the scene's `end_time`, s).
@@ -29,12 +25,8 @@ pub unsafe extern "C" fn mi_sim_time(sim: *mut mi_sim, time: *mut f64) -> mi_res
 /// `sim` must be NULL or a live handle; `time` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_end_time(sim: *mut mi_sim, time: *mut f64) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(time, "time")?;
-        let t = s.sim()?.end_time();
-        // SAFETY: forwarded contract on `time`.
-        unsafe { put(time, t, "time") }
-    })
+    // SAFETY: forwarded contract on `time`.
+    unsafe { get_into(sim, time, "time", |s| Ok(s.sim()?.end_time())) }
 }
 
 /// Writes the number of steps taken.
@@ -43,12 +35,8 @@ pub unsafe extern "C" fn mi_sim_end_time(sim: *mut mi_sim, time: *mut f64) -> mi
 /// `sim` must be NULL or a live handle; `steps` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_steps(sim: *mut mi_sim, steps: *mut u64) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(steps, "steps")?;
-        let n = s.sim()?.steps();
-        // SAFETY: forwarded contract on `steps`.
-        unsafe { put(steps, n, "steps") }
-    })
+    // SAFETY: forwarded contract on `steps`.
+    unsafe { get_into(sim, steps, "steps", |s| Ok(s.sim()?.steps())) }
 }
 
 /// Writes the number of particles.
@@ -57,12 +45,8 @@ pub unsafe extern "C" fn mi_sim_steps(sim: *mut mi_sim, steps: *mut u64) -> mi_r
 /// `sim` must be NULL or a live handle; `count` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_particle_count(sim: *mut mi_sim, count: *mut usize) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(count, "count")?;
-        let n = s.sim()?.particles();
-        // SAFETY: forwarded contract on `count`.
-        unsafe { put(count, n, "count") }
-    })
+    // SAFETY: forwarded contract on `count`.
+    unsafe { get_into(sim, count, "count", |s| Ok(s.sim()?.particles())) }
 }
 
 /// Writes whether the run has ended (end condition, solver stop or cancel).
@@ -71,12 +55,8 @@ pub unsafe extern "C" fn mi_sim_particle_count(sim: *mut mi_sim, count: *mut usi
 /// `sim` must be NULL or a live handle; `finished` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_finished(sim: *mut mi_sim, finished: *mut bool) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(finished, "finished")?;
-        let f = s.finished()?;
-        // SAFETY: forwarded contract on `finished`.
-        unsafe { put(finished, f, "finished") }
-    })
+    // SAFETY: forwarded contract on `finished`.
+    unsafe { get_into(sim, finished, "finished", |s| s.finished()) }
 }
 
 /// One observable of a scene. The strings belong to the handle and stay valid
@@ -101,11 +81,12 @@ pub struct mi_observable_info {
 /// `sim` must be NULL or a live handle; `count` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_observable_count(sim: *mut mi_sim, count: *mut usize) -> mi_result {
-    with_sim(sim, |s| {
-        let n = s.kind().observable_specs().len();
-        // SAFETY: forwarded contract on `count`.
-        unsafe { put(count, n, "count") }
-    })
+    // SAFETY: forwarded contract on `count`.
+    unsafe {
+        get_into(sim, count, "count", |s| {
+            Ok(s.kind().observable_specs().len())
+        })
+    }
 }
 
 /// Describes the observable at `index` (0 .. count-1; else
@@ -204,12 +185,8 @@ pub unsafe extern "C" fn mi_sim_observables(
 /// `sim` must be NULL or a live handle; `rows` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_history_len(sim: *mut mi_sim, rows: *mut usize) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(rows, "rows")?;
-        let n = s.sim()?.history().len();
-        // SAFETY: forwarded contract on `rows`.
-        unsafe { put(rows, n, "rows") }
-    })
+    // SAFETY: forwarded contract on `rows`.
+    unsafe { get_into(sim, rows, "rows", |s| Ok(s.sim()?.history().len())) }
 }
 
 /// Copies the recorded times (s) by the buffer convention.
@@ -304,12 +281,8 @@ fn meta(name: &str, unit: &str, comps: &[&str]) -> FieldMeta {
 /// `sim` must be NULL or a live handle; `count` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_field_count(sim: *mut mi_sim, count: *mut usize) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(count, "count")?;
-        let n = field_meta(s)?.len();
-        // SAFETY: forwarded contract on `count`.
-        unsafe { put(count, n, "count") }
-    })
+    // SAFETY: forwarded contract on `count`.
+    unsafe { get_into(sim, count, "count", |s| Ok(field_meta(s)?.len())) }
 }
 
 /// Describes the particle field at `index` (0 .. count-1; else

@@ -11,7 +11,7 @@
 //! that needs it), while names and ranges are checked by the setter.
 
 use super::error::{Fail, mi_result};
-use super::panic::{guard, with_sim};
+use super::panic::{get_into, guard, with_sim};
 use super::ptr::{need_out, put, text};
 use crate::error::Error;
 use crate::scene::{Scene, SceneKind};
@@ -495,11 +495,8 @@ pub struct mi_param_info {
 /// `sim` must be NULL or a live handle; `count` NULL or valid for one write.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mi_sim_param_count(sim: *mut mi_sim, count: *mut usize) -> mi_result {
-    with_sim(sim, |s| {
-        let n = s.kind().param_specs().len();
-        // SAFETY: forwarded contract on `count`.
-        unsafe { put(count, n, "count") }
-    })
+    // SAFETY: forwarded contract on `count`.
+    unsafe { get_into(sim, count, "count", |s| Ok(s.kind().param_specs().len())) }
 }
 
 /// Describes the parameter at `index` (0 .. count-1; else `MI_OUT_OF_RANGE`).

@@ -49,6 +49,26 @@ pub(crate) fn with_sim(
     })
 }
 
+/// A getter of the C ABI: on the handle behind `sim` (as [`with_sim`]),
+/// checks the output pointer `out` (named `what` in the error), computes
+/// `value` and writes it to `*out`.
+///
+/// # Safety
+/// `out` must be NULL or valid for a write of one `T`.
+pub(crate) unsafe fn get_into<T>(
+    sim: *mut mi_sim,
+    out: *mut T,
+    what: &str,
+    value: impl FnOnce(&mut mi_sim) -> Result<T, Fail>,
+) -> mi_result {
+    with_sim(sim, |s| {
+        super::ptr::need_out(out, what)?;
+        let v = value(s)?;
+        // SAFETY: forwarded contract on `out`.
+        unsafe { super::ptr::put(out, v, what) }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
