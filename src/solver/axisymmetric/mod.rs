@@ -52,11 +52,11 @@ mod surfaces;
 mod workspace;
 
 pub use fields::TAYLOR_FIELDS;
+pub use setup::TaylorParams;
 
 use crate::isa::Isa;
 use crate::material::{Material, MaterialState};
 use crate::observe::FieldSpec;
-use crate::scene::taylor::TaylorParams;
 use crate::solver::COURANT;
 use crate::solver::boundary::{Stress, Surface};
 use workspace::Workspace;

@@ -1,5 +1,7 @@
-//! The setup of a Taylor run: the rod on its (R, Z) lattice at the instant
-//! of impact, of the material its parameters describe.
+//! The setup of a Taylor run: its parameters ([`TaylorParams`], which the
+//! solver keeps and saves with its state; their table, defaults and ranges
+//! are the `taylor` scene's), and the rod on its (R, Z) lattice at the
+//! instant of impact, of the material they describe.
 
 use super::TaylorSolver;
 use super::workspace::Workspace;
@@ -8,8 +10,42 @@ use crate::isa::Isa;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Material, MaterialState};
 use crate::run::check_derived;
-use crate::scene::taylor::TaylorParams;
 use crate::solver::boundary::Surface;
+use crate::solver::setup_struct;
+
+setup_struct! {
+    /// The parameters of a Taylor run that the solver keeps (SI units):
+    /// those of the `taylor` scene's table. A run of another material
+    /// choice takes its geometry, numerical parameters, density and initial
+    /// temperature from here and its material from the scene's material
+    /// block (`TaylorSolver::with_material`); the other material fields
+    /// then keep their defaults and are not used.
+    TaylorParams, with set {
+        impact_speed: "speed of the rod toward the anvil",
+        initial_length: "rod length L0",
+        initial_diameter: "rod diameter D0",
+        density: "reference mass density",
+        shear_modulus: "shear modulus mu",
+        bulk_modulus: "bulk modulus K of the linear EOS P = K(rho/rho0 - 1)",
+        specific_heat: "specific heat C",
+        taylor_quinney: "Taylor-Quinney coefficient: the fraction of plastic work that becomes heat",
+        jc_a: "Johnson-Cook a (initial yield stress)",
+        jc_b: "Johnson-Cook b (hardening modulus)",
+        jc_n: "Johnson-Cook n (hardening exponent)",
+        jc_c: "Johnson-Cook c (strain-rate sensitivity)",
+        jc_m: "Johnson-Cook m (thermal softening exponent)",
+        melt_temperature: "melting temperature T_M",
+        room_temperature: "room temperature T_room",
+        initial_temperature: "rod temperature at impact",
+        ref_strain_rate: "reference strain rate of Johnson-Cook",
+        particles_radial: "particles across the radius, axis and mantle included; axial spacing matches",
+        smoothing_ratio: "smoothing length h divided by the particle spacing",
+        smoothing_coefficient: "alpha_cs of the conservative smoothing (3.23)",
+        smoothing_order: "velocity and density smoothing: 1 = the paper's (3.23), 2 = its bi-Laplacian",
+        shifting: "particle shifting beta (0 = Lagrangian particles)",
+        end_time: "latest simulated time",
+    }
+}
 
 impl TaylorSolver {
     /// Sets up the rod at the instant of impact, of the material the
