@@ -57,6 +57,7 @@ pub use setup::TaylorParams;
 use crate::isa::Isa;
 use crate::material::{Material, MaterialState};
 use crate::observe::FieldSpec;
+use crate::run::QuietEnd;
 use crate::solver::COURANT;
 use crate::solver::boundary::{Stress, Surface};
 use workspace::Workspace;
@@ -118,10 +119,11 @@ pub struct TaylorSolver {
     smoothing_dissipation: f64,
     contact_dissipation: f64,
     at_rest: bool,
-    /// Time since which the kinetic energy has stayed at or below
-    /// [`QUIET_FRACTION`](crate::run::QUIET_FRACTION) of the impact energy (`None` while it is above).
+    /// The rest detector: the time since which the kinetic energy has
+    /// stayed at or below [`QUIET_FRACTION`](crate::run::QUIET_FRACTION) of
+    /// the impact energy (`None` while it is above).
     #[serde(default)]
-    quiet_since: Option<f64>,
+    quiet_since: QuietEnd,
     /// Smallest spacing seen between neighbours, relative to the initial one.
     min_spacing: f64,
     #[serde(skip)]

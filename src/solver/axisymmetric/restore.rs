@@ -101,7 +101,7 @@ impl TaylorSolver {
                 self.smoothing_dissipation,
                 self.contact_dissipation,
                 self.min_spacing,
-                self.quiet_since.unwrap_or(0.0),
+                self.quiet_since.since().unwrap_or(0.0),
             ],
         )?;
         // Finite is not enough: a velocity of 1e300 overflows the energies.

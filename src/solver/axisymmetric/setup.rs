@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Material, MaterialState};
-use crate::run::check_derived;
+use crate::run::{QuietEnd, check_derived};
 use crate::solver::boundary::Surface;
 use crate::solver::setup_struct;
 
@@ -146,7 +146,7 @@ impl TaylorSolver {
             smoothing_dissipation: 0.0,
             contact_dissipation: 0.0,
             at_rest: false,
-            quiet_since: None,
+            quiet_since: QuietEnd::default(),
             min_spacing: 1.0,
             ws: Workspace::default(),
             isa: Isa::best(),

@@ -14,10 +14,7 @@ use super::workspace::{BatchTally, Tally, Workspace};
 use super::{MIN_LEN, TaylorSolver};
 use crate::error::{Error, Result};
 use crate::lanes::W;
-use crate::run::{
-    ENERGY_ERROR_BOUND, QUIET_FRACTION, QUIET_TRANSITS, SPACING_COLLAPSE_BOUND, above, below,
-    check_time_step,
-};
+use crate::run::{ENERGY_ERROR_BOUND, SPACING_COLLAPSE_BOUND, above, below, check_time_step};
 use crate::solver::COURANT;
 use crate::solver::pairs::{PairInputs, Rows};
 use crate::solver::scheme::{MsphScheme, SmoothingOrder};
@@ -278,14 +275,12 @@ impl TaylorSolver {
         // leaves it, and the rod rings elastically on it for ever. Its impact
         // energy is spent once the kinetic energy has stayed below
         // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
-        if t.kinetic <= QUIET_FRACTION * self.initial_energy {
-            let since = *self.quiet_since.get_or_insert(self.time);
-            let window = QUIET_TRANSITS * self.p.initial_length / self.wave_speed();
-            if self.time - since >= window {
-                self.at_rest = true;
-            }
-        } else {
-            self.quiet_since = None;
+        let (length, speed) = (self.p.initial_length, self.wave_speed());
+        if self
+            .quiet_since
+            .at_rest(self.time, t.kinetic, self.initial_energy, length, speed)
+        {
+            self.at_rest = true;
         }
         Ok(())
     }
