@@ -1,9 +1,9 @@
 //! The run's guards and bounds, shared by every solver (the axisymmetric
 //! and radial MSPH solvers in [`crate::solver`], the 3-D MLPG solver in
 //! [`crate::mlpg`]): the named stops (energy drift, spacing collapse, time
-//! step collapse, NaN), the quiet end, the shifting bounds, and the checks
-//! of a restored run's clock and bounds. No solver imports these from
-//! another solver's file.
+//! step collapse, NaN), the quiet end and its detector ([`QuietEnd`]), the
+//! shifting bounds, and the checks of a restored run's clock and bounds. No
+//! solver imports these from another solver's file.
 
 /// Smallest distance between two neighbouring particles (every pair, mirror
 /// images included), relative to the initial spacing, below which a run
@@ -35,6 +35,52 @@ pub const QUIET_FRACTION: f64 = 0.01;
 /// of the rod's slowest (free-free) longitudinal mode, so the rod's own
 /// ringing cannot pass as rest.
 pub const QUIET_TRANSITS: f64 = 2.0;
+
+/// The quiet end of a run, the rest detector every solver of a rod on the
+/// anvil shares: the rod is at rest once its kinetic energy has stayed at
+/// or below [`QUIET_FRACTION`] of the impact energy for [`QUIET_TRANSITS`]
+/// elastic transits (a flange pressed flat on the anvil never leaves it,
+/// and the rod rings elastically on it for ever).
+///
+/// A solver keeps one as a field and saves it as the time since which the
+/// run has been quiet, or `null` (serde: the bare option, the format of the
+/// `quiet_since` field it replaces), and calls [`QuietEnd::at_rest`] at the
+/// end of each step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(transparent)]
+pub struct QuietEnd {
+    since: Option<f64>,
+}
+
+impl QuietEnd {
+    /// Whether the run is at rest at the end of a step at `time` with
+    /// `kinetic` energy, out of `initial_energy`: the window
+    /// `QUIET_TRANSITS * length / wave_speed` (the rod's length and
+    /// elastic wave speed) has passed since the kinetic energy last rose
+    /// above [`QUIET_FRACTION`] of the initial energy.
+    pub fn at_rest(
+        &mut self,
+        time: f64,
+        kinetic: f64,
+        initial_energy: f64,
+        length: f64,
+        wave_speed: f64,
+    ) -> bool {
+        if kinetic <= QUIET_FRACTION * initial_energy {
+            let since = *self.since.get_or_insert(time);
+            let window = QUIET_TRANSITS * length / wave_speed;
+            time - since >= window
+        } else {
+            self.since = None;
+            false
+        }
+    }
+
+    /// The time since which the run has been quiet, if it is.
+    pub fn since(&self) -> Option<f64> {
+        self.since
+    }
+}
 
 /// The smallest accepted step, as a fraction of the first step: below it the
 /// run stops with [`crate::Error::TimeStepCollapse`].
@@ -180,4 +226,41 @@ pub(crate) fn first_non_finite(fields: &[(&'static str, &[f64])]) -> Option<(&'s
     fields
         .iter()
         .find_map(|(name, v)| v.iter().position(|x| !x.is_finite()).map(|i| (*name, i)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A quiet end saves as the bare option it replaces, in JSON and in
+    /// postcard, and reads back.
+    #[test]
+    fn quiet_end_keeps_the_format_of_its_option() {
+        for since in [None, Some(1.25e-5)] {
+            let q = QuietEnd { since };
+            assert_eq!(json(&q), json(&since));
+            let bytes = postcard::to_allocvec(&q).unwrap();
+            assert_eq!(bytes, postcard::to_allocvec(&since).unwrap());
+            let back: QuietEnd = postcard::from_bytes(&bytes).unwrap();
+            assert_eq!(back, q);
+            let back: QuietEnd = serde_json::from_str(&json(&since)).unwrap();
+            assert_eq!(back, q);
+        }
+    }
+
+    /// At rest once quiet for the window, the clock of the window restarted
+    /// by a rise of the kinetic energy.
+    #[test]
+    fn quiet_end_waits_for_the_whole_window() {
+        // Window: QUIET_TRANSITS * 2 / 1 = 4 (s).
+        let at = |q: &mut QuietEnd, t: f64, ke: f64| q.at_rest(t, ke, 100.0, 2.0, 1.0);
+        let mut q = QuietEnd::default();
+        assert!(!at(&mut q, 1.0, 0.5));
+        assert_eq!(q.since(), Some(1.0));
+        assert!(!at(&mut q, 4.0, 0.5));
+        assert!(!at(&mut q, 4.5, 2.0));
+        assert_eq!(q.since(), None);
+        assert!(!at(&mut q, 5.0, 1.0));
+        assert!(at(&mut q, 9.0, 1.0));
+    }
 }

@@ -4,62 +4,6 @@
 
 pub use crate::params::{Level, ParamSpec, Range, concat, levels_spec, spec};
 
-/// Declares a parameter struct together with its table, `Default`, and
-/// name-based access, so that the three can never disagree.
-macro_rules! param_table {
-    (
-        $(#[$meta:meta])*
-        $name:ident, $specs:ident {
-            $( $field:ident : $unit:literal = $default:expr, $range:expr, $desc:literal; )*
-        }
-    ) => {
-        $(#[$meta])*
-        #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-        #[serde(deny_unknown_fields, default)]
-        pub struct $name {
-            $( #[doc = $desc] pub $field: f64, )*
-        }
-
-        /// The parameter table of this scene, in declaration order.
-        pub const $specs: &[$crate::params::ParamSpec] = &[
-            $( $crate::params::ParamSpec {
-                name: stringify!($field),
-                unit: $unit,
-                default: $default,
-                range: $range,
-                description: $desc,
-                levels: &[],
-            }, )*
-        ];
-
-        impl Default for $name {
-            fn default() -> Self {
-                Self { $( $field: $default, )* }
-            }
-        }
-
-        impl $name {
-            /// The parameters from one value per row of the table, in its
-            /// order (as [`crate::Scene::values`] holds them).
-            pub fn from_values(values: &[f64]) -> Self {
-                let mut v = values.iter().copied();
-                let p = Self { $( $field: v.next().expect("one value per row of the table"), )* };
-                debug_assert!(v.next().is_none(), "one value per row of the table");
-                p
-            }
-
-            /// Value of the parameter called `name`, if it exists.
-            pub fn get(&self, name: &str) -> Option<f64> {
-                match name {
-                    $( stringify!($field) => Some(self.$field), )*
-                    _ => None,
-                }
-            }
-        }
-    };
-}
-pub(crate) use param_table;
-
 /// Declares a parameter struct whose rows live in a table declared
 /// elsewhere (for example a scene table composed with a material block):
 /// `Default` takes each field's default from `$table`, and `get` and `set`

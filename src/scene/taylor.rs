@@ -12,12 +12,16 @@
 //! `TaylorImpactBilinearMieGruneisen`.
 
 use super::Scene;
-use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec, param_struct};
+use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec};
 use super::registry::{FmuIdentity, MaterialSlot, SceneRow, restore};
 use crate::budget::MemoryPerNode;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::observe::TAYLOR_OBSERVABLES;
 use crate::solver::axisymmetric::TaylorSolver;
+
+/// The parameters of a Taylor run, the solver's setup (defined with it);
+/// their defaults are this table's.
+pub use crate::solver::axisymmetric::TaylorParams;
 
 /// The registry row of the `taylor` scene.
 pub static ROW: SceneRow = SceneRow {
@@ -218,19 +222,16 @@ choice_tables! {
     TAYLOR_BILINEAR_MIE_GRUNEISEN_PARAMS,
 }
 
-param_struct! {
-    /// The parameters of a Taylor run that the solver keeps (SI units):
-    /// those of the `taylor` scene's table. A run of another material
-    /// choice takes its geometry, numerical parameters, density and initial
-    /// temperature from here and its material from the scene's material
-    /// block (`TaylorSolver::with_material`); the other material fields
-    /// then keep their defaults and are not used.
-    TaylorParams, TAYLOR_PARAMS, {
-        impact_speed, initial_length, initial_diameter, density, shear_modulus,
-        bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
-        melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
-        particles_radial, smoothing_ratio, smoothing_coefficient, smoothing_order,
-        shifting, end_time,
+impl Default for TaylorParams {
+    /// The defaults of the table.
+    fn default() -> Self {
+        TaylorParams::from_fn(|name| {
+            TAYLOR_PARAMS
+                .iter()
+                .find(|s| s.name == name)
+                .expect("every field is a row of the table")
+                .default
+        })
     }
 }
 

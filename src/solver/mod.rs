@@ -18,6 +18,68 @@ mod team;
 /// Courant number of eq. (3.22).
 pub const COURANT: f64 = 0.2;
 
+/// Declares the setup struct of a solver: its parameters as public `f64`
+/// fields, each with its description, saved with the solver's state
+/// (serde: unknown fields refused, missing ones at `Default`, which the
+/// scene that holds the parameter table implements from it), `get` by
+/// name, and `from_fn`, which takes each field from a function of its name;
+/// `with set` adds a public `set` by name.
+macro_rules! setup_struct {
+    (
+        $(#[$meta:meta])*
+        $name:ident {
+            $( $field:ident: $doc:literal, )*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[serde(deny_unknown_fields, default)]
+        pub struct $name {
+            $( #[doc = $doc] pub $field: f64, )*
+        }
+
+        impl $name {
+            /// Value of the parameter called `name`, if it exists.
+            pub fn get(&self, name: &str) -> Option<f64> {
+                match name {
+                    $( stringify!($field) => Some(self.$field), )*
+                    _ => None,
+                }
+            }
+
+            /// The parameters whose values `value` gives by name, taken
+            /// field by field in declaration order.
+            pub(crate) fn from_fn(mut value: impl FnMut(&str) -> f64) -> Self {
+                Self { $( $field: value(stringify!($field)), )* }
+            }
+        }
+    };
+    (
+        $(#[$meta:meta])*
+        $name:ident, with set {
+            $( $field:ident: $doc:literal, )*
+        }
+    ) => {
+        $crate::solver::setup_struct! {
+            $(#[$meta])*
+            $name {
+                $( $field: $doc, )*
+            }
+        }
+
+        impl $name {
+            /// Sets the parameter called `name`; whether it exists.
+            pub fn set(&mut self, name: &str, value: f64) -> bool {
+                match name {
+                    $( stringify!($field) => { self.$field = value; true } )*
+                    _ => false,
+                }
+            }
+        }
+    };
+}
+pub(crate) use setup_struct;
+
 /// Splits a CSR-aligned buffer into one mutable slice per particle so that
 /// rows can be filled in parallel.
 pub(crate) fn rows_mut<'a, T>(mut buf: &'a mut [T], offsets: &[usize]) -> Vec<&'a mut [T]> {

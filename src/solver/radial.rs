@@ -44,8 +44,31 @@ use crate::msph::{Msph1Rows, Row1};
 use crate::neighbors::{NeighborList, cell_list};
 use crate::observe::{FieldSpec, NOH_OBSERVABLES};
 use crate::run::{check_derived, check_time_step, first_non_finite};
-use crate::scene::noh::{NohParams, POST_SHOCK_WINDOW, PRE_SHOCK_WINDOW};
+use crate::solver::setup_struct;
 use rayon::prelude::*;
+
+/// Window `(r_min, r_max)` of `post_shock_density`.
+pub const POST_SHOCK_WINDOW: (f64, f64) = (0.1, 0.18);
+
+/// Window `(r_min, r_max)` of `pre_shock_density_l1`.
+pub const PRE_SHOCK_WINDOW: (f64, f64) = (0.25, 0.9);
+
+setup_struct! {
+    /// Parameters of the cylindrical Noh scene (dimensionless units of the
+    /// problem: initial density 1, inflow speed 1): the setup the solver
+    /// keeps and saves with its state; their table, defaults and ranges are
+    /// the `noh` scene's.
+    NohParams {
+        particles_radial: "particles along the radius, the one on the axis included",
+        outer_radius: "initial radius of the gas column; 1.5 keeps gas out to r = 0.9 at t = 0.6",
+        gamma: "ratio of specific heats of the ideal gas",
+        smoothing_ratio: "smoothing length h divided by the particle spacing",
+        smoothing_coefficient: "alpha_cs of the conservative smoothing (3.23)",
+        viscosity_quadratic: "c_q of the radial von Neumann-Richtmyer artificial viscosity",
+        viscosity_linear: "c_l of the radial artificial viscosity",
+        end_time: "simulated time at which the run ends",
+    }
+}
 
 /// Inner and outer radius of each shell: the midpoints to its neighbours,
 /// the axis for the first and its own radius for the last.

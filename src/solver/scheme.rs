@@ -5,7 +5,7 @@
 //! values in range is known to be unworkable (VALIDATION.md, "Right by
 //! default", the schemes and their mixtures measured).
 
-use crate::scene::taylor::TaylorParams;
+use crate::solver::axisymmetric::TaylorParams;
 
 /// The velocity and density smoothing's order (`smoothing_order`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -324,6 +324,52 @@ tuple_parts!(A, B, C, D, E);
 tuple_parts!(A, B, C, D, E, F);
 tuple_parts!(A, B, C, D, E, F, G);
 
+/// Declares a named set of arrays cut into chunks, and the named chunk of
+/// each that a pass gets: `$chunks` holds a [`Chunks`] per field, `$part` a
+/// `&mut [T]` per field, and `$chunks` is [`Parts`] with `Part = $part`
+/// (the named form of a tuple of [`Chunks`]). The unsafe code it writes is
+/// the tuples' own: each field's chunk under the caller's contract.
+macro_rules! named_parts {
+    (
+        $(#[$chunks_meta:meta])* $chunks:ident,
+        $(#[$part_meta:meta])* $part:ident {
+            $( $(#[$field_meta:meta])* $field:ident : $ty:ty ),+ $(,)?
+        }
+    ) => {
+        $(#[$chunks_meta])*
+        pub(super) struct $chunks<'a> {
+            $( $(#[$field_meta])* pub $field: $crate::solver::team::Chunks<'a, $ty>, )+
+        }
+
+        $(#[$part_meta])*
+        pub(super) struct $part<'a> {
+            $( $(#[$field_meta])* pub $field: &'a mut [$ty], )+
+        }
+
+        #[allow(unsafe_code)]
+        impl<'a> $crate::solver::team::Parts for $chunks<'a> {
+            type Part = $part<'a>;
+
+            fn count(&self) -> usize {
+                let counts = [$( $crate::solver::team::Parts::count(&self.$field), )+];
+                assert!(
+                    counts.iter().all(|&c| c == counts[0]),
+                    "arrays with different chunk counts"
+                );
+                counts[0]
+            }
+
+            unsafe fn part(&self, c: usize) -> $part<'a> {
+                // SAFETY: the caller's contract, for each member.
+                unsafe {
+                    $part { $( $field: $crate::solver::team::Parts::part(&self.$field, c), )+ }
+                }
+            }
+        }
+    };
+}
+pub(super) use named_parts;
+
 impl Team {
     /// Runs `job(c, chunk c of parts)` for every chunk of `parts` (see
     /// [`Team::run`]).

@@ -1,0 +1,112 @@
+//! What a Taylor run reports: its observables, its particle fields and the
+//! rod's particle sets.
+
+use super::{TaylorSolver, kinetic};
+use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
+use crate::rod::{self, RodSets};
+
+impl TaylorSolver {
+    fn kinetic_energy(&self) -> f64 {
+        kinetic(&self.vel, &self.mass)
+    }
+
+    fn energy_error(&self) -> f64 {
+        self.energy_error_with(self.kinetic_energy())
+    }
+
+    /// The energy error with the kinetic energy given (the update pass sums
+    /// it in chunks).
+    pub(super) fn energy_error_with(&self, kinetic: f64) -> f64 {
+        (kinetic + self.internal_energy + self.smoothing_dissipation + self.contact_dissipation
+            - self.initial_energy)
+            .abs()
+            / self.initial_energy
+    }
+
+    /// The centre-of-mass axial velocity toward the anvil.
+    pub fn centre_of_mass_speed(&self) -> f64 {
+        let (mut mv, mut m) = (0.0, 0.0);
+        for (v, mi) in self.vel.iter().zip(&self.mass) {
+            mv -= mi * v[1];
+            m += mi;
+        }
+        mv / m
+    }
+
+    /// The rod's particle sets: the face row, the mantle column from the
+    /// face up, and the tail on the axis.
+    pub fn rod_sets(&self) -> RodSets {
+        let (nr, nz) = (self.nr, self.nz);
+        RodSets {
+            face: self.face.particles.clone(),
+            mantle: (0..nz).map(|k| k * nr + nr - 1).collect(),
+            tail: (nz - 1) * nr,
+        }
+    }
+
+    /// Current values of [`TAYLOR_OBSERVABLES`], in that order.
+    pub fn observables(&self) -> Vec<f64> {
+        (0..TAYLOR_OBSERVABLES.len())
+            .map(|k| self.observable(k).expect("one value per row of the table"))
+            .collect()
+    }
+
+    /// The current value of the `k`-th of [`TAYLOR_OBSERVABLES`] alone
+    /// (`None` past the table): the rod's length and the largest plastic
+    /// strain and temperature take one pass over the particles, the
+    /// kinetic energy and the energy error one sum; the others read the
+    /// face, the mantle generator, the tail or a total kept by the step.
+    /// Nothing is allocated; the bits are those of
+    /// [`TaylorSolver::observables`].
+    pub fn observable(&self, k: usize) -> Option<f64> {
+        Some(match TAYLOR_OBSERVABLES.get(k)?.name {
+            "rod_length" => rod::rod_length(&self.pos),
+            "mushroom_radius" => rod::mushroom_radius(&self.face.particles, &self.pos),
+            "undeformed_length" => {
+                rod::undeformed_length(&self.mantle.particles, &self.pos, self.r0)
+            }
+            "tail_velocity" => rod::tail_velocity((self.nz - 1) * self.nr, &self.vel),
+            "face_lift" => self.pos[0][1],
+            "max_plastic_strain" => self.eps_p.iter().copied().fold(0.0, f64::max),
+            "max_temperature" => self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            "kinetic_energy" => self.kinetic_energy(),
+            "internal_energy" => self.internal_energy,
+            "smoothing_dissipation" => self.smoothing_dissipation,
+            "contact_dissipation" => self.contact_dissipation,
+            "energy_error" => self.energy_error(),
+            "at_rest" => {
+                if self.at_rest {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            other => unreachable!("the Taylor observable `{other}` has no formula"),
+        })
+    }
+
+    /// The values of the particle field `name` (one of [`TAYLOR_FIELDS`]),
+    /// interleaved per particle.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        Some(match name {
+            "position" => self.pos.iter().flatten().copied().collect(),
+            "density" => self.rho.clone(),
+            "velocity" => self.vel.iter().flatten().copied().collect(),
+            "pressure" => self.pressure.clone(),
+            "stress" => self
+                .dev
+                .iter()
+                .zip(&self.pressure)
+                .flat_map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3]])
+                .collect(),
+            "plastic_strain" => self.eps_p.clone(),
+            "temperature" => self.temp.clone(),
+            "in_contact" => self.contact.iter().map(|&c| c as u8 as f64).collect(),
+            _ => return None,
+        })
+    }
+}
+
+/// The particle fields of the Taylor solver.
+pub const TAYLOR_FIELDS: &[FieldSpec] =
+    &crate::observe::rod_fields(&["R", "Z"], &["RR", "ZZ", "TT", "RZ"]);

@@ -1,0 +1,61 @@
+//! The stress boundary conditions on the rod's surfaces: traction-free on
+//! the mantle, the top and the part of the impact face off the anvil, no
+//! shear on the anvil.
+
+use super::TaylorSolver;
+use crate::solver::boundary::{Surface, corner_free, traction_free};
+
+/// The outward normal of the top at the axis.
+pub(super) const TOP_ON_AXIS: [f64; 2] = [0.0, 1.0];
+/// The outward normal of the impact face at the axis.
+pub(super) const FACE_ON_AXIS: [f64; 2] = [0.0, -1.0];
+
+/// The outward normal at the `k`-th particle of a surface that starts on
+/// the axis (the top or the face): `on_axis` for the particle on the axis,
+/// where the surface is flat by symmetry, else [`Surface::normal`].
+pub(super) fn normal_from_axis(
+    s: &Surface,
+    k: usize,
+    pos: &[[f64; 2]],
+    on_axis: [f64; 2],
+) -> [f64; 2] {
+    if k == 0 { on_axis } else { s.normal(k, pos) }
+}
+
+impl TaylorSolver {
+    /// Stress used by the momentum equation: the traction-free and
+    /// smooth-contact conditions applied on the surfaces to the constitutive
+    /// stress `dev - p I` (which the update pass writes for every particle).
+    pub(super) fn apply_surface_stress_bc(&mut self) {
+        let n = self.particles();
+        let (nr, nz) = (self.nr, self.nz);
+        for (k, &i) in self.mantle.particles.iter().enumerate() {
+            let s = &self.stress_bc[i];
+            self.stress_bc[i] = if k == nz - 1 || (k == 0 && !self.contact[i]) {
+                corner_free(s)
+            } else {
+                traction_free(s, self.mantle.normal(k, &self.pos))
+            };
+        }
+        for (k, &i) in self.top.particles.iter().enumerate().take(nr - 1) {
+            let n = normal_from_axis(&self.top, k, &self.pos, TOP_ON_AXIS);
+            self.stress_bc[i] = traction_free(&self.stress_bc[i], n);
+        }
+        for (k, &i) in self.face.particles.iter().enumerate().take(nr - 1) {
+            if self.contact[i] {
+                // Smooth anvil: no shear traction.
+                self.stress_bc[i][3] = 0.0;
+            } else {
+                let n = normal_from_axis(&self.face, k, &self.pos, FACE_ON_AXIS);
+                self.stress_bc[i] = traction_free(&self.stress_bc[i], n);
+            }
+        }
+        // Particles that started elsewhere but touch the anvil (a folded
+        // mantle) carry no shear there either.
+        for i in 0..n {
+            if self.contact[i] && i >= self.nr {
+                self.stress_bc[i][3] = 0.0;
+            }
+        }
+    }
+}
