@@ -106,8 +106,8 @@ use crate::material::{Loading, Material, MaterialState, Point};
 use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
 use crate::rod::{RodObservables, radius};
 use crate::run::{
-    ENERGY_ERROR_BOUND, QUIET_FRACTION, QUIET_TRANSITS, SHIFT_CAP, SHIFT_RANGE,
-    SPACING_COLLAPSE_BOUND, above, below, check_derived, check_time_step,
+    ENERGY_ERROR_BOUND, QuietEnd, SHIFT_CAP, SHIFT_RANGE, SPACING_COLLAPSE_BOUND, above, below,
+    check_derived, check_time_step,
 };
 use geometry::Geometry;
 pub use observe::{Energies, MLPG_FIELDS};
@@ -211,7 +211,9 @@ pub struct Mlpg3d {
     smoothing_dissipation: f64,
     rebuilds: u64,
     at_rest: bool,
-    quiet_since: Option<f64>,
+    /// The quiet end (saved as the time since which the run has been
+    /// quiet).
+    quiet_since: QuietEnd,
     /// Time of the last release of a node from the anvil.
     last_release: f64,
     /// Wall time per phase of this process's steps (not saved).
@@ -373,7 +375,7 @@ impl Mlpg3d {
             smoothing_dissipation: 0.0,
             rebuilds: 0,
             at_rest: false,
-            quiet_since: None,
+            quiet_since: QuietEnd::default(),
             last_release: 0.0,
             profile: PhaseTimes::default(),
             scratch: Scratch::default(),

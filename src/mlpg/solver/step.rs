@@ -199,7 +199,7 @@ impl Mlpg3d {
     /// Step 6: the checks of the step (non-finite positions, energy drift),
     /// the next step (eq. 15) and its floor, and the end of a Taylor run:
     /// the rod has left the anvil, or it has been quiet for
-    /// [`QUIET_TRANSITS`] transits.
+    /// [`crate::run::QUIET_TRANSITS`] transits ([`QuietEnd`]).
     fn end_step(&mut self, t: &Tally, d_min: f64) -> Result<()> {
         if let Some(i) = self
             .pos
@@ -226,16 +226,17 @@ impl Mlpg3d {
         if self.anvil && -t.momentum / t.mass <= 0.0 && !touching {
             self.at_rest = true;
         }
-        if !self.anvil {
-            // A run of several bodies ends at its end time.
-        } else if t.kinetic <= QUIET_FRACTION * self.initial_energy {
-            let since = *self.quiet_since.get_or_insert(self.time);
-            let window = QUIET_TRANSITS * self.setup.cylinder.length / self.wave_speed();
-            if self.time - since >= window {
-                self.at_rest = true;
-            }
-        } else {
-            self.quiet_since = None;
+        // A run of several bodies (no anvil) ends at its end time.
+        if self.anvil
+            && self.quiet_since.at_rest(
+                self.time,
+                t.kinetic,
+                self.initial_energy,
+                self.setup.cylinder.length,
+                self.wave_speed(),
+            )
+        {
+            self.at_rest = true;
         }
         Ok(())
     }
