@@ -69,8 +69,12 @@
 #![allow(clippy::needless_range_loop)]
 
 mod budget;
-// The C ABI, the FMI glue and the pointer and panic helpers they share are
-// the only places with unsafe code.
+// Unsafe code is allowed in these places only: the C ABI, the FMI glue and
+// the pointer and panic helpers they share (here), the dispatch to the
+// compiled copies of the hot loops (`hot!` in src/isa.rs), the team of
+// threads sharing disjoint chunks of the axisymmetric step's arrays
+// (src/solver/team.rs, and the chunk sets `named_parts!` declares) and the
+// AVX-512 kernels of its pair pass (src/solver/pairs/avx512.rs).
 #[allow(unsafe_code)]
 mod capi;
 mod error;
@@ -85,7 +89,7 @@ mod material;
 mod mlpg;
 mod model;
 mod msph;
-mod neighbors;
+mod neighbours;
 mod observe;
 mod params;
 mod rod;
@@ -170,7 +174,7 @@ pub mod internals {
     pub use crate::kernel::kernel2;
     pub use crate::lanes::W;
     pub use crate::msph::{Neighbourhood, Row2};
-    pub use crate::neighbors::{cell_list, naive, padded_rows};
+    pub use crate::neighbours::{cell_list, naive, padded_rows};
     pub use crate::run::SPACING_COLLAPSE_BOUND;
     pub use crate::scene::reference;
     pub use crate::solver::axisymmetric::TaylorSolver;

@@ -597,7 +597,7 @@ impl<const K: usize> Msph2Rows<K> {
     /// `pos` are the (R, Z) positions, `vol` the weights `m_j / rho_j`.
     pub fn new(
         i: usize,
-        neighbors: &[usize],
+        neighbours: &[usize],
         pos: &[[f64; 2]],
         vol: &[f64],
         h: f64,
@@ -606,7 +606,7 @@ impl<const K: usize> Msph2Rows<K> {
         let xi = pos[i];
         let inv_h = 1.0 / h;
         let mut b = Moments2::default();
-        for &j in neighbors {
+        for &j in neighbours {
             let sr = (pos[j][0] - xi[0]) * inv_h;
             let sz = (pos[j][1] - xi[1]) * inv_h;
             if let Some(phi) = phi2(sr, sz) {
@@ -739,7 +739,7 @@ impl<const K: usize> Msph1Rows<K> {
     /// Solves the 3x3 MSPH system (f, f_R, f_RR) of particle `i` on a line.
     pub fn new(
         i: usize,
-        neighbors: &[usize],
+        neighbours: &[usize],
         pos: &[f64],
         vol: &[f64],
         h: f64,
@@ -748,7 +748,7 @@ impl<const K: usize> Msph1Rows<K> {
         let xi = pos[i];
         let inv_h = 1.0 / h;
         let mut b = [[0.0; 3]; 3];
-        for &j in neighbors {
+        for &j in neighbours {
             let s = (pos[j] - xi) * inv_h;
             let Some(phi) = phi1(s) else { continue };
             let th = [1.0, s, 0.5 * s * s];
@@ -787,7 +787,7 @@ impl<const K: usize> Msph1Rows<K> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::neighbors::cell_list;
+    use crate::neighbours::cell_list;
 
     /// A jittered lattice of ring particles in a rectangle touching the axis,
     /// with ring volumes as weights.

@@ -82,6 +82,33 @@ impl QuietEnd {
     }
 }
 
+/// The clock's getters of a solver, `time()` (s) and `steps()`, and with
+/// `dt` also `dt()` (s), over its fields of those names: written once for
+/// every solver (the fields stay in each solver's struct, flat in its saved
+/// state).
+macro_rules! clock_getters {
+    () => {
+        /// Simulated time (s).
+        pub fn time(&self) -> f64 {
+            self.time
+        }
+
+        /// Steps taken.
+        pub fn steps(&self) -> u64 {
+            self.steps
+        }
+    };
+    (dt) => {
+        $crate::run::clock_getters!();
+
+        /// Current time step (s).
+        pub fn dt(&self) -> f64 {
+            self.dt
+        }
+    };
+}
+pub(crate) use clock_getters;
+
 /// The smallest accepted step, as a fraction of the first step: below it the
 /// run stops with [`crate::Error::TimeStepCollapse`].
 pub const MIN_DT_FRACTION: f64 = 1e-4;

@@ -219,10 +219,7 @@ impl PlateImpact {
         self.time >= self.end_time
     }
 
-    /// Steps taken.
-    pub fn steps(&self) -> u64 {
-        self.steps
-    }
+    crate::run::clock_getters!();
 
     /// The end time (s), infinite if none was set.
     pub fn end_time(&self) -> f64 {
@@ -254,11 +251,6 @@ impl PlateImpact {
     /// The target's current free-surface velocity (m/s).
     pub fn free_surface_velocity(&self) -> f64 {
         *self.v.last().expect("nodes")
-    }
-
-    /// Simulated time (s).
-    pub fn time(&self) -> f64 {
-        self.time
     }
 
     /// The target's free-surface velocity history `(t, u)`, one entry per

@@ -26,7 +26,7 @@
 //! 4.79 µs, two pulverized nodes of the plate's top surface 0.16 mm apart,
 //! and runs to 6.56 µs with these contacts).
 
-use crate::neighbors::cell_list;
+use crate::neighbours::cell_list;
 
 /// The pairs `(i, j)`, `i < j`, of nodes of different bodies (`group`)
 /// closer than `reach`, in ascending order, written into `out`. Only the

@@ -57,7 +57,7 @@
 
 use crate::isa::{Isa, hot};
 use crate::msph::{MAX_CONDITION, invert};
-use crate::neighbors::{NeighborList, cell_list_first};
+use crate::neighbours::{NeighbourList, cell_list_first};
 use crate::{Error, Result};
 use rayon::prelude::*;
 

@@ -18,8 +18,8 @@ use crate::msph::{
 };
 use std::sync::{Mutex, MutexGuard};
 
-// AVX-512 versions of parts of the pair pass, chosen at run time; the only
-// unsafe code outside the C and FMI layers (vector loads, gathers, stores).
+// AVX-512 versions of parts of the pair pass, chosen at run time (vector
+// loads, gathers, stores; src/lib.rs lists every place with unsafe code).
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx512;
@@ -542,7 +542,7 @@ mod tests {
 #[cfg(all(test, target_arch = "x86_64"))]
 mod avx512_tests {
     use super::*;
-    use crate::neighbors::cell_list_first;
+    use crate::neighbours::cell_list_first;
 
     /// A pseudo-random number in [0, 1) from a linear congruential step.
     fn uniform(seed: &mut u64) -> f64 {

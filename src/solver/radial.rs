@@ -41,7 +41,7 @@ use crate::error::{Error, Result};
 use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
 use crate::msph::{Msph1Rows, Row1};
-use crate::neighbors::{NeighborList, cell_list};
+use crate::neighbours::{NeighbourList, cell_list};
 use crate::observe::{FieldSpec, NOH_OBSERVABLES};
 use crate::run::{check_derived, check_time_step, first_non_finite};
 use crate::solver::setup_struct;
@@ -228,15 +228,7 @@ impl NohSolver {
         Ok(())
     }
 
-    /// Simulated time.
-    pub fn time(&self) -> f64 {
-        self.time
-    }
-
-    /// Steps taken.
-    pub fn steps(&self) -> u64 {
-        self.steps
-    }
+    crate::run::clock_getters!();
 
     /// Whether `end_time` has been reached.
     pub fn finished(&self) -> bool {
@@ -269,7 +261,7 @@ impl NohSolver {
     }
 
     /// MSPH first-derivative weights of every neighbour pair (CSR order).
-    fn pair_weights(&self, nl: &NeighborList, r: &[f64], vol: &[f64]) -> Result<Vec<f64>> {
+    fn pair_weights(&self, nl: &NeighbourList, r: &[f64], vol: &[f64]) -> Result<Vec<f64>> {
         let n = self.particles();
         let mut w = vec![0.0; nl.indices.len()];
         let rows = rows_mut(&mut w, &nl.offsets);

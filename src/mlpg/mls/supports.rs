@@ -55,7 +55,7 @@ pub struct Supports {
     /// Support radius `r_J` of each node (m).
     pub radius: Vec<f64>,
     /// The `k` nearest other nodes named by each node, nearest first.
-    pub named: NeighborList,
+    pub named: NeighbourList,
     /// Distance of each named pair when the supports were computed.
     pub named_distance: Vec<f64>,
     /// The parameters used.
@@ -187,7 +187,7 @@ impl Supports {
             .collect();
         let mut radius: Vec<f64> = named_rows.iter().map(|r| r[k - 1].0).collect();
         radius.resize(points.len(), 0.0);
-        let mut named = NeighborList {
+        let mut named = NeighbourList {
             offsets: Vec::with_capacity(rows + 1),
             indices: Vec::with_capacity(rows * k),
         };
@@ -345,13 +345,13 @@ pub fn candidates_first(
     rows: usize,
     supports: &Supports,
     reach: f64,
-) -> NeighborList {
+) -> NeighbourList {
     let list = cell_list_first(points, rows, reach + supports.max_radius());
     let g = &supports.group;
     if g.is_empty() {
         return list;
     }
-    let mut out = NeighborList {
+    let mut out = NeighbourList {
         offsets: Vec::with_capacity(list.offsets.len()),
         indices: Vec::with_capacity(list.indices.len()),
     };

@@ -10,20 +10,7 @@ impl Mlpg3d {
         self.pos.len()
     }
 
-    /// Simulated time (s).
-    pub fn time(&self) -> f64 {
-        self.time
-    }
-
-    /// Steps taken.
-    pub fn steps(&self) -> u64 {
-        self.steps
-    }
-
-    /// Current time step (s).
-    pub fn dt(&self) -> f64 {
-        self.dt
-    }
+    crate::run::clock_getters!(dt);
 
     /// Builds of the operator so far (the first included).
     pub fn rebuilds(&self) -> u64 {

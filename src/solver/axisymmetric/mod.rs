@@ -177,20 +177,7 @@ impl TaylorSolver {
         self.h
     }
 
-    /// Simulated time.
-    pub fn time(&self) -> f64 {
-        self.time
-    }
-
-    /// Steps taken.
-    pub fn steps(&self) -> u64 {
-        self.steps
-    }
-
-    /// Current time step.
-    pub fn dt(&self) -> f64 {
-        self.dt
-    }
+    crate::run::clock_getters!(dt);
 
     /// Whether the end condition holds: the rod is at rest, or `end_time` has
     /// been reached.

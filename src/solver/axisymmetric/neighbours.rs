@@ -7,7 +7,7 @@ use super::workspace::{BatchTally, KineticChange, Tally, Workspace};
 use super::{MIN_LEN, SKIN, TaylorSolver};
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
-use crate::neighbors::padded_rows;
+use crate::neighbours::padded_rows;
 use crate::run::SPACING_COLLAPSE_BOUND;
 use crate::solver::pairs::PairPass;
 use crate::solver::scheme::{MsphScheme, SmoothingOrder};

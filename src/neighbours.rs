@@ -13,14 +13,14 @@ use rayon::prelude::*;
 /// A compressed-row neighbour list: the neighbours of particle `i` are
 /// `indices[offsets[i]..offsets[i + 1]]`, sorted ascending.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct NeighborList {
+pub struct NeighbourList {
     /// Row offsets, `len = n + 1`.
     pub offsets: Vec<usize>,
     /// Neighbour indices.
     pub indices: Vec<usize>,
 }
 
-impl NeighborList {
+impl NeighbourList {
     /// Neighbours of particle `i`.
     #[inline]
     pub fn of(&self, i: usize) -> &[usize] {
@@ -40,7 +40,7 @@ impl NeighborList {
 
 /// Naive O(N^2) search: all `j` with `|x_i - x_j| <= radius`. Used as the
 /// oracle in tests.
-pub fn naive<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighborList {
+pub fn naive<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighbourList {
     let r2 = radius * radius;
     let mut offsets = Vec::with_capacity(points.len() + 1);
     let mut indices = Vec::new();
@@ -53,7 +53,7 @@ pub fn naive<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighborList {
         }
         offsets.push(indices.len());
     }
-    NeighborList { offsets, indices }
+    NeighbourList { offsets, indices }
 }
 
 /// Squared distance, summed over the axes in order.
@@ -70,7 +70,7 @@ fn dist2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
 /// Cell-list search with cells of side `radius`: all `j` with
 /// `|x_i - x_j| <= radius`. Queries run in parallel; the result equals
 /// [`naive`] exactly.
-pub fn cell_list<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighborList {
+pub fn cell_list<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighbourList {
     cell_list_first(points, points.len(), radius)
 }
 
@@ -81,9 +81,9 @@ pub fn cell_list_first<const D: usize>(
     points: &[[f64; D]],
     rows: usize,
     radius: f64,
-) -> NeighborList {
+) -> NeighbourList {
     let Some(cells) = Cells::new(points, radius) else {
-        return NeighborList {
+        return NeighbourList {
             offsets: vec![0],
             indices: vec![],
         };
@@ -105,7 +105,7 @@ pub fn cell_list_first<const D: usize>(
         indices.extend_from_slice(&row);
         offsets.push(indices.len());
     }
-    NeighborList { offsets, indices }
+    NeighbourList { offsets, indices }
 }
 
 /// The neighbour lists of `cell_list_first` written straight into rows of
