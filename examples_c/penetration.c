@@ -15,19 +15,6 @@
 #include "util.h"
 #include <math.h>
 
-/* The field `name` in a malloc'ed array (caller frees); its length in *n. */
-static double *field(mi_sim *sim, const char *name, size_t *n) {
-    double *v;
-    check(sim, mi_sim_field(sim, name, NULL, 0, n), name); /* size query */
-    v = (double *)malloc(*n * sizeof *v);
-    if (v == NULL) {
-        mi_sim_free(sim);
-        exit(1);
-    }
-    check(sim, mi_sim_field(sim, name, v, *n, NULL), name);
-    return v;
-}
-
 int main(int argc, char **argv) {
     mi_sim *sim = NULL;
     size_t particles = 0, nb = 0, nm = 0, nv = 0, k, nodes[2] = {0, 0};
@@ -48,9 +35,9 @@ int main(int argc, char **argv) {
     check(sim, mi_sim_particle_count(sim, &particles), "mi_sim_particle_count");
     printf("nodes = %zu\n", particles);
 
-    body = field(sim, "body", &nb);
-    m = field(sim, "mass", &nm);
-    v = field(sim, "velocity", &nv); /* x, y, z per node */
+    body = read_field(sim, "body", &nb);
+    m = read_field(sim, "mass", &nm);
+    v = read_field(sim, "velocity", &nv); /* x, y, z per node */
     if (nb != particles || nm != particles || nv != 3 * particles) {
         fprintf(stderr, "field lengths %zu, %zu, %zu for %zu nodes\n", nb, nm, nv, particles);
         status = 1;

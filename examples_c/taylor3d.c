@@ -13,19 +13,6 @@
 #include <math.h>
 #include <string.h>
 
-/* The field `name` in a malloc'ed array (caller frees); its length in *n. */
-static double *field(mi_sim *sim, const char *name, size_t *n) {
-    double *v;
-    check(sim, mi_sim_field(sim, name, NULL, 0, n), name); /* size query */
-    v = (double *)malloc(*n * sizeof *v);
-    if (v == NULL) {
-        mi_sim_free(sim);
-        exit(1);
-    }
-    check(sim, mi_sim_field(sim, name, v, *n, NULL), name);
-    return v;
-}
-
 int main(int argc, char **argv) {
     mi_sim *sim = NULL;
     size_t particles = 0, fields = 0, k, np = 0, ns = 0, nq = 0;
@@ -66,9 +53,9 @@ int main(int argc, char **argv) {
         return 1;
     }
 
-    pos = field(sim, "position", &np);
-    stress = field(sim, "stress", &ns);
-    pressure = field(sim, "pressure", &nq);
+    pos = read_field(sim, "position", &np);
+    stress = read_field(sim, "stress", &ns);
+    pressure = read_field(sim, "pressure", &nq);
     printf("position_values = %zu\n", np);
     printf("stress_values = %zu\n", ns);
     for (k = 0; k < particles && 3 * k + 2 < np && 6 * k + 5 < ns && k < nq; ++k) {

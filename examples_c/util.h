@@ -31,6 +31,19 @@ static inline void check(mi_sim *sim, mi_result r, const char *what) {
     exit(1);
 }
 
+/* The field `name` in a malloc'ed array (caller frees); its length in *n. */
+static inline double *read_field(mi_sim *sim, const char *name, size_t *n) {
+    double *v;
+    check(sim, mi_sim_field(sim, name, NULL, 0, n), name); /* size query */
+    v = (double *)malloc(*n * sizeof *v);
+    if (v == NULL) {
+        mi_sim_free(sim);
+        exit(1);
+    }
+    check(sim, mi_sim_field(sim, name, v, *n, NULL), name);
+    return v;
+}
+
 /* Applies NAME=VALUE arguments as parameters. */
 static inline void apply_settings(mi_sim *sim, int argc, char **argv) {
     int i;

@@ -100,21 +100,21 @@ pub unsafe extern "C" fn mi_sim_observable_info(
     index: usize,
     info: *mut mi_observable_info,
 ) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(info, "info")?;
-        let specs = s.kind().observable_specs();
-        let (Some(o), Some(names)) = (specs.get(index), s.meta.observables.get(index)) else {
-            return Err(index_error("observable", index, specs.len()));
-        };
-        let v = mi_observable_info {
-            name: names[0].as_ptr(),
-            unit: names[1].as_ptr(),
-            description: names[2].as_ptr(),
-            is_bool: o.is_bool(),
-        };
-        // SAFETY: forwarded contract on `info`.
-        unsafe { put(info, v, "info") }
-    })
+    // SAFETY: forwarded contract on `info`.
+    unsafe {
+        get_into(sim, info, "info", |s| {
+            let specs = s.kind().observable_specs();
+            let (Some(o), Some(names)) = (specs.get(index), s.meta.observables.get(index)) else {
+                return Err(index_error("observable", index, specs.len()));
+            };
+            Ok(mi_observable_info {
+                name: names[0].as_ptr(),
+                unit: names[1].as_ptr(),
+                description: names[2].as_ptr(),
+                is_bool: o.is_bool(),
+            })
+        })
+    }
 }
 
 fn observable_index(s: &mi_sim, name: &str) -> Result<usize, Fail> {
@@ -299,21 +299,21 @@ pub unsafe extern "C" fn mi_sim_field_info(
     index: usize,
     info: *mut mi_field_info,
 ) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(info, "info")?;
-        let fields = field_meta(s)?;
-        let Some(f) = fields.get(index) else {
-            return Err(index_error("field", index, fields.len()));
-        };
-        let v = mi_field_info {
-            name: f.name.as_ptr(),
-            unit: f.unit.as_ptr(),
-            components: f.components.len(),
-            component_names: f.component_ptrs.as_ptr(),
-        };
-        // SAFETY: forwarded contract on `info`.
-        unsafe { put(info, v, "info") }
-    })
+    // SAFETY: forwarded contract on `info`.
+    unsafe {
+        get_into(sim, info, "info", |s| {
+            let fields = field_meta(s)?;
+            let Some(f) = fields.get(index) else {
+                return Err(index_error("field", index, fields.len()));
+            };
+            Ok(mi_field_info {
+                name: f.name.as_ptr(),
+                unit: f.unit.as_ptr(),
+                components: f.components.len(),
+                component_names: f.component_ptrs.as_ptr(),
+            })
+        })
+    }
 }
 
 /// Copies the current values of the particle field `name` by the buffer

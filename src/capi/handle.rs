@@ -509,26 +509,26 @@ pub unsafe extern "C" fn mi_sim_param_info(
     index: usize,
     info: *mut mi_param_info,
 ) -> mi_result {
-    with_sim(sim, |s| {
-        need_out(info, "info")?;
-        let specs = s.kind().param_specs();
-        let (Some(p), Some(names)) = (specs.get(index), s.meta.params.get(index)) else {
-            return Err(index_error("parameter", index, specs.len()));
-        };
-        let v = mi_param_info {
-            name: names[0].as_ptr(),
-            unit: names[1].as_ptr(),
-            description: names[2].as_ptr(),
-            default_value: p.default,
-            min: p.range.min,
-            max: p.range.max,
-            min_inclusive: p.range.min_inclusive,
-            max_inclusive: p.range.max_inclusive,
-            integer: p.range.integer,
-        };
-        // SAFETY: forwarded contract on `info`.
-        unsafe { put(info, v, "info") }
-    })
+    // SAFETY: forwarded contract on `info`.
+    unsafe {
+        get_into(sim, info, "info", |s| {
+            let specs = s.kind().param_specs();
+            let (Some(p), Some(names)) = (specs.get(index), s.meta.params.get(index)) else {
+                return Err(index_error("parameter", index, specs.len()));
+            };
+            Ok(mi_param_info {
+                name: names[0].as_ptr(),
+                unit: names[1].as_ptr(),
+                description: names[2].as_ptr(),
+                default_value: p.default,
+                min: p.range.min,
+                max: p.range.max,
+                min_inclusive: p.range.min_inclusive,
+                max_inclusive: p.range.max_inclusive,
+                integer: p.range.integer,
+            })
+        })
+    }
 }
 
 pub(crate) fn index_error(what: &str, index: usize, count: usize) -> Fail {

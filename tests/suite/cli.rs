@@ -551,24 +551,32 @@ fn material_choice_on_the_command_line() {
 /// shortest end time allowed finishes in one step.
 #[test]
 fn a_penetration_end_time_of_1e_300_is_refused_and_1_ns_finishes() {
+    let v = refused_then_run(
+        &["--set", "plate_diameter=0.02", "--set", "end_time=1e-300"],
+        &["`end_time` = 1e-300", "out of range"],
+        &["--set", "plate_diameter=0.02", "--set", "end_time=1e-9"],
+    );
+    assert_eq!(v["steps"], 1);
+    assert!(v["energy_error"].as_f64().unwrap().is_finite(), "{v}");
+}
+
+/// `penetration` at 3 across: with the settings `refused` the program fails
+/// with an error naming `needle`; with `accepted` it finishes. Returns the
+/// accepted run's JSON.
+fn refused_then_run(refused: &[&str], needle: &[&str], accepted: &[&str]) -> serde_json::Value {
     let base = ["run", "penetration", "-q", "--set", "particles_radial=3"];
+    let out = bin().args(base).args(refused).output().unwrap();
+    assert_error(&out, needle);
     let out = bin()
         .args(base)
-        .args(["--set", "plate_diameter=0.02", "--set", "end_time=1e-300"])
-        .output()
-        .unwrap();
-    assert_error(&out, &["`end_time` = 1e-300", "out of range"]);
-    let out = bin()
-        .args(base)
-        .args(["--set", "plate_diameter=0.02", "--set", "end_time=1e-9"])
+        .args(accepted)
         .args(["--json", "/dev/stdout"])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["outcome"], "finished");
-    assert_eq!(v["steps"], 1);
-    assert!(v["energy_error"].as_f64().unwrap().is_finite(), "{v}");
+    v
 }
 
 /// Issue 48, failure 2: `taylor3d` at 60 nodes across (6.3 million nodes)
@@ -650,22 +658,11 @@ fn a_fast_soft_projectile_meets_the_plate() {
 /// scenes' does; the slowest shot allowed has a finite energy error.
 #[test]
 fn a_subnormal_impact_speed_is_refused_and_the_slowest_has_a_finite_energy_error() {
-    let base = ["run", "penetration", "-q", "--set", "particles_radial=3"];
-    let out = bin()
-        .args(base)
-        .args(["--set", "impact_speed=5e-324"])
-        .output()
-        .unwrap();
-    assert_error(&out, &["`impact_speed` = 5e-324", "out of range"]);
-    let out = bin()
-        .args(base)
-        .args(["--set", "impact_speed=0.01", "--set", "end_time=3e-7"])
-        .args(["--json", "/dev/stdout"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", stderr(&out));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["outcome"], "finished");
+    let v = refused_then_run(
+        &["--set", "impact_speed=5e-324"],
+        &["`impact_speed` = 5e-324", "out of range"],
+        &["--set", "impact_speed=0.01", "--set", "end_time=3e-7"],
+    );
     assert!(v["energy_error"].as_f64().unwrap().is_finite(), "{v}");
 }
 
