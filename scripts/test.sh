@@ -38,7 +38,9 @@ if grep -qw avx512f /proc/cpuinfo 2>/dev/null && grep -qw avx512vl /proc/cpuinfo
 fi
 # The fuzzer runs for a fixed time (MI_FUZZ_SECONDS, default 60) on about
 # one core: it runs below beside the C and FMU steps, not here.
-cargo test --profile ci --all-targets -- --skip fuzz_the_boundaries
+# (the benchmarks' harness, criterion's, takes no `--skip`: they run apart).
+cargo test --profile ci --lib --bins --tests --examples -- --skip fuzz_the_boundaries
+cargo test --profile ci --benches
 cargo test --profile ci --doc
 fuzz_bin=$(cargo test --profile ci --test fuzz --no-run --message-format=json |
   python3 -c 'import json, sys
