@@ -40,7 +40,7 @@ fi
 # one core: it runs below beside the C and FMU steps, not here.
 # (the benchmarks' harness, criterion's, takes no `--skip`: they run apart).
 cargo test --profile ci --lib --bins --tests --examples -- --skip fuzz_the_boundaries
-cargo test --profile ci --benches
+cargo test --profile ci --bench '*'
 cargo test --profile ci --doc
 fuzz_bin=$(cargo test --profile ci --test fuzz --no-run --message-format=json |
   python3 -c 'import json, sys
@@ -57,7 +57,7 @@ trap 'kill $fuzz_pid 2>/dev/null || true' EXIT
 # release optimisation without LTO: the same code, built once; what ships is
 # built with `release`).
 export MI_PROFILE=ci
-# ... and with the tests' features (`--tests`), so that the library the tests
+# ... and with the tests' features (`--lib --bins --tests`), so that the library the tests
 # built is reused rather than compiled once more for the features of a plain
 # `cargo build` (the dev-dependencies turn on features of `either`,
 # `num-traits` and the host `syn`: 57 s on two cores).

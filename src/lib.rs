@@ -113,6 +113,7 @@ pub use params::{Level, ParamSpec, Range};
 pub use rod::{profile_deviation, profile_radius};
 pub use run::ENERGY_ERROR_BOUND;
 pub use scene::noh::NohParams;
+pub use scene::reference;
 pub use scene::table1::Table1Row;
 pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
@@ -159,7 +160,7 @@ pub mod internals {
     pub mod mlpg {
         pub use crate::mlpg::mls::distance;
         pub use crate::mlpg::nodal::NodalOperator;
-        pub use crate::mlpg::penetration::{Penetration, PenetrationSetup, damaged_threshold};
+        pub use crate::mlpg::penetration::{Penetration, PenetrationSetup};
         pub use crate::mlpg::solver::{SMOOTHING, WeakForm};
         pub use crate::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
         pub use crate::mlpg::step::{
@@ -176,7 +177,6 @@ pub mod internals {
     pub use crate::msph::{Neighbourhood, Row2};
     pub use crate::neighbours::{cell_list, naive, padded_rows};
     pub use crate::run::SPACING_COLLAPSE_BOUND;
-    pub use crate::scene::reference;
     pub use crate::solver::axisymmetric::TaylorSolver;
 }
 

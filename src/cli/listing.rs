@@ -9,7 +9,7 @@ use std::io::Write;
 /// `meshless-impact params`: the parameter table of a scene, or with
 /// `markdown` its reference page (`docs/reference/SCENE.md`).
 pub(crate) fn params(scene: &str, material: &ChoiceArgs, markdown: bool) -> Result<(), Stop> {
-    use meshless_impact::internals::reference;
+    use meshless_impact::reference;
     let mut s = Scene::builtin(scene)?;
     material.apply(&mut s)?;
     if markdown {

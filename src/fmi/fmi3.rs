@@ -239,7 +239,7 @@ values_of_type! {
 /// empty list in a state that allows the getters (setters), otherwise an
 /// error.
 macro_rules! no_variables_of_type {
-    ($( $fname:ident, $t:ty, $ptr:ident, $mask:ident; )*) => {$(
+    ($( $fname:ident, $mask:ident, ($($arg:ident: $t:ty),*); )*) => {$(
         #[doc = concat!("`", stringify!($fname), "`: this FMU has no variables of this type.")]
         ///
         /// # Safety
@@ -249,8 +249,7 @@ macro_rules! no_variables_of_type {
             instance: Instance3,
             vrs: *const Vr,
             nvr: usize,
-            _values: *$ptr $t,
-            _n_values: usize,
+            $($arg: $t),*
         ) -> Fmi3Status {
             // SAFETY: FMI 3.0 contract.
             unsafe { no_such_type(instance, stringify!($fname), mask::$mask, vrs, nvr) }
@@ -283,86 +282,26 @@ unsafe fn no_such_type(
 }
 
 no_variables_of_type! {
-    fmi3GetFloat32, f32, mut, GET;
-    fmi3GetInt8, i8, mut, GET;
-    fmi3GetUInt8, u8, mut, GET;
-    fmi3GetInt16, i16, mut, GET;
-    fmi3GetUInt16, u16, mut, GET;
-    fmi3GetUInt32, u32, mut, GET;
-    fmi3GetUInt64, u64, mut, GET;
-    fmi3GetString, *const c_char, mut, GET;
-    fmi3SetFloat32, f32, const, SET;
-    fmi3SetInt8, i8, const, SET;
-    fmi3SetUInt8, u8, const, SET;
-    fmi3SetInt16, i16, const, SET;
-    fmi3SetUInt16, u16, const, SET;
-    fmi3SetUInt32, u32, const, SET;
-    fmi3SetUInt64, u64, const, SET;
-    fmi3SetString, *const c_char, const, SET;
-}
-
-/// `fmi3GetBinary`: no Binary variables.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetBinary(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    _value_sizes: *mut usize,
-    _values: *mut *const u8,
-    _n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3GetBinary", mask::GET, vrs, nvr) }
-}
-
-/// `fmi3SetBinary`: no Binary variables.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetBinary(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    _value_sizes: *const usize,
-    _values: *const *const u8,
-    _n_values: usize,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3SetBinary", mask::SET, vrs, nvr) }
-}
-
-/// `fmi3GetClock`: no clocks.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetClock(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    _values: *mut u8,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3GetClock", mask::GET, vrs, nvr) }
-}
-
-/// `fmi3SetClock`: no clocks.
-///
-/// # Safety
-/// FMI 3.0 contract.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetClock(
-    instance: Instance3,
-    vrs: *const Vr,
-    nvr: usize,
-    _values: *const u8,
-) -> Fmi3Status {
-    // SAFETY: forwarded.
-    unsafe { no_such_type(instance, "fmi3SetClock", mask::SET, vrs, nvr) }
+    fmi3GetFloat32, GET, (_values: *mut f32, _n_values: usize);
+    fmi3GetInt8, GET, (_values: *mut i8, _n_values: usize);
+    fmi3GetUInt8, GET, (_values: *mut u8, _n_values: usize);
+    fmi3GetInt16, GET, (_values: *mut i16, _n_values: usize);
+    fmi3GetUInt16, GET, (_values: *mut u16, _n_values: usize);
+    fmi3GetUInt32, GET, (_values: *mut u32, _n_values: usize);
+    fmi3GetUInt64, GET, (_values: *mut u64, _n_values: usize);
+    fmi3GetString, GET, (_values: *mut *const c_char, _n_values: usize);
+    fmi3SetFloat32, SET, (_values: *const f32, _n_values: usize);
+    fmi3SetInt8, SET, (_values: *const i8, _n_values: usize);
+    fmi3SetUInt8, SET, (_values: *const u8, _n_values: usize);
+    fmi3SetInt16, SET, (_values: *const i16, _n_values: usize);
+    fmi3SetUInt16, SET, (_values: *const u16, _n_values: usize);
+    fmi3SetUInt32, SET, (_values: *const u32, _n_values: usize);
+    fmi3SetUInt64, SET, (_values: *const u64, _n_values: usize);
+    fmi3SetString, SET, (_values: *const *const c_char, _n_values: usize);
+    fmi3GetBinary, GET, (_value_sizes: *mut usize, _values: *mut *const u8, _n_values: usize);
+    fmi3SetBinary, SET, (_value_sizes: *const usize, _values: *const *const u8, _n_values: usize);
+    fmi3GetClock, GET, (_values: *mut u8);
+    fmi3SetClock, SET, (_values: *const u8);
 }
 
 /// Functions this Co-Simulation FMU does not provide: an error naming them.

@@ -118,6 +118,24 @@ pub struct RajendranGrove {
 }
 
 impl RajendranGrove {
+    /// Fraction of the crack density at pulverization past which a point
+    /// counts as damaged (the penetration run's `damaged_fraction`, the
+    /// report's damage pictures), if that is at least twice its initial
+    /// crack density ([`RajendranGrove::damaged_threshold`]).
+    pub const DAMAGED_AT: f64 = 0.01;
+
+    /// The crack density past which a point counts as damaged: its cracks
+    /// have grown, to at least 1 % ([`RajendranGrove::DAMAGED_AT`]) of the
+    /// crack density at pulverization and at least twice the initial crack
+    /// density. (A plate whose initial cracks already pass 1 % of
+    /// pulverization, as those of `plate_ceramic = ad85_spall` (a0 =
+    /// 100 µm, γ0 = 0.0183) do, would otherwise count as damaged before the
+    /// impact.)
+    pub fn damaged_threshold(&self) -> f64 {
+        (Self::DAMAGED_AT * self.critical_damage)
+            .max(2.0 * self.crack_density(self.initial_crack_size))
+    }
+
     /// AD85 alumina, seed 004 Table 1 (with the reference strain rate of
     /// eq. 22, 1/s, and pulverization at the crack density 0.75 of section
     /// 4.3), as printed: the initial crack size 0.58 µm. A `const fn`, so

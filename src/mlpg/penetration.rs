@@ -22,22 +22,6 @@ use crate::material::Material;
 use crate::material::rajendran_grove::RajendranGrove;
 use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
 
-/// Fraction of the crack density at pulverization past which a plate node
-/// counts as damaged (`damaged_fraction`), if that is at least twice its
-/// initial crack density ([`damaged_threshold`]).
-pub const DAMAGED_AT: f64 = 0.01;
-
-/// The crack density past which a plate node counts as damaged: its cracks
-/// have grown, to at least 1 % (`DAMAGED_AT`) of the crack density at
-/// pulverization and at least twice the initial crack density. (A plate
-/// whose initial cracks already pass 1 % of pulverization, as those of
-/// `plate_ceramic = ad85_spall` (a0 = 100 µm, γ0 = 0.0183) do, would
-/// otherwise count as damaged before the impact.)
-pub fn damaged_threshold(ceramic: &RajendranGrove) -> f64 {
-    (DAMAGED_AT * ceramic.critical_damage)
-        .max(2.0 * ceramic.crack_density(ceramic.initial_crack_size))
-}
-
 /// The geometry and resolution of a penetration run.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PenetrationSetup {
@@ -308,7 +292,9 @@ impl Penetration {
 
     /// `(damaged_fraction, pulverized_fraction, max_damage)` of the plate.
     pub fn damage(&self) -> (f64, f64, f64) {
-        let threshold = self.ceramic().map_or(f64::INFINITY, damaged_threshold);
+        let threshold = self
+            .ceramic()
+            .map_or(f64::INFINITY, RajendranGrove::damaged_threshold);
         let (mut damaged, mut pulverized, mut total, mut max) = (0.0, 0.0, 0.0, 0.0f64);
         for (g, p, m) in self.plate_damage() {
             total += m;

@@ -6,7 +6,6 @@ use super::plot::{self, Axes, Plane, Series};
 use super::runner::{Probe, run_case, run_parallel, scene};
 use super::{Doc, Plan, Table, sig};
 use meshless_impact::Result;
-use meshless_impact::internals::mlpg::damaged_threshold;
 use meshless_impact::materials::RajendranGrove;
 
 /// The seed's residual velocity (m/s).
@@ -151,7 +150,7 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
         ..RajendranGrove::ad85()
     };
     let gamma0 = ceramic.crack_density(ceramic.initial_crack_size);
-    let damaged = damaged_threshold(&ceramic);
+    let damaged = ceramic.damaged_threshold();
     let scale = (gamma0.log10().floor(), PULVERIZED.log10());
     let mut slices = Vec::new();
     for snap in &run.snapshots {

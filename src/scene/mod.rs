@@ -117,6 +117,12 @@ impl SceneKind {
         self.row.observables
     }
 
+    /// The particle (node) fields of a run of this kind, in the order a run
+    /// gives them ([`crate::Simulation::field_specs`]).
+    pub fn field_specs(self) -> &'static [crate::observe::FieldSpec] {
+        self.row.fields
+    }
+
     /// The key of this kind in saved states: its name with a capital
     /// (`Taylor`).
     pub(crate) fn saved_key(self) -> String {
@@ -644,6 +650,30 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fields a scene's row declares (what the reference pages list)
+    /// are the fields a run of it gives, for every built-in scene and
+    /// material choice.
+    #[test]
+    fn every_rows_fields_are_its_runs_fields() {
+        for name in builtin_names() {
+            let mut scene = Scene::builtin(&name).unwrap();
+            // Coarse, where the scene has a resolution across: the fields
+            // do not depend on it.
+            let _ = scene.set("particles_radial", 3.0);
+            let run = crate::Simulation::new(scene.clone()).unwrap();
+            let names = |f: &[crate::observe::FieldSpec]| {
+                f.iter()
+                    .map(|s| (s.name, s.unit, s.components))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(
+                names(scene.kind().field_specs()),
+                names(run.field_specs()),
+                "{name}"
+            );
+        }
+    }
 
     #[test]
     fn unknown_parameter_lists_allowed_names() {

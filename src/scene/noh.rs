@@ -22,6 +22,7 @@ pub static ROW: SceneRow = SceneRow {
     params: NOH_PARAMS,
     material: None,
     observables: NOH_OBSERVABLES,
+    fields: crate::solver::radial::NOH_FIELDS,
     reference: || {
         BTreeMap::from([
             ("shock_radius".to_string(), 0.2),

@@ -30,6 +30,7 @@ pub static ROW: SceneRow = SceneRow {
     params: PENETRATION_PARAMS,
     material: None,
     observables: PENETRATION_OBSERVABLES,
+    fields: crate::mlpg::penetration::PENETRATION_FIELDS,
     reference: || BTreeMap::from([("projectile_velocity".to_string(), RESIDUAL_VELOCITY)]),
     variants: no_variants,
     check: |s| setup(s).map(|_| ()),

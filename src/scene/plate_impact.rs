@@ -32,6 +32,7 @@ pub static ROW: SceneRow = SceneRow {
     params: PLATE_IMPACT_PARAMS,
     material: None,
     observables: PLATE_IMPACT_OBSERVABLES,
+    fields: crate::uniaxial::PLATE_IMPACT_FIELDS,
     reference: BTreeMap::new,
     variants: no_variants,
     check: |s| setup(s).map(|_| ()),

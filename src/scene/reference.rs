@@ -8,7 +8,6 @@
 use super::Scene;
 use super::params::ParamSpec;
 use crate::error::Result;
-use crate::sim::Simulation;
 use std::fmt::Write as _;
 
 /// The directory of the pages, relative to the workspace root.
@@ -177,7 +176,7 @@ pub fn page(name: &str, scene: &Scene) -> Result<String> {
         );
     }
 
-    let fields = Simulation::new(scene.clone())?.field_specs();
+    let fields = scene.kind().field_specs();
     let _ = writeln!(w, "\n## Fields\n");
     let _ = writeln!(
         w,

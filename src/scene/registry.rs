@@ -48,6 +48,10 @@ pub struct SceneRow {
     pub material: Option<MaterialSlot>,
     /// Observables, in output order.
     pub observables: &'static [ObservableSpec],
+    /// The particle (node) fields of the scene's solver, as a run gives
+    /// them ([`crate::Simulation::field_specs`]; a unit test holds the two
+    /// together), so that the reference pages list them without a run.
+    pub fields: &'static [crate::observe::FieldSpec],
     /// Reference values of the default scene (experiment or exact solution),
     /// keyed like the observables they compare with.
     pub reference: fn() -> BTreeMap<String, f64>,

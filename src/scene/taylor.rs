@@ -62,6 +62,7 @@ pub static ROW: SceneRow = SceneRow {
         ],
     }),
     observables: TAYLOR_OBSERVABLES,
+    fields: crate::solver::axisymmetric::TAYLOR_FIELDS,
     reference: || super::table1::Table1Row::all()[6].reference(),
     variants: super::table1::variants,
     check: |s| {

@@ -31,6 +31,7 @@ pub static ROW: SceneRow = SceneRow {
         fmus: &[],
     }),
     observables: TAYLOR3D_OBSERVABLES,
+    fields: crate::mlpg::solver::MLPG_FIELDS,
     reference: || super::table1::Table1Row::all()[6].reference(),
     variants,
     check: |s| {

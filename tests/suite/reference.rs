@@ -3,7 +3,7 @@
 //! byte for byte its rendering now, every built-in scene has one, and the
 //! index lists them all.
 
-use meshless_impact::internals::reference::{DIR, INDEX, files};
+use meshless_impact::reference::{DIR, INDEX, files};
 use std::path::Path;
 
 /// The directory of the pages in this checkout.
@@ -76,7 +76,7 @@ fn every_scene_has_a_page_listed_in_the_index() {
 /// `meshless-impact params SCENE --markdown` prints the scene's page.
 #[test]
 fn the_cli_prints_the_page() {
-    let page = meshless_impact::internals::reference::builtin_page("penetration").unwrap();
+    let page = meshless_impact::reference::builtin_page("penetration").unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
         .args(["params", "penetration", "--markdown"])
         .output()

@@ -42,7 +42,7 @@ pub fn run() -> Result<(), String> {
     // the tests' build, so that its library is reused, not compiled again
     // (`examples_c/Makefile`, MI_WITH_TESTS).
     if std::env::var_os("MI_WITH_TESTS").is_some_and(|v| !v.is_empty()) {
-        build.arg("--tests");
+        build.args(["--lib", "--bins", "--tests"]);
     }
     let status = build
         .status()

@@ -1,12 +1,12 @@
 //! `cargo xtask reference`: regenerate the reference pages of the user
 //! guide, `docs/reference/README.md` and `docs/reference/SCENE.md` for every
 //! built-in scene, from the scene registry
-//! (`meshless_impact::internals::reference`, the renderer of `meshless-impact
+//! (`meshless_impact::reference`, the renderer of `meshless-impact
 //! params SCENE --markdown`). Pages of scenes that no longer exist are
 //! removed. `tests/suite/reference.rs` renders them the same way and fails when a
 //! committed page differs.
 
-use meshless_impact::internals::reference::{DIR, files};
+use meshless_impact::reference::{DIR, files};
 use std::collections::BTreeSet;
 
 /// Regenerates `docs/reference/`.
