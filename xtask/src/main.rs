@@ -7,6 +7,7 @@
 //!   `docs/reference/`, from the scene registry.
 
 mod fmu;
+mod fmu_package;
 mod header;
 mod reference;
 
