@@ -86,27 +86,7 @@ impl Mlpg3d {
     /// `supports_at` when `supports` is true or none exist).
     pub(super) fn build_geometry(&mut self, supports: bool) -> Result<()> {
         let time = self.time;
-        let at_time = |e: Error| match e {
-            Error::SingularMomentMatrix {
-                method,
-                particle,
-                condition,
-                ..
-            } => Error::SingularMomentMatrix {
-                method,
-                particle,
-                time,
-                condition,
-            },
-            Error::NonFinite {
-                field, particle, ..
-            } => Error::NonFinite {
-                field,
-                particle,
-                time,
-            },
-            e => e,
-        };
+        let stamp = |e: Error| at_time(e, time);
         let mut clock = std::time::Instant::now();
         let mut g = self.geometry.take().unwrap_or_default();
         // The old shapes and operator go before the new are built: they are
@@ -116,7 +96,7 @@ impl Mlpg3d {
         g.nodal = NodalOperator::default();
         let n = self.pos.len();
         if supports || g.supports.is_none() {
-            let (sup, mirror) = self.supports_with_images().map_err(at_time)?;
+            let (sup, mirror) = self.supports_with_images().map_err(stamp)?;
             g.supports = Some(sup);
             g.mirror = mirror;
             self.profile.supports += 1;
@@ -125,7 +105,7 @@ impl Mlpg3d {
         let sup = g.supports.as_ref().expect("computed above");
         let mut buf = Vec::new();
         let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
-        g.shapes = NodalShapes::build_rows(pts, sup, n).map_err(at_time)?;
+        g.shapes = NodalShapes::build_rows(pts, sup, n).map_err(stamp)?;
         if self.setup.conforming {
             let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
             let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
@@ -144,7 +124,7 @@ impl Mlpg3d {
                     &SphereRule::of(DEFAULT_RULE),
                     &SphereRule::of(BOUNDARY_RULE),
                 )
-                .map_err(at_time)?;
+                .map_err(stamp)?;
             }
             WeakForm::Nodal => {
                 g.spheres.clear();

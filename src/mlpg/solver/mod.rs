@@ -116,7 +116,7 @@ use scratch::{CARRIED, Scratch, Tally};
 use setup::anvil_default;
 pub use setup::{Body, DAMPING, REBUILD_STRAIN, RodSetup, SMOOTHING, WeakForm};
 use spheres::{nanson, radial};
-use util::{extended, kinetic, kinetic1, material_of, norm, pin};
+use util::{at_time, extended, kinetic, kinetic1, material_of, norm, pin};
 
 /// A 3-D MLPG run of a rod striking a rigid smooth anvil.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]

@@ -166,7 +166,7 @@ pub(super) fn sum(
 ) -> Result<Tally> {
     let mut t = Tally::default();
     for r in results {
-        let s = r.as_ref().map_err(|(_, e)| with_time(e.clone(), time))?;
+        let s = r.as_ref().map_err(|(_, e)| at_time(e.clone(), time))?;
         t.internal += s.internal;
         t.plastic += s.plastic;
         t.damping += s.damping;
@@ -176,30 +176,4 @@ pub(super) fn sum(
         t.worst_speed = t.worst_speed.max(s.worst_speed);
     }
     Ok(t)
-}
-
-/// The error `e` of a node at `time` (the passes over the nodes do not
-/// know the time).
-fn with_time(e: Error, time: f64) -> Error {
-    match e {
-        Error::NonFinite {
-            field, particle, ..
-        } => Error::NonFinite {
-            field,
-            particle,
-            time,
-        },
-        Error::CompressionLimit {
-            particle,
-            compression,
-            limit,
-            ..
-        } => Error::CompressionLimit {
-            particle,
-            time,
-            compression,
-            limit,
-        },
-        e => e,
-    }
 }

@@ -57,3 +57,40 @@ pub(super) fn kinetic(v: &[[f64; 3]], m: &[f64]) -> f64 {
 pub(super) fn norm(a: [f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
+
+/// The error `e` met at a node, stamped with the run's `time` (the passes
+/// over the nodes and the builds of the geometry do not know the time).
+pub(super) fn at_time(e: Error, time: f64) -> Error {
+    match e {
+        Error::NonFinite {
+            field, particle, ..
+        } => Error::NonFinite {
+            field,
+            particle,
+            time,
+        },
+        Error::CompressionLimit {
+            particle,
+            compression,
+            limit,
+            ..
+        } => Error::CompressionLimit {
+            particle,
+            time,
+            compression,
+            limit,
+        },
+        Error::SingularMomentMatrix {
+            method,
+            particle,
+            condition,
+            ..
+        } => Error::SingularMomentMatrix {
+            method,
+            particle,
+            time,
+            condition,
+        },
+        e => e,
+    }
+}
