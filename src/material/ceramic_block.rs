@@ -37,7 +37,7 @@
 //! every shot from 400 to 1500 m/s perforates with 83-85 % of its speed
 //! (the Lambert-Jonas fit puts the ballistic limit near 20 m/s), and the
 //! residual velocity still climbs by 18 m/s from 8 to 10 nodes across. The
-//! seed's a0 keeps the plate, converges (1140 ± 10 m/s) and has a ballistic
+//! seed's a0 keeps the plate, converges (1131 ± 16 m/s, 4 to 12 across) and has a ballistic
 //! limit between 700 and 800 m/s, so it stays the default until the growth
 //! and pulverized constants are fitted with a0.
 //!
