@@ -92,8 +92,7 @@ pub fn cell_list_first<const D: usize>(
         .par_iter()
         .map(|p| {
             let mut row = Vec::with_capacity(32);
-            cells.visit(p, |j| row.push(j));
-            row.sort_unstable();
+            cells.sorted_into(p, &mut row);
             row
         })
         .collect();
@@ -163,8 +162,10 @@ pub fn padded_rows<const D: usize>(
 
 /// A uniform grid of cells of side `radius` over a point set, with the
 /// points of each cell in ascending index order. Cells are numbered with the
-/// first axis fastest.
-struct Cells<'a, const D: usize> {
+/// first axis fastest. [`Cells::sorted_into`] answers one point at a time,
+/// for a caller that needs a point's neighbours only while it handles the
+/// point (no list of every point's neighbours held at once).
+pub(crate) struct Cells<'a, const D: usize> {
     points: &'a [[f64; D]],
     lo: [f64; D],
     cell: f64,
@@ -179,7 +180,7 @@ const MAX_CELLS: f64 = 4_194_304.0;
 
 impl<'a, const D: usize> Cells<'a, D> {
     /// The grid, or `None` for no points.
-    fn new(points: &'a [[f64; D]], radius: f64) -> Option<Self> {
+    pub(crate) fn new(points: &'a [[f64; D]], radius: f64) -> Option<Self> {
         if points.is_empty() {
             return None;
         }
@@ -230,6 +231,14 @@ impl<'a, const D: usize> Cells<'a, D> {
             fill[c] += 1;
         }
         Some(grid)
+    }
+
+    /// Writes into `out` (cleared first) every point within the radius of
+    /// `p`, ascending: the row of `p` in [`cell_list_first`].
+    pub(crate) fn sorted_into(&self, p: &[f64; D], out: &mut Vec<usize>) {
+        out.clear();
+        self.visit(p, |j| out.push(j));
+        out.sort_unstable();
     }
 
     fn cell_of(&self, p: &[f64; D]) -> [usize; D] {

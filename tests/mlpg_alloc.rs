@@ -121,9 +121,14 @@ fn heap_by_part() {
         ..Taylor3dParams::default()
     };
     let mut s = p.build().unwrap();
+    let built = PEAK.load(Ordering::Relaxed) - base;
     s.step().unwrap();
     let n = s.particles() as f64;
     let kb = |b: u64| b as f64 / n / 1e3;
+    println!(
+        "most live at once in the construction: {:.2} kB a node",
+        kb(built)
+    );
     let live = LIVE.load(Ordering::Relaxed) - base;
     println!(
         "{} nodes; held after the first step: {:.2} kB a node",
@@ -140,9 +145,21 @@ fn heap_by_part() {
         "other",
         kb(live - parts as u64)
     );
+    // The largest rise of the heap within one step, and that step.
+    let (mut rise, mut at) = (0u64, 0u64);
     for _ in 0..steps {
+        let live = LIVE.load(Ordering::Relaxed);
+        let peak = PEAK.swap(live, Ordering::Relaxed);
         s.step().unwrap();
+        if PEAK.load(Ordering::Relaxed) - live > rise {
+            (rise, at) = (PEAK.load(Ordering::Relaxed) - live, s.steps());
+        }
+        PEAK.fetch_max(peak, Ordering::Relaxed);
     }
+    println!(
+        "the largest rise within one step: {:.2} kB a node (step {at})",
+        kb(rise)
+    );
     println!(
         "most live at once over {} steps ({} builds): {:.2} kB a node, {:.1} MB",
         s.steps(),

@@ -62,7 +62,7 @@ pub struct Conformed {
 /// ([`super::nodal::transpose`]).
 struct Columns {
     offsets: Vec<usize>,
-    entries: Vec<(usize, usize)>,
+    entries: Vec<(u32, u32)>,
 }
 
 impl Columns {
@@ -122,6 +122,13 @@ fn dot(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
 
 fn norm3(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// `e_q = μ_J [J inner] − λ_iᵀ p_J` of one entry `q = (i, J)`, with
+/// `p = p_J` in row `i`'s basis.
+fn entry(p: [f64; 4], inner: bool, mu: [f64; 3], lambda: &[[f64; 3]; 4]) -> [f64; 3] {
+    let own = if inner { mu } else { [0.0; 3] };
+    std::array::from_fn(|c| own[c] - (0..4).map(|a| p[a] * lambda[a][c]).sum::<f64>())
 }
 
 /// The operator of the multipliers.
@@ -205,6 +212,7 @@ impl<'a> System<'a> {
     }
 
     /// `e_q = μ_J [J inner] − λ_iᵀ p_J` for every entry `q = (i, J)`.
+    #[cfg(test)]
     fn entries(&self, mu: &[[f64; 3]], e: &mut [[f64; 3]]) {
         let s = self.shapes;
         let rows: Vec<(usize, &mut [[f64; 3]])> = {
@@ -223,15 +231,43 @@ impl<'a> System<'a> {
             for (k, q) in s.row(i).enumerate() {
                 let j = s.nodes[q];
                 let p = basis(self.points[j], xi, h);
-                let own = if self.inner[j] { mu[j] } else { [0.0; 3] };
-                out[k] = std::array::from_fn(|c| {
-                    own[c] - (0..4).map(|a| p[a] * lambda[a][c]).sum::<f64>()
-                });
+                out[k] = entry(p, self.inner[j], mu[j], &lambda);
             }
         });
     }
 
+    /// The Jacobi preconditioner `A_JJ = Σ_i V_i² (1 − p_Jᵀ M_i⁻¹ p_J)`
+    /// (inner `J` only; the same three values for each axis): the sums of
+    /// [`System::gather`] with power 2 over the entries `1 − p_Jᵀ M_i⁻¹ p_J`,
+    /// each computed where it is summed (no buffer of `3 nnz` values).
+    fn diagonal(&self) -> Vec<[f64; 3]> {
+        let c = self.columns;
+        (0..self.shapes.len())
+            .into_par_iter()
+            .map(|j| {
+                let mut yj = [0.0; 3];
+                if !self.inner[j] {
+                    return yj;
+                }
+                for k in c.offsets[j]..c.offsets[j + 1] {
+                    let i = c.entries[k].1 as usize;
+                    let p = basis(self.points[j], self.points[i], self.scale[i]);
+                    let m = &self.minv[i];
+                    let pmp: f64 = (0..4)
+                        .map(|x| (0..4).map(|y| p[x] * m[x][y] * p[y]).sum::<f64>())
+                        .sum();
+                    let v = self.volume[i].powi(2);
+                    for d in yj.iter_mut() {
+                        *d += v * (1.0 - pmp);
+                    }
+                }
+                yj
+            })
+            .collect()
+    }
+
     /// `y_J = Σ_i V_i^power w_q` over column `J` (inner `J` only).
+    #[cfg(test)]
     fn gather(&self, w: &[[f64; 3]], power: i32, y: &mut [[f64; 3]]) {
         let c = &self.columns;
         y.par_iter_mut().enumerate().for_each(|(j, yj)| {
@@ -240,7 +276,7 @@ impl<'a> System<'a> {
                 return;
             }
             for k in c.offsets[j]..c.offsets[j + 1] {
-                let (q, i) = c.entries[k];
+                let (q, i) = (c.entries[k].0 as usize, c.entries[k].1 as usize);
                 let v = self.volume[i].powi(power);
                 for d in 0..3 {
                     yj[d] += v * w[q][d];
@@ -274,7 +310,7 @@ impl Fused {
                     return 0.0;
                 }
                 (c.offsets[j]..c.offsets[j + 1])
-                    .map(|k| sys.volume[c.entries[k].1].powi(2))
+                    .map(|k| sys.volume[c.entries[k].1 as usize].powi(2))
                     .sum()
             })
             .collect();
@@ -299,7 +335,7 @@ impl Fused {
             let xj = sys.points[j];
             let mut t = [0.0; 3];
             for k in c.offsets[j]..c.offsets[j + 1] {
-                let i = c.entries[k].1;
+                let i = c.entries[k].1 as usize;
                 let p = basis(xj, sys.points[i], sys.scale[i]);
                 for d in 0..3 {
                     t[d] += (0..4).map(|a| p[a] * w[i][a][d]).sum::<f64>();
@@ -332,7 +368,7 @@ pub fn conform(
         let c = &sys.columns;
         a.par_iter_mut().enumerate().for_each(|(j, aj)| {
             for k in c.offsets[j]..c.offsets[j + 1] {
-                let (q, i) = c.entries[k];
+                let (q, i) = (c.entries[k].0 as usize, c.entries[k].1 as usize);
                 for d in 0..3 {
                     aj[d] += volume[i] * shapes.grad[q][d];
                 }
@@ -349,21 +385,7 @@ pub fn conform(
     let before = inner_max(&a);
     let goal = tolerance * largest;
     // Jacobi preconditioner: A_JJ = Σ_i V_i² (1 − p_Jᵀ M_i⁻¹ p_J).
-    let mut diag_e = vec![[0.0; 3]; shapes.nodes.len()];
-    for i in 0..n {
-        for q in shapes.row(i) {
-            let j = shapes.nodes[q];
-            let p = basis(points[j], points[i], sys.scale[i]);
-            let m = &sys.minv[i];
-            let pmp: f64 = (0..4)
-                .map(|x| (0..4).map(|y| p[x] * m[x][y] * p[y]).sum::<f64>())
-                .sum();
-            diag_e[q] = [1.0 - pmp; 3];
-        }
-    }
-    let mut diag = vec![[0.0; 3]; n];
-    sys.gather(&diag_e, 2, &mut diag);
-    drop(diag_e);
+    let diag = sys.diagonal();
     let precond = |r: &[[f64; 3]], z: &mut [[f64; 3]]| {
         for j in 0..n {
             z[j] = if inner[j] && diag[j][0] > 0.0 {
@@ -416,24 +438,36 @@ pub fn conform(
         iterations += 1;
     }
     drop(fused);
-    let mut e = vec![[0.0; 3]; shapes.nodes.len()];
-    sys.entries(&mu, &mut e);
-    drop(sys);
+    // g_q += V_i e_q, row by row in place (no buffer of the 3 nnz e_q):
+    // the λ_i first, while the system holds the shapes.
+    let lambda: Vec<[[f64; 3]; 4]> = (0..n).into_par_iter().map(|i| sys.lambda(i, &mu)).collect();
+    let System { scale, .. } = sys;
+    let (offsets, nodes) = (&shapes.offsets, &shapes.nodes);
+    let mut rows: Vec<(usize, &mut [[f64; 3]])> = Vec::with_capacity(n);
+    let mut rest = &mut shapes.grad[..];
     for i in 0..n {
+        let (head, tail) = rest.split_at_mut(offsets[i + 1] - offsets[i]);
+        rows.push((i, head));
+        rest = tail;
+    }
+    rows.into_par_iter().for_each(|(i, grad)| {
         let v = volume[i];
-        for q in shapes.row(i) {
+        for (g, q) in grad.iter_mut().zip(offsets[i]..offsets[i + 1]) {
+            let j = nodes[q];
+            let p = basis(points[j], points[i], scale[i]);
+            let e = entry(p, inner[j], mu[j], &lambda[i]);
             for d in 0..3 {
-                shapes.grad[q][d] += v * e[q][d];
+                g[d] += v * e[d];
             }
         }
-    }
+    });
     // The constraint after, measured afresh.
     let mut after = 0.0f64;
     let cols = &columns;
     for j in (0..n).filter(|&j| inner[j]) {
         let mut s = [0.0; 3];
         for k in cols.offsets[j]..cols.offsets[j + 1] {
-            let (q, i) = cols.entries[k];
+            let (q, i) = (cols.entries[k].0 as usize, cols.entries[k].1 as usize);
             for d in 0..3 {
                 s[d] += volume[i] * shapes.grad[q][d];
             }

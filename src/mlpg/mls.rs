@@ -55,9 +55,10 @@
 //! (too few, coplanar or collinear covering nodes) is the named error
 //! [`crate::Error::SingularMomentMatrix`], never a NaN.
 
+use super::buffers::refill;
 use crate::isa::{Isa, hot};
 use crate::msph::{MAX_CONDITION, invert};
-use crate::neighbours::{NeighbourList, cell_list_first};
+use crate::neighbours::{Cells, NeighbourList, cell_list_first};
 use crate::{Error, Result};
 use rayon::prelude::*;
 
@@ -128,13 +129,8 @@ impl ShapeRow {
         self.dweight.clear();
         let mut h = 0.0f64;
         for (slot, &j) in candidates.iter().enumerate() {
-            let d = [
-                x[0] - points[j][0],
-                x[1] - points[j][1],
-                x[2] - points[j][2],
-            ];
             let r = radius[j];
-            let s = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / r;
+            let (d, s) = scaled_offset(x, points[j], r);
             if s < 1.0 {
                 let (w, dw_s) = quartic_spline(s);
                 self.nodes.push(j);
@@ -197,6 +193,14 @@ impl ShapeRow {
         }
         Ok(())
     }
+}
+
+/// The offset `x − p` and the distance in units of the support radius `r`
+/// (`< 1`: the support covers `x`), as [`ShapeRow::evaluate`] decides.
+#[inline]
+fn scaled_offset(x: [f64; 3], p: [f64; 3], r: f64) -> ([f64; 3], f64) {
+    let d = [x[0] - p[0], x[1] - p[1], x[2] - p[2]];
+    (d, (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / r)
 }
 
 /// The MLS shape functions, without gradients, at the many points of one
@@ -456,6 +460,9 @@ fn norm1(m: &[[f64; BASIS]; BASIS]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Rows of [`NodalShapes::rebuild_rows`] handled as one task.
+const ROWS_PER_BLOCK: usize = 256;
+
 /// The shape functions and their gradients at the nodes themselves, in
 /// compressed rows: row `i` lists the nodes covering `x_i`.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -481,31 +488,104 @@ impl NodalShapes {
     /// The shape functions at the first `rows` nodes only (the real nodes;
     /// the others, mirror images, are only covering nodes).
     pub fn build_rows(points: &[[f64; 3]], supports: &Supports, rows: usize) -> Result<Self> {
-        let list = candidates_first(points, rows, supports, 0.0);
-        let rows: Vec<Result<ShapeRow>> = (0..rows)
-            .into_par_iter()
-            .map_init(ShapeRow::default, |row, i| {
-                row.evaluate(points[i], list.of(i), points, &supports.radius, true, i)?;
-                Ok(ShapeRow {
-                    nodes: row.nodes.clone(),
-                    phi: row.phi.clone(),
-                    grad: row.grad.clone(),
-                    ..ShapeRow::default()
-                })
-            })
-            .collect();
-        let mut out = NodalShapes {
-            offsets: vec![0],
-            ..NodalShapes::default()
+        let mut shapes = NodalShapes::default();
+        shapes.rebuild_rows(points, supports, rows)?;
+        Ok(shapes)
+    }
+
+    /// [`NodalShapes::build_rows`] into these shapes' buffers (reused: no
+    /// allocation unless the rows grow). Each row's candidates (the rows
+    /// of `candidates_first` with no reach: within the largest support
+    /// radius, of the node's own body, ascending) are found while the row
+    /// is handled, and a first pass counts each row's covering nodes so
+    /// that the second writes the shapes in place: nothing is held beside
+    /// the shapes (BENCHMARKS.md, memory). On an error the shapes are left
+    /// partly written.
+    pub fn rebuild_rows(
+        &mut self,
+        points: &[[f64; 3]],
+        supports: &Supports,
+        rows: usize,
+    ) -> Result<()> {
+        refill(&mut self.offsets, rows + 1, 0);
+        let Some(grid) = Cells::new(points, 0.0 + supports.max_radius()) else {
+            self.offsets.truncate(1);
+            self.nodes.clear();
+            self.phi.clear();
+            self.grad.clear();
+            return Ok(());
         };
-        for row in rows {
-            let row = row?;
-            out.nodes.extend_from_slice(&row.nodes);
-            out.phi.extend_from_slice(&row.phi);
-            out.grad.extend_from_slice(&row.grad);
-            out.offsets.push(out.nodes.len());
+        let group = &supports.group;
+        let candidates = |i: usize, out: &mut Vec<usize>| {
+            grid.sorted_into(&points[i], out);
+            if !group.is_empty() {
+                out.retain(|&j| group[j] == group[i]);
+            }
+        };
+        // Pass 1: each row's length, into offsets[i + 1].
+        self.offsets[1..]
+            .par_chunks_mut(ROWS_PER_BLOCK)
+            .enumerate()
+            .for_each_init(Vec::new, |list, (b, lens)| {
+                for (k, len) in lens.iter_mut().enumerate() {
+                    let i = b * ROWS_PER_BLOCK + k;
+                    candidates(i, list);
+                    *len = list
+                        .iter()
+                        .filter(|&&j| {
+                            scaled_offset(points[i], points[j], supports.radius[j]).1 < 1.0
+                        })
+                        .count();
+                }
+            });
+        for i in 0..rows {
+            self.offsets[i + 1] += self.offsets[i];
         }
-        Ok(out)
+        let total = self.offsets[rows];
+        refill(&mut self.nodes, total, 0);
+        refill(&mut self.phi, total, 0.0);
+        refill(&mut self.grad, total, [0.0; 3]);
+        // Pass 2: the rows, a block at a time, each into its own entries.
+        let mut blocks = Vec::with_capacity(rows.div_ceil(ROWS_PER_BLOCK));
+        let (mut nodes, mut phi, mut grad) =
+            (&mut self.nodes[..], &mut self.phi[..], &mut self.grad[..]);
+        for b in 0..rows.div_ceil(ROWS_PER_BLOCK) {
+            let (first, last) = (b * ROWS_PER_BLOCK, rows.min((b + 1) * ROWS_PER_BLOCK));
+            let len = self.offsets[last] - self.offsets[first];
+            let (n, rest_n) = nodes.split_at_mut(len);
+            let (p, rest_p) = phi.split_at_mut(len);
+            let (g, rest_g) = grad.split_at_mut(len);
+            blocks.push((first..last, n, p, g));
+            (nodes, phi, grad) = (rest_n, rest_p, rest_g);
+        }
+        let offsets = &self.offsets;
+        let errors: Vec<Option<Error>> = blocks
+            .into_par_iter()
+            .map_init(
+                || (ShapeRow::default(), Vec::new()),
+                |(row, list), (range, nodes, phi, grad)| {
+                    let base = offsets[range.start];
+                    for i in range {
+                        candidates(i, list);
+                        if let Err(e) =
+                            row.evaluate(points[i], list, points, &supports.radius, true, i)
+                        {
+                            return Some(e);
+                        }
+                        let at = offsets[i] - base..offsets[i + 1] - base;
+                        debug_assert_eq!(at.len(), row.nodes.len());
+                        nodes[at.clone()].copy_from_slice(&row.nodes);
+                        phi[at.clone()].copy_from_slice(&row.phi);
+                        grad[at].copy_from_slice(&row.grad);
+                    }
+                    None
+                },
+            )
+            .collect();
+        match errors.into_iter().flatten().next() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
     }
 
     /// Number of nodes.

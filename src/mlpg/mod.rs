@@ -28,6 +28,7 @@
 //! see [`sphere::ALPHA`]. The time loop with materials, the anvil contact
 //! and the scene are the solver's, built on these pieces.
 
+mod buffers;
 pub mod conform;
 pub mod contact;
 pub mod lattice;

@@ -30,6 +30,7 @@
 //! whose shapes name it), so that each force is a gather in a fixed order:
 //! the same bits for any number of threads.
 
+use super::buffers::refill;
 use super::mls::NodalShapes;
 use super::weak::VOIGT;
 use rayon::prelude::*;
@@ -38,24 +39,31 @@ use rayon::prelude::*;
 /// nodes, by a counting sort: column `J` is `offsets[J]..offsets[J + 1]`
 /// of the entries `(q, i)`, `q` the entry of row `i` that names `J`, in
 /// ascending `i`.
-pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<(usize, usize)>) {
-    let mut offsets = vec![0usize; columns + 1];
+pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<(u32, u32)>) {
+    let mut offsets = Vec::new();
+    column_offsets(shapes, columns, &mut offsets);
+    let mut next = offsets.clone();
+    let mut entries = vec![(0, 0); shapes.nodes.len()];
+    for i in 0..shapes.len() {
+        for q in shapes.row(i) {
+            let j = shapes.nodes[q];
+            entries[next[j]] = (q as u32, i as u32);
+            next[j] += 1;
+        }
+    }
+    (offsets, entries)
+}
+
+/// Where each of the `columns` columns of `shapes` starts among the entries
+/// of the transpose: `columns + 1` offsets, written into `offsets`.
+fn column_offsets(shapes: &NodalShapes, columns: usize, offsets: &mut Vec<usize>) {
+    refill(offsets, columns + 1, 0);
     for &j in &shapes.nodes {
         offsets[j + 1] += 1;
     }
     for j in 0..columns {
         offsets[j + 1] += offsets[j];
     }
-    let mut next = offsets.clone();
-    let mut entries = vec![(0, 0); shapes.nodes.len()];
-    for i in 0..shapes.len() {
-        for q in shapes.row(i) {
-            let j = shapes.nodes[q];
-            entries[next[j]] = (q, i);
-            next[j] += 1;
-        }
-    }
-    (offsets, entries)
 }
 
 /// The transpose of the nodal shape functions and their gradients: for
@@ -78,12 +86,31 @@ impl NodalOperator {
     /// with mirror images, `src/mlpg/mirror.rs`): a counting sort, rows in node
     /// order, each in ascending `i`.
     pub fn build(shapes: &NodalShapes, columns: usize) -> Self {
-        let (offsets, entries) = transpose(shapes, columns);
-        NodalOperator {
-            offsets,
-            nodes: entries.iter().map(|&(_, i)| i).collect(),
-            grad: entries.iter().map(|&(q, _)| shapes.grad[q]).collect(),
-            phi: entries.iter().map(|&(q, _)| shapes.phi[q]).collect(),
+        let mut op = NodalOperator::default();
+        op.rebuild(shapes, columns);
+        op
+    }
+
+    /// [`NodalOperator::build`] into this operator's buffers (reused: no
+    /// allocation unless the operator grows). The counting sort of
+    /// [`transpose`], written straight into the operator: no list of
+    /// entries beside it (BENCHMARKS.md, memory).
+    pub fn rebuild(&mut self, shapes: &NodalShapes, columns: usize) {
+        column_offsets(shapes, columns, &mut self.offsets);
+        let mut next = self.offsets[..columns].to_vec();
+        let total = shapes.nodes.len();
+        refill(&mut self.nodes, total, 0);
+        refill(&mut self.grad, total, [0.0; 3]);
+        refill(&mut self.phi, total, 0.0);
+        for i in 0..shapes.len() {
+            for q in shapes.row(i) {
+                let j = shapes.nodes[q];
+                let k = next[j];
+                self.nodes[k] = i;
+                self.grad[k] = shapes.grad[q];
+                self.phi[k] = shapes.phi[q];
+                next[j] += 1;
+            }
         }
     }
 

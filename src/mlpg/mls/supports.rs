@@ -149,10 +149,43 @@ impl Supports {
             thin_start(extents, fill)
         }
         .max(1e-300);
-        let list = loop {
-            let list = cell_list_first(points, rows, search);
-            if (0..rows).all(|i| list.of(i).iter().filter(|&&j| same(i, j)).count() > k) {
-                break list;
+        // Each row is found from the grid while it is handled, a block of
+        // rows at a time: no list of every node's candidates is held
+        // (BENCHMARKS.md, memory). A row with k others or fewer within
+        // the search radius doubles the radius for all.
+        let blocks = loop {
+            let grid = Cells::new(points, search).expect("more than k points");
+            let blocks: Vec<Option<NamedBlock>> = (0..rows.div_ceil(ROWS_PER_BLOCK))
+                .into_par_iter()
+                .map_init(
+                    || (Vec::new(), Vec::new()),
+                    |(list, row), b| {
+                        let mut block = NamedBlock::default();
+                        for i in b * ROWS_PER_BLOCK..rows.min((b + 1) * ROWS_PER_BLOCK) {
+                            grid.sorted_into(&points[i], list);
+                            if list.iter().filter(|&&j| same(i, j)).count() <= k {
+                                return None;
+                            }
+                            row.clear();
+                            row.extend(
+                                list.iter()
+                                    .filter(|&&j| j != i && same(i, j))
+                                    .map(|&j| (distance(&points[i], &points[j]), j)),
+                            );
+                            row.sort_unstable_by(|a: &(f64, usize), b| {
+                                a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+                            });
+                            let named = spanning_count(&points[i], row, k, |j| points[j]);
+                            block.kth.push(row[k - 1].0);
+                            block.len.push(named);
+                            block.named.extend_from_slice(&row[..named]);
+                        }
+                        Some(block)
+                    },
+                )
+                .collect();
+            if blocks.iter().all(Option::is_some) {
+                break blocks.into_iter().flatten().collect::<Vec<_>>();
             }
             search *= 2.0;
             // Every body holds more than k nodes (checked above), so a
@@ -170,36 +203,29 @@ impl Supports {
                 });
             }
         };
-        let named_rows: Vec<Vec<(f64, usize)>> = (0..rows)
-            .into_par_iter()
-            .map(|i| {
-                let mut row: Vec<(f64, usize)> = list
-                    .of(i)
-                    .iter()
-                    .filter(|&&j| j != i && same(i, j))
-                    .map(|&j| (distance(&points[i], &points[j]), j))
-                    .collect();
-                row.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                let named = spanning_count(&points[i], &row, k, |j| points[j]);
-                row.truncate(named);
-                row
-            })
-            .collect();
-        let mut radius: Vec<f64> = named_rows.iter().map(|r| r[k - 1].0).collect();
+        let mut radius: Vec<f64> = Vec::with_capacity(points.len());
+        for block in &blocks {
+            radius.extend_from_slice(&block.kth);
+        }
         radius.resize(points.len(), 0.0);
+        let entries = blocks.iter().map(|b| b.named.len()).sum();
         let mut named = NeighbourList {
             offsets: Vec::with_capacity(rows + 1),
-            indices: Vec::with_capacity(rows * k),
+            indices: Vec::with_capacity(entries),
         };
-        let mut named_distance = Vec::with_capacity(rows * k);
+        let mut named_distance = Vec::with_capacity(entries);
         named.offsets.push(0);
-        for row in &named_rows {
-            for &(d, j) in row {
-                radius[j] = radius[j].max(d);
-                named.indices.push(j);
-                named_distance.push(d);
+        for block in &blocks {
+            let mut at = 0;
+            for &len in &block.len {
+                for &(d, j) in &block.named[at..at + len] {
+                    radius[j] = radius[j].max(d);
+                    named.indices.push(j);
+                    named_distance.push(d);
+                }
+                at += len;
+                named.offsets.push(named.indices.len());
             }
-            named.offsets.push(named.indices.len());
         }
         for r in &mut radius {
             *r *= params.factor;
@@ -248,6 +274,17 @@ impl Supports {
     pub fn max_radius(&self) -> f64 {
         self.radius.iter().copied().fold(0.0, f64::max)
     }
+}
+
+/// The named pairs of a block of rows of [`Supports::compute_rows`].
+#[derive(Default)]
+struct NamedBlock {
+    /// Each row's `k`-th nearest distance.
+    kth: Vec<f64>,
+    /// Each row's number of named nodes.
+    len: Vec<usize>,
+    /// The rows' (distance, node) pairs, nearest first in each row.
+    named: Vec<(f64, usize)>,
 }
 
 /// How flat a node's named neighbourhood may be, as the determinant of the

@@ -89,11 +89,10 @@ impl Mlpg3d {
         let stamp = |e: Error| at_time(e, time);
         let mut clock = std::time::Instant::now();
         let mut g = self.geometry.take().unwrap_or_default();
-        // The old shapes and operator go before the new are built: they are
-        // most of the heap (BENCHMARKS.md, "3-D MLPG speed").
-        g.shapes = NodalShapes::default();
+        // The old traction operator goes before the new is built; the
+        // shapes and the nodal operator are rebuilt in their own buffers.
+        // They are most of the heap (BENCHMARKS.md, memory).
         g.op = TractionOperator::default();
-        g.nodal = NodalOperator::default();
         let n = self.pos.len();
         if supports || g.supports.is_none() {
             let (sup, mirror) = self.supports_with_images().map_err(stamp)?;
@@ -105,7 +104,7 @@ impl Mlpg3d {
         let sup = g.supports.as_ref().expect("computed above");
         let mut buf = Vec::new();
         let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
-        g.shapes = NodalShapes::build_rows(pts, sup, n).map_err(stamp)?;
+        g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
         if self.setup.conforming {
             let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
             let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
@@ -131,7 +130,9 @@ impl Mlpg3d {
             }
         }
         if self.setup.weak_form == WeakForm::Nodal || self.setup.smoothing_order >= 2 {
-            g.nodal = NodalOperator::build(&g.shapes, pts.len());
+            g.nodal.rebuild(&g.shapes, pts.len());
+        } else {
+            g.nodal = NodalOperator::default();
         }
         self.profile.lap(Phase::Operator, &mut clock);
         self.profile.operators += 1;

@@ -1,0 +1,36 @@
+//! Buffers refilled build after build: the geometry's arrays keep their
+//! room from one build to the next, so that a build allocates only when
+//! its arrays outgrow it (BENCHMARKS.md, memory).
+
+/// Empties `v` and fills it with `len` copies of `value`. When `v` has no
+/// room for `len`, its old buffer is freed before the new one is allocated
+/// (no moment with both), with an eighth more room than `len`: rows grow a
+/// little as a body is compressed, and the doubling of `Vec`'s own growth
+/// would hold twice the array.
+pub(crate) fn refill<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
+    v.clear();
+    if v.capacity() < len {
+        *v = Vec::new();
+        v.reserve_exact(len + len / 8);
+    }
+    v.resize(len, value);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refill within the room keeps the buffer; one past it takes an
+    /// eighth more, not double.
+    #[test]
+    fn a_refill_grows_by_an_eighth() {
+        let mut v = vec![1u32; 800];
+        let cap = v.capacity();
+        refill(&mut v, 700, 7);
+        assert_eq!((v.len(), v.capacity()), (700, cap));
+        assert!(v.iter().all(|&x| x == 7));
+        refill(&mut v, 801, 3);
+        assert_eq!((v.len(), v.capacity()), (801, 901));
+        assert!(v.iter().all(|&x| x == 3));
+    }
+}
