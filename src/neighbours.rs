@@ -241,6 +241,13 @@ impl<'a, const D: usize> Cells<'a, D> {
         out.sort_unstable();
     }
 
+    /// How many points within the radius of `p` pass `keep`.
+    pub(crate) fn count(&self, p: &[f64; D], mut keep: impl FnMut(usize) -> bool) -> usize {
+        let mut n = 0;
+        self.visit(p, |j| n += usize::from(keep(j)));
+        n
+    }
+
     fn cell_of(&self, p: &[f64; D]) -> [usize; D] {
         std::array::from_fn(|d| (((p[d] - self.lo[d]) / self.cell) as usize).min(self.dims[d] - 1))
     }

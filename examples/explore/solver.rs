@@ -143,13 +143,16 @@ pub fn explore_taylor3d_stop() {
 }
 
 /// Exploration: the phase profile of `taylor3d` run to its end
-/// (`PARTICLES_RADIAL`, default 6), printed with the CPU time per
+/// (`PARTICLES_RADIAL`, default 6), or for `STEPS` steps when that is set,
+/// printed with the wall time of the construction and of the loop per
 /// node-step (BENCHMARKS.md, "3-D MLPG speed"); with `MI_SCENE_FILE` or
 /// `MI_SET` set, of that scene instead (as `explore_energy_jump`).
 pub fn explore_taylor3d_profile() {
     let across: f64 = std::env::var("PARTICLES_RADIAL")
         .map(|s| s.parse().unwrap())
         .unwrap_or(6.0);
+    let steps: Option<u64> = std::env::var("STEPS").ok().map(|s| s.parse().unwrap());
+    let built = std::time::Instant::now();
     let mut s = if std::env::var("MI_SCENE_FILE").is_ok() || std::env::var("MI_SET").is_ok() {
         build3d(&wilkins_or_env_scene())
     } else {
@@ -159,14 +162,18 @@ pub fn explore_taylor3d_profile() {
         };
         p.build().unwrap()
     };
+    let construction = built.elapsed().as_secs_f64();
+    let construction_table = s.profile().table();
     let t0 = std::time::Instant::now();
-    while !s.finished() {
+    while !s.finished() && steps.is_none_or(|n| s.steps() < n) {
         s.step().unwrap();
     }
     let wall = t0.elapsed().as_secs_f64();
     let node_steps = s.particles() as f64 * s.steps() as f64;
     println!(
-        "{} nodes, {} steps, {wall:.2} s wall in the loop ({:.3} us per node-step)\n{}",
+        "{} nodes; the construction {construction:.2} s wall:\n{construction_table}\n\
+         {} steps, {wall:.2} s wall in the loop ({:.3} us per node-step); the phases \
+         since the construction's first:\n{}",
         s.particles(),
         s.steps(),
         wall / node_steps * 1e6,

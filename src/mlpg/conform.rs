@@ -376,24 +376,28 @@ pub fn conform(
         });
     }
     let largest = a.iter().map(|&v| norm3(v)).fold(0.0, f64::max);
+    // The loops of the conjugate gradients run on the pool: each entry is
+    // its own, and a largest value is the same in any order; only the dot
+    // products stay in order (their sums would move the bits).
     let inner_max = |r: &[[f64; 3]]| {
         (0..n)
+            .into_par_iter()
             .filter(|&j| inner[j])
             .map(|j| norm3(r[j]))
-            .fold(0.0, f64::max)
+            .reduce(|| 0.0, f64::max)
     };
     let before = inner_max(&a);
     let goal = tolerance * largest;
     // Jacobi preconditioner: A_JJ = Σ_i V_i² (1 − p_Jᵀ M_i⁻¹ p_J).
     let diag = sys.diagonal();
     let precond = |r: &[[f64; 3]], z: &mut [[f64; 3]]| {
-        for j in 0..n {
-            z[j] = if inner[j] && diag[j][0] > 0.0 {
+        z.par_iter_mut().enumerate().for_each(|(j, zj)| {
+            *zj = if inner[j] && diag[j][0] > 0.0 {
                 std::array::from_fn(|d| r[j][d] / diag[j][d])
             } else {
                 [0.0; 3]
             };
-        }
+        });
     };
     // r = b − A μ with μ = 0: b_J = −a_J on the inner nodes.
     let mut mu = vec![[0.0; 3]; n];
@@ -420,21 +424,23 @@ pub fn conform(
             break;
         }
         let alpha = rz / pap;
-        for j in 0..n {
-            for d in 0..3 {
-                mu[j][d] += alpha * p[j][d];
-                r[j][d] -= alpha * ap[j][d];
-            }
-        }
+        (&mut mu, &mut r, &p, &ap)
+            .into_par_iter()
+            .for_each(|(mu, r, p, ap)| {
+                for d in 0..3 {
+                    mu[d] += alpha * p[d];
+                    r[d] -= alpha * ap[d];
+                }
+            });
         precond(&r, &mut z);
         let rz_new = dot(&r, &z);
         let beta = rz_new / rz;
         rz = rz_new;
-        for j in 0..n {
+        p.par_iter_mut().zip(&z).for_each(|(p, z)| {
             for d in 0..3 {
-                p[j][d] = z[j][d] + beta * p[j][d];
+                p[d] = z[d] + beta * p[d];
             }
-        }
+        });
         iterations += 1;
     }
     drop(fused);

@@ -524,19 +524,14 @@ impl NodalShapes {
         };
         // Pass 1: each row's length, into offsets[i + 1].
         self.offsets[1..]
-            .par_chunks_mut(ROWS_PER_BLOCK)
+            .par_iter_mut()
             .enumerate()
-            .for_each_init(Vec::new, |list, (b, lens)| {
-                for (k, len) in lens.iter_mut().enumerate() {
-                    let i = b * ROWS_PER_BLOCK + k;
-                    candidates(i, list);
-                    *len = list
-                        .iter()
-                        .filter(|&&j| {
-                            scaled_offset(points[i], points[j], supports.radius[j]).1 < 1.0
-                        })
-                        .count();
-                }
+            .with_min_len(ROWS_PER_BLOCK)
+            .for_each(|(i, len)| {
+                *len = grid.count(&points[i], |j| {
+                    (group.is_empty() || group[j] == group[i])
+                        && scaled_offset(points[i], points[j], supports.radius[j]).1 < 1.0
+                });
             });
         for i in 0..rows {
             self.offsets[i + 1] += self.offsets[i];

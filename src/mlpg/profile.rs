@@ -26,6 +26,9 @@ pub enum Phase {
     Supports,
     /// MLS shape functions and gradients at the nodes.
     Shapes,
+    /// The conforming correction of the gradients (`src/mlpg/conform.rs`;
+    /// schemes with conforming gradients only).
+    Conform,
     /// Test spheres: the Nanson normals and the test radii.
     Spheres,
     /// The traction operator: MLS at every quadrature point.
@@ -40,7 +43,7 @@ pub enum Phase {
 
 impl Phase {
     /// Every phase, in the order of the step.
-    pub const ALL: [Phase; 13] = [
+    pub const ALL: [Phase; 14] = [
         Phase::Force,
         Phase::Kick,
         Phase::Smoothing,
@@ -49,6 +52,7 @@ impl Phase {
         Phase::Pairs,
         Phase::Supports,
         Phase::Shapes,
+        Phase::Conform,
         Phase::Spheres,
         Phase::Operator,
         Phase::Gradients,
@@ -67,6 +71,7 @@ impl Phase {
             Phase::Pairs => "spacing and rebuild checks",
             Phase::Supports => "supports (neighbour search)",
             Phase::Shapes => "MLS shapes at the nodes",
+            Phase::Conform => "conforming correction",
             Phase::Spheres => "test spheres",
             Phase::Operator => "traction operator build",
             Phase::Gradients => "gradient collocation",
@@ -80,11 +85,14 @@ impl Phase {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PhaseTimes {
     /// Wall time of each phase, indexed as [`Phase::ALL`].
-    pub wall: [Duration; 13],
+    pub wall: [Duration; 14],
     /// Builds of the supports (the first included).
     pub supports: u64,
     /// Builds of the shapes, spheres and operator (the first included).
     pub operators: u64,
+    /// Iterations of the conforming correction's conjugate gradients, over
+    /// all builds.
+    pub conform_iterations: u64,
 }
 
 impl PhaseTimes {
@@ -119,8 +127,9 @@ impl PhaseTimes {
             );
         }
         s += &format!(
-            "{:<28} {:>9.3} s ({} support builds, {} operator builds)\n",
-            "total", total, self.supports, self.operators
+            "{:<28} {:>9.3} s ({} support builds, {} operator builds, {} iterations of the \
+             conforming correction)\n",
+            "total", total, self.supports, self.operators, self.conform_iterations
         );
         s
     }

@@ -81,7 +81,10 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
          with the scene's choices (README, \"Ballistic penetration\"), at {across} nodes across \
          the projectile's radius ({} nodes): {} at {:.2} µs after {} steps in {:.1} s. \
          Projectile velocity at the end {:.1} m/s (the seed's residual velocity: \
-         {SEED_RESIDUAL} m/s, {:+.1} %), energy error {}.",
+         {SEED_RESIDUAL} m/s, {:+.1} %), energy error {}. The residual velocity under \
+         refinement, 4 to 12 nodes across as a quarter model (runs of up to an hour, not \
+         made by this report), its energy errors and the converged value with its \
+         uncertainty are in VALIDATION.md (\"penetration\").",
         run.particles,
         run.outcome.label(),
         run.time * 1e6,

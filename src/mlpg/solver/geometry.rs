@@ -105,12 +105,14 @@ impl Mlpg3d {
         let mut buf = Vec::new();
         let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
         g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
+        self.profile.lap(Phase::Shapes, &mut clock);
         if self.setup.conforming {
             let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
             let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
-            conform(&mut g.shapes, pts, &volume, &inner, CONFORM_TOLERANCE);
+            let c = conform(&mut g.shapes, pts, &volume, &inner, CONFORM_TOLERANCE);
+            self.profile.conform_iterations += c.iterations as u64;
         }
-        self.profile.lap(Phase::Shapes, &mut clock);
+        self.profile.lap(Phase::Conform, &mut clock);
         match self.setup.weak_form {
             WeakForm::Sphere => {
                 g.spheres = self.spheres(pts, &g.mirror, sup, &g.shapes);
