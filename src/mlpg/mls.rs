@@ -63,6 +63,7 @@ use crate::{Error, Result};
 use rayon::prelude::*;
 
 mod supports;
+pub(crate) use supports::candidates_of;
 #[cfg(test)]
 use supports::{Recompute, spanning_count};
 pub use supports::{SupportParams, Supports, candidates_first};
@@ -516,12 +517,8 @@ impl NodalShapes {
             return Ok(());
         };
         let group = &supports.group;
-        let candidates = |i: usize, out: &mut Vec<usize>| {
-            grid.sorted_into(&points[i], out);
-            if !group.is_empty() {
-                out.retain(|&j| group[j] == group[i]);
-            }
-        };
+        let candidates =
+            |i: usize, out: &mut Vec<usize>| candidates_of(&grid, points, group, i, out);
         // Pass 1: each row's length, into offsets[i + 1].
         self.offsets[1..]
             .par_iter_mut()

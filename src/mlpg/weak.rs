@@ -14,8 +14,11 @@
 
 use crate::Result;
 use crate::isa::Isa;
-use crate::mlpg::mls::{PointShapes, ShapeRow, Supports, candidates_first, distance};
+use crate::mlpg::mls::{
+    PointShapes, ShapeRow, Supports, candidates_first, candidates_of, distance,
+};
 use crate::mlpg::sphere::{SphereRule, TestSphere};
+use crate::neighbours::Cells;
 use rayon::prelude::*;
 
 /// The index in `[xx, yy, zz, xy, yz, zx]` of component `(a, b)`.
@@ -62,39 +65,46 @@ impl TractionOperator {
         cut: &SphereRule,
     ) -> Result<Self> {
         let reach = spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
-        let list = candidates_first(points, spheres.len(), supports, reach);
+        // Each node's candidates (its row of `candidates_first`) are found
+        // while the node is handled: no list of every node's candidates.
+        let Some(grid) = Cells::new(points, reach + supports.max_radius()) else {
+            return Self::assemble(Vec::new(), spheres);
+        };
         let radius = &supports.radius;
         let rows: Vec<Result<Row>> = (0..spheres.len())
             .into_par_iter()
-            .map_init(PointShapes::default, |ps, i| {
-                let cand = list.of(i);
-                let xi = points[i];
-                let r0 = spheres[i].radius;
-                ps.gather(
-                    cand.iter().copied().filter(|&j| {
-                        // A margin far above round-off: the narrowing only
-                        // has to keep every node that can cover a point.
-                        distance(&xi, &points[j]) <= (r0 + radius[j]) * (1.0 + 1e-9)
-                    }),
-                    points,
-                    radius,
-                );
-                let mut failed = None;
-                spheres[i].for_each_point(xi, whole, cut, |x, n, w| {
-                    if failed.is_some() {
-                        return;
+            .map_init(
+                || (PointShapes::default(), Vec::new()),
+                |(ps, cand), i| {
+                    candidates_of(&grid, points, &supports.group, i, cand);
+                    let xi = points[i];
+                    let r0 = spheres[i].radius;
+                    ps.gather(
+                        cand.iter().copied().filter(|&j| {
+                            // A margin far above round-off: the narrowing only
+                            // has to keep every node that can cover a point.
+                            distance(&xi, &points[j]) <= (r0 + radius[j]) * (1.0 + 1e-9)
+                        }),
+                        points,
+                        radius,
+                    );
+                    let mut failed = None;
+                    spheres[i].for_each_point(xi, whole, cut, |x, n, w| {
+                        if failed.is_some() {
+                            return;
+                        }
+                        if let Err(e) = ps.evaluate(isa, x, i) {
+                            failed = Some(e);
+                            return;
+                        }
+                        ps.accumulate(n, w);
+                    });
+                    if let Some(e) = failed {
+                        return Err(e);
                     }
-                    if let Err(e) = ps.evaluate(isa, x, i) {
-                        failed = Some(e);
-                        return;
-                    }
-                    ps.accumulate(n, w);
-                });
-                if let Some(e) = failed {
-                    return Err(e);
-                }
-                Ok(ps.row())
-            })
+                    Ok(ps.row())
+                },
+            )
             .collect();
         Self::assemble(rows, spheres)
     }
@@ -155,11 +165,16 @@ impl TractionOperator {
     /// The operator of the rows of every node, in node order (the first
     /// failed row's error).
     fn assemble(rows: Vec<Result<Row>>, spheres: &[TestSphere]) -> Result<Self> {
+        // The rows' entries counted first, so that the operator is
+        // allocated once at its size (no doubling beside the rows).
+        let entries: usize = rows.iter().flatten().map(|(nodes, _)| nodes.len()).sum();
         let mut op = TractionOperator {
-            offsets: vec![0],
+            offsets: Vec::with_capacity(rows.len() + 1),
+            nodes: Vec::with_capacity(entries),
+            b: Vec::with_capacity(entries),
             volume: spheres.iter().map(TestSphere::volume).collect(),
-            ..TractionOperator::default()
         };
+        op.offsets.push(0);
         for row in rows {
             let (nodes, b) = row?;
             op.nodes.extend_from_slice(&nodes);

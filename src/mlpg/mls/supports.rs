@@ -370,6 +370,24 @@ pub(super) fn thin_start(extents: [f64; 3], fill: f64) -> f64 {
     e[0] * fill
 }
 
+/// Writes into `out` the row of node `i` of [`candidates_first`] from its
+/// `grid` (cells of side `reach + supports.max_radius()` over `points`):
+/// every node within the radius, of `i`'s body, ascending. One row at a
+/// time, so that no list of every node's candidates is held
+/// (BENCHMARKS.md, memory).
+pub(crate) fn candidates_of(
+    grid: &Cells<3>,
+    points: &[[f64; 3]],
+    group: &[u8],
+    i: usize,
+    out: &mut Vec<usize>,
+) {
+    grid.sorted_into(&points[i], out);
+    if !group.is_empty() {
+        out.retain(|&j| group[j] == group[i]);
+    }
+}
+
 /// Candidate nodes for points within `reach` of each node: the cell-list
 /// neighbours within `reach + max r_J`, a superset of the nodes whose
 /// supports cover any point within `reach` of the node.
