@@ -73,8 +73,9 @@ mod budget;
 // the pointer and panic helpers they share (here), the dispatch to the
 // compiled copies of the hot loops (`hot!` in src/isa.rs), the team of
 // threads sharing disjoint chunks of the axisymmetric step's arrays
-// (src/solver/team.rs, and the chunk sets `named_parts!` declares) and the
-// AVX-512 kernels of its pair pass (src/solver/pairs/avx512.rs).
+// (src/solver/team.rs, and the chunk sets `named_parts!` declares), the
+// AVX-512 kernels of its pair pass (src/solver/pairs/avx512.rs) and the
+// read of the stepping thread's processor time (src/mlpg/profile.rs).
 #[allow(unsafe_code)]
 mod capi;
 mod error;
@@ -171,6 +172,7 @@ pub mod internals {
             Body, Cylinder, Mlpg3d, NodalShapes, NodeLattice, RodSetup, SphereRule, SupportParams,
             Supports, TestSphere, TractionOperator,
         };
+        pub use crate::scene::penetration::penetration;
     }
     pub use crate::kernel::kernel2;
     pub use crate::lanes::W;

@@ -52,6 +52,11 @@ const EXPLORATIONS: &[(&str, &str, fn())] = &[
         solver::explore_taylor3d_profile,
     ),
     (
+        "penetration_profile",
+        "the phase profile of the penetration scene, with serial time (MI_SET, STEPS)",
+        solver::explore_penetration_profile,
+    ),
+    (
         "wilkins3d_face",
         "the face region of the Wilkins bar in 3-D every 2.5 us (MI_SET)",
         solver::explore_wilkins3d_face,

@@ -2,7 +2,9 @@
 //! `tests/suite/mlpg_solver.rs`).
 
 use crate::rod::*;
-use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup, WeakForm};
+use meshless_impact::internals::mlpg::{
+    Cylinder, Mlpg3d, Penetration, RodSetup, WeakForm, penetration,
+};
 use meshless_impact::{Scene, Taylor3dParams};
 
 /// Exploration: an elastic Taylor impact at 10 m/s, printed (RINGS, ZETA;
@@ -145,13 +147,13 @@ pub fn explore_taylor3d_stop() {
 /// Exploration: the phase profile of `taylor3d` run to its end
 /// (`PARTICLES_RADIAL`, default 6), or for `STEPS` steps when that is set,
 /// printed with the wall time of the construction and of the loop per
-/// node-step (BENCHMARKS.md, "3-D MLPG speed"); with `MI_SCENE_FILE` or
-/// `MI_SET` set, of that scene instead (as `explore_energy_jump`).
+/// node-step, and each phase's serial time (BENCHMARKS.md, "3-D MLPG
+/// speed"); with `MI_SCENE_FILE` or `MI_SET` set, of that scene instead
+/// (as `explore_energy_jump`).
 pub fn explore_taylor3d_profile() {
     let across: f64 = std::env::var("PARTICLES_RADIAL")
         .map(|s| s.parse().unwrap())
         .unwrap_or(6.0);
-    let steps: Option<u64> = std::env::var("STEPS").ok().map(|s| s.parse().unwrap());
     let built = std::time::Instant::now();
     let mut s = if std::env::var("MI_SCENE_FILE").is_ok() || std::env::var("MI_SET").is_ok() {
         build3d(&wilkins_or_env_scene())
@@ -164,20 +166,107 @@ pub fn explore_taylor3d_profile() {
     };
     let construction = built.elapsed().as_secs_f64();
     let construction_table = s.profile().table();
-    let t0 = std::time::Instant::now();
-    while !s.finished() && steps.is_none_or(|n| s.steps() < n) {
-        s.step().unwrap();
+    s.count_serial(true);
+    profile_loop(construction, construction_table, &mut s);
+}
+
+/// Exploration: the phase profile of the built-in `penetration` scene with
+/// the overrides `MI_SET` ("name=value,..."), run to its end or for `STEPS`
+/// steps, printed as `taylor3d_profile` prints.
+pub fn explore_penetration_profile() {
+    let mut scene = Scene::builtin("penetration").unwrap();
+    for kv in std::env::var("MI_SET").unwrap_or_default().split(',') {
+        if let Some((k, v)) = kv.split_once('=') {
+            scene.set(k, v.parse().unwrap()).unwrap();
+        }
+    }
+    let built = std::time::Instant::now();
+    let mut s = penetration(&scene).unwrap();
+    let construction = built.elapsed().as_secs_f64();
+    let construction_table = s.run().profile().table();
+    s.count_serial(true);
+    profile_loop(construction, construction_table, &mut s);
+}
+
+/// A 3-D run whose phases are profiled.
+trait Profiled {
+    fn done(&self) -> bool;
+    fn step_count(&self) -> u64;
+    fn step_once(&mut self);
+    /// Nodes, the phase table and the serial time.
+    fn report(&self) -> (usize, String, std::time::Duration);
+}
+
+impl Profiled for Mlpg3d {
+    fn done(&self) -> bool {
+        self.finished()
+    }
+    fn step_count(&self) -> u64 {
+        self.steps()
+    }
+    fn step_once(&mut self) {
+        self.step().unwrap()
+    }
+    fn report(&self) -> (usize, String, std::time::Duration) {
+        let p = self.profile();
+        (self.particles(), p.table(), p.serial_total())
+    }
+}
+
+impl Profiled for Penetration {
+    fn done(&self) -> bool {
+        self.finished()
+    }
+    fn step_count(&self) -> u64 {
+        self.steps()
+    }
+    fn step_once(&mut self) {
+        self.step().unwrap()
+    }
+    fn report(&self) -> (usize, String, std::time::Duration) {
+        self.run().report()
+    }
+}
+
+/// The process's processor time (user and system) from /proc/self/stat.
+fn process_cpu() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit_once(')').map(|p| p.1).unwrap_or("");
+    let f: Vec<f64> = after
+        .split_whitespace()
+        .map(|x| x.parse().unwrap_or(0.0))
+        .collect();
+    // utime and stime are fields 14 and 15 (11 and 12 after the name).
+    (f.get(11).unwrap_or(&0.0) + f.get(12).unwrap_or(&0.0)) / 100.0
+}
+
+/// Steps `s` until it finishes (or `STEPS` steps) and prints the profile
+/// of the loop: wall per node-step, the phases with their serial time, and
+/// the serial share of the loop's wall time.
+fn profile_loop(construction: f64, construction_table: String, s: &mut impl Profiled) {
+    let steps: Option<u64> = std::env::var("STEPS").ok().map(|s| s.parse().unwrap());
+    let threads = rayon::current_num_threads();
+    let (t0, cpu0) = (std::time::Instant::now(), process_cpu());
+    let first = s.step_count();
+    while !s.done() && steps.is_none_or(|n| s.step_count() < n) {
+        s.step_once();
     }
     let wall = t0.elapsed().as_secs_f64();
-    let node_steps = s.particles() as f64 * s.steps() as f64;
+    let cpu = process_cpu() - cpu0;
+    let (particles, table, serial) = s.report();
+    let taken = s.step_count() - first;
+    let node_steps = particles as f64 * taken as f64;
+    let serial = serial.as_secs_f64();
     println!(
-        "{} nodes; the construction {construction:.2} s wall:\n{construction_table}\n\
-         {} steps, {wall:.2} s wall in the loop ({:.3} us per node-step); the phases \
-         since the construction's first:\n{}",
-        s.particles(),
-        s.steps(),
+        "{particles} nodes, {threads} threads; the construction {construction:.2} s wall:\n\
+         {construction_table}\n{taken} steps, {wall:.2} s wall in the loop ({:.3} us per \
+         node-step), {cpu:.2} s of processor time; the phases since the construction's \
+         first:\n{table}serial time {serial:.3} s: {:.2} % of the loop's wall time; with the \
+         parallel work (processor time less the serial) spread evenly over the {threads} \
+         threads, {:.2} %",
         wall / node_steps * 1e6,
-        s.profile().table()
+        100.0 * serial / wall,
+        100.0 * serial / (serial + (cpu - serial).max(0.0) / threads as f64)
     );
 }
 

@@ -107,6 +107,12 @@ impl Penetration {
         &self.run
     }
 
+    /// Turns on or off the counting of each phase's serial time in the
+    /// run's profile ([`Mlpg3d::count_serial`]).
+    pub fn count_serial(&mut self, on: bool) {
+        self.run.count_serial(on);
+    }
+
     /// The setup.
     pub fn setup(&self) -> &PenetrationSetup {
         &self.setup

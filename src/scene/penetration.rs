@@ -39,12 +39,7 @@ pub static ROW: SceneRow = SceneRow {
     // 29 kB as a quarter): the contact pairs and the damaged plate's
     // supports grow (BENCHMARKS.md, "Memory per node").
     memory: MemoryPerNode { bytes: 40_000.0 },
-    build: |s: &Scene| {
-        let (setup, (projectile, plate), numerics) = setup(s)?;
-        Ok(Box::new(Penetration::new(
-            setup, projectile, plate, numerics,
-        )?))
-    },
+    build: |s: &Scene| Ok(Box::new(penetration(s)?)),
     restore: restore::<Penetration>,
     fmu: Some(super::registry::FmuIdentity {
         model_identifier: "BallisticImpact",
@@ -283,6 +278,12 @@ fn nodes(s: &Scene) -> f64 {
     } else {
         nodes
     }
+}
+
+/// The run of a `penetration` scene (its registry row's build, typed).
+pub fn penetration(s: &Scene) -> Result<Penetration> {
+    let (setup, (projectile, plate), numerics) = setup(s)?;
+    Penetration::new(setup, projectile, plate, numerics)
 }
 
 /// The setup, the two materials and the solver's choices of a scene, with

@@ -87,7 +87,7 @@ impl Mlpg3d {
     pub(super) fn build_geometry(&mut self, supports: bool) -> Result<()> {
         let time = self.time;
         let stamp = |e: Error| at_time(e, time);
-        let mut clock = std::time::Instant::now();
+        let mut clock = self.profile.clock();
         let mut g = self.geometry.take().unwrap_or_default();
         // The old traction operator goes before the new is built; the
         // shapes and the nodal operator are rebuilt in their own buffers.

@@ -94,7 +94,7 @@ use super::lattice::{Cylinder, NodeLattice, Surfaces};
 use super::mirror::{self, Mirror};
 use super::mls::{NodalShapes, SupportParams, Supports, distance};
 use super::nodal::NodalOperator;
-use super::profile::{Phase, PhaseTimes};
+use super::profile::{Clock, Phase, PhaseTimes};
 use super::shift::{Freedom, carry, exchange, shifts};
 use super::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii};
 use super::step::{OMEGA_FACTOR, OMEGA_FACTOR_CONFORMING, OMEGA_FACTOR_NODAL, stable_step_with};
@@ -446,7 +446,7 @@ impl Mlpg3d {
             self.rebuilds -= 1;
         }
         let n = self.particles();
-        let clock = std::time::Instant::now();
+        let clock = self.profile.clock();
         self.material_state.fit(n);
         let mut scratch = std::mem::take(&mut self.scratch);
         scratch.fit(n);

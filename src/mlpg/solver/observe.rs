@@ -160,6 +160,12 @@ impl Mlpg3d {
         &self.profile
     }
 
+    /// Turns on or off the counting of each phase's serial time in
+    /// [`Mlpg3d::profile`] ([`PhaseTimes::count_serial`]).
+    pub fn count_serial(&mut self, on: bool) {
+        self.profile.count_serial(on);
+    }
+
     /// The rod observables of the current state.
     pub fn rod(&self) -> RodObservables {
         RodObservables::of::<3>(
