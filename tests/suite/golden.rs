@@ -14,7 +14,11 @@
 //! `penetration`'s quarter model. On 2026-11-28 (issue 50) that case gained
 //! the observable `shot_outcome` (0, undecided, at 2 µs): its history's
 //! checksum, which covers every observable, was re-recorded then, and its
-//! first twelve finals kept their bits.
+//! first twelve finals kept their bits. On 2026-11-28 (issue 52) the
+//! default `taylor3d` case was re-recorded when the conforming correction's
+//! conjugate gradients began to stop at 1e-5 (was 1e-8) and to start from
+//! the last build's multipliers (its finals moved in the eighth digit;
+//! BENCHMARKS.md, "The conforming correction's stop").
 //!
 //! `plate_impact` was added on 2026-11-28 (its uniaxial solver has no
 //! compiled copies; the digest is the same in each), with the ceramic set
@@ -162,24 +166,24 @@ fn cases() -> Vec<Golden> {
             scene: "taylor3d",
             sets: &[("particles_radial", 4.0), ("end_time", 5e-6)],
             finals: &[
-                0x3fa2_f97b_446d_6fa2,
-                0x3f72_242d_970a_36d6,
-                0x3f95_d446_3d84_4001,
-                0x4066_92e2_df31_99a1,
+                0x3fa2_f97b_440c_7a57,
+                0x3f72_242d_99e0_9136,
+                0x3f95_d444_ec5b_e0ec,
+                0x4066_92e2_dd6f_ef0f,
                 0x0000_0000_0000_0000,
-                0x3fd7_a748_f34b_6732,
-                0x4079_fc40_ee7f_26e3,
-                0x4064_c3a6_9f26_ca51,
-                0x4048_c659_e653_f84d,
-                0x3ff2_b3b0_843b_0c00,
-                0x4012_39db_1f16_fb7f,
-                0x3f6b_fced_45d7_2ad3,
+                0x3fd7_a749_7cad_c3a2,
+                0x4079_fc41_1b08_f2a4,
+                0x4064_c3a6_a117_2586,
+                0x4048_c659_da3e_409d,
+                0x3ff2_b3b1_0e36_e280,
+                0x4012_39db_3123_76ac,
+                0x3f6b_fced_ec17_646b,
                 0x0000_0000_0000_0000,
-                0x3f7c_2546_280e_6e62,
+                0x3f7c_2544_2156_9d67,
                 0x0000_0000_0000_0000,
-                0x4047_4db0_ea34_6c2c,
+                0x4047_4db1_371a_12cc,
             ],
-            history: 0xe700_589e_43d8_4634,
+            history: 0x6663_0727_e27a_8d8f,
             rows: 51,
         },
         Golden {

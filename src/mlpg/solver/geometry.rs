@@ -19,6 +19,9 @@ pub(super) struct Geometry {
     /// The mirror images of the quarter model (none for the whole body),
     /// chosen with the supports.
     pub(super) mirror: Mirror,
+    /// The conforming correction's multipliers at this build (empty
+    /// without it): the next build starts from them.
+    pub(super) multipliers: Vec<[f64; 3]>,
 }
 
 /// What [`Mlpg3d::named_pairs`] finds.
@@ -109,7 +112,20 @@ impl Mlpg3d {
         if self.setup.conforming {
             let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
             let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
-            let c = conform(&mut g.shapes, pts, &volume, &inner, CONFORM_TOLERANCE);
+            // The start: the last build's multipliers in this process, or
+            // the saved start of a restored run's last build.
+            if !g.multipliers.is_empty() {
+                self.built_multipliers.clone_from(&g.multipliers);
+            }
+            g.multipliers.clone_from(&self.built_multipliers);
+            let c = conform(
+                &mut g.shapes,
+                pts,
+                &volume,
+                &inner,
+                CONFORM_TOLERANCE,
+                &mut g.multipliers,
+            );
             self.profile.conform_iterations += c.iterations as u64;
         }
         self.profile.lap(Phase::Conform, &mut clock);

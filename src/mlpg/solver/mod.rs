@@ -162,6 +162,11 @@ pub struct Mlpg3d {
     /// restored run rebuilds them as they were).
     #[serde(default)]
     built_rho: Vec<f64>,
+    /// The multipliers the conforming correction started from at the last
+    /// build (those of the build before; empty: from zero), so a restored
+    /// run rebuilds its gradients as they were ([`conform`]'s warm start).
+    #[serde(default)]
+    built_multipliers: Vec<[f64; 3]>,
     /// The anvil's reaction on each node held on it at the last step's
     /// forces, `−F_z ≥ 0` (N; zero on a free node): a release is timed by
     /// the zero of the node's net axial force between that step and the
@@ -338,6 +343,7 @@ impl Mlpg3d {
             vel,
             mass,
             built_rho: rho.clone(),
+            built_multipliers: Vec::new(),
             rho,
             dev: vec![[0.0; 6]; n],
             pressure: vec![0.0; n],

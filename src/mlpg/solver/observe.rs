@@ -124,6 +124,7 @@ impl Mlpg3d {
             + b(&self.built_reference)
             + b(&self.built_contact)
             + b(&self.built_rho)
+            + b(&self.built_multipliers)
             + b(&self.reaction)
             + b(&l.position)
             + b(&l.volume)
@@ -139,7 +140,7 @@ impl Mlpg3d {
                     b(&s.radius) + b(&s.named.offsets) + b(&s.named.indices) + b(&s.named_distance);
             }
             let h = &g.shapes;
-            shapes = b(&h.offsets) + b(&h.nodes) + b(&h.phi) + b(&h.grad);
+            shapes = b(&h.offsets) + b(&h.nodes) + b(&h.phi) + b(&h.grad) + b(&g.multipliers);
             spheres = b(&g.spheres);
             let o = &g.op;
             op = b(&o.offsets) + b(&o.nodes) + b(&o.b) + b(&o.volume) + g.nodal.bytes();

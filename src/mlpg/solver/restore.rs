@@ -59,6 +59,17 @@ impl Mlpg3d {
                 return Err(format!("its {what} are not {n} finite, physical values"));
             }
         }
+        if !(self.built_multipliers.is_empty() || self.built_multipliers.len() == n)
+            || !self
+                .built_multipliers
+                .iter()
+                .flatten()
+                .all(|x| x.is_finite())
+        {
+            return Err(format!(
+                "its multipliers of the conforming correction are not none or {n} finite vectors"
+            ));
+        }
         if self.contact.len() != n || self.built_contact.len() != n {
             return Err(format!("its contact flags are not {n}"));
         }
