@@ -35,7 +35,7 @@
 //! threads.
 
 use super::mls::NodalShapes;
-use super::nodal::transpose;
+use super::nodal::{entry_parts, for_segments, transpose};
 use rayon::prelude::*;
 
 /// Where the solver stops the conjugate gradients: when the largest inner
@@ -71,13 +71,18 @@ pub struct Conformed {
 /// ([`super::nodal::transpose`]).
 struct Columns {
     offsets: Vec<usize>,
-    entries: Vec<(u32, u32)>,
+    entries: Vec<u64>,
 }
 
 impl Columns {
     fn of(shapes: &NodalShapes, columns: usize) -> Self {
         let (offsets, entries) = transpose(shapes, columns);
         Columns { offsets, entries }
+    }
+
+    /// The entry `q` and the row `i` of the `k`-th entry.
+    fn at(&self, k: usize) -> (usize, usize) {
+        entry_parts(self.entries[k])
     }
 }
 
@@ -163,6 +168,7 @@ impl<'a> System<'a> {
     ) -> Self {
         let n = shapes.len();
         let scale: Vec<f64> = (0..n)
+            .into_par_iter()
             .map(|i| {
                 shapes
                     .row(i)
@@ -259,7 +265,7 @@ impl<'a> System<'a> {
                     return yj;
                 }
                 for k in c.offsets[j]..c.offsets[j + 1] {
-                    let i = c.entries[k].1 as usize;
+                    let i = c.at(k).1;
                     let p = basis(self.points[j], self.points[i], self.scale[i]);
                     let m = &self.minv[i];
                     let pmp: f64 = (0..4)
@@ -285,7 +291,7 @@ impl<'a> System<'a> {
                 return;
             }
             for k in c.offsets[j]..c.offsets[j + 1] {
-                let (q, i) = (c.entries[k].0 as usize, c.entries[k].1 as usize);
+                let (q, i) = c.at(k);
                 let v = self.volume[i].powi(power);
                 for d in 0..3 {
                     yj[d] += v * w[q][d];
@@ -319,7 +325,7 @@ impl Fused {
                     return 0.0;
                 }
                 (c.offsets[j]..c.offsets[j + 1])
-                    .map(|k| sys.volume[c.entries[k].1 as usize].powi(2))
+                    .map(|k| sys.volume[c.at(k).1].powi(2))
                     .sum()
             })
             .collect();
@@ -344,7 +350,7 @@ impl Fused {
             let xj = sys.points[j];
             let mut t = [0.0; 3];
             for k in c.offsets[j]..c.offsets[j + 1] {
-                let i = c.entries[k].1 as usize;
+                let i = c.at(k).1;
                 let p = basis(xj, sys.points[i], sys.scale[i]);
                 for d in 0..3 {
                     t[d] += (0..4).map(|a| p[a] * w[i][a][d]).sum::<f64>();
@@ -385,7 +391,7 @@ pub fn conform(
         let c = &sys.columns;
         a.par_iter_mut().enumerate().for_each(|(j, aj)| {
             for k in c.offsets[j]..c.offsets[j + 1] {
-                let (q, i) = (c.entries[k].0 as usize, c.entries[k].1 as usize);
+                let (q, i) = c.at(k);
                 for d in 0..3 {
                     aj[d] += volume[i] * shapes.grad[q][d];
                 }
@@ -486,14 +492,7 @@ pub fn conform(
     let lambda: Vec<[[f64; 3]; 4]> = (0..n).into_par_iter().map(|i| sys.lambda(i, mu)).collect();
     let System { scale, .. } = sys;
     let (offsets, nodes) = (&shapes.offsets, &shapes.nodes);
-    let mut rows: Vec<(usize, &mut [[f64; 3]])> = Vec::with_capacity(n);
-    let mut rest = &mut shapes.grad[..];
-    for i in 0..n {
-        let (head, tail) = rest.split_at_mut(offsets[i + 1] - offsets[i]);
-        rows.push((i, head));
-        rest = tail;
-    }
-    rows.into_par_iter().for_each(|(i, grad)| {
+    for_segments(&mut shapes.grad, offsets, &|i, grad| {
         let v = volume[i];
         for (g, q) in grad.iter_mut().zip(offsets[i]..offsets[i + 1]) {
             let j = nodes[q];
@@ -504,19 +503,24 @@ pub fn conform(
             }
         }
     });
-    // The constraint after, measured afresh.
-    let mut after = 0.0f64;
+    // The constraint after, measured afresh (the largest is the same in
+    // any order).
     let cols = &columns;
-    for j in (0..n).filter(|&j| inner[j]) {
-        let mut s = [0.0; 3];
-        for k in cols.offsets[j]..cols.offsets[j + 1] {
-            let (q, i) = (cols.entries[k].0 as usize, cols.entries[k].1 as usize);
-            for d in 0..3 {
-                s[d] += volume[i] * shapes.grad[q][d];
+    let grad = &shapes.grad;
+    let after = (0..n)
+        .into_par_iter()
+        .filter(|&j| inner[j])
+        .map(|j| {
+            let mut s = [0.0; 3];
+            for k in cols.offsets[j]..cols.offsets[j + 1] {
+                let (q, i) = cols.at(k);
+                for d in 0..3 {
+                    s[d] += volume[i] * grad[q][d];
+                }
             }
-        }
-        after = after.max(norm3(s));
-    }
+            norm3(s)
+        })
+        .reduce(|| 0.0, f64::max);
     Conformed {
         iterations,
         before,

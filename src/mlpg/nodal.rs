@@ -34,36 +34,110 @@ use super::buffers::refill;
 use super::mls::NodalShapes;
 use super::weak::VOIGT;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// The transpose of the rows of `shapes` over `columns ≥ shapes.len()`
 /// nodes, by a counting sort: column `J` is `offsets[J]..offsets[J + 1]`
-/// of the entries `(q, i)`, `q` the entry of row `i` that names `J`, in
-/// ascending `i`.
-pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<(u32, u32)>) {
+/// of the entries `q << 32 | i` ([`entry_parts`]), `q` the entry of row
+/// `i` that names `J`, in ascending `i`.
+pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<u64>) {
     let mut offsets = Vec::new();
     column_offsets(shapes, columns, &mut offsets);
-    let mut next = offsets.clone();
-    let mut entries = vec![(0, 0); shapes.nodes.len()];
-    for i in 0..shapes.len() {
-        for q in shapes.row(i) {
-            let j = shapes.nodes[q];
-            entries[next[j]] = (q as u32, i as u32);
-            next[j] += 1;
-        }
-    }
+    let entries = column_entries(shapes, &offsets);
     (offsets, entries)
 }
 
+/// The entry `q` and the row `i` of a transposed entry `q << 32 | i`.
+pub(crate) fn entry_parts(e: u64) -> (usize, usize) {
+    ((e >> 32) as usize, (e & 0xffff_ffff) as usize)
+}
+
 /// Where each of the `columns` columns of `shapes` starts among the entries
-/// of the transpose: `columns + 1` offsets, written into `offsets`.
+/// of the transpose: `columns + 1` offsets, written into `offsets`. The
+/// counts run on the pool (an atomic counter per column; a count is the
+/// same in any order).
 fn column_offsets(shapes: &NodalShapes, columns: usize, offsets: &mut Vec<usize>) {
+    let counts: Vec<AtomicUsize> = (0..columns)
+        .into_par_iter()
+        .map(|_| AtomicUsize::new(0))
+        .collect();
+    shapes.nodes.par_chunks(1 << 14).for_each(|chunk| {
+        for &j in chunk {
+            counts[j].fetch_add(1, Ordering::Relaxed);
+        }
+    });
     refill(offsets, columns + 1, 0);
-    for &j in &shapes.nodes {
-        offsets[j + 1] += 1;
+    for (j, c) in counts.into_iter().enumerate() {
+        offsets[j + 1] = offsets[j] + c.into_inner();
     }
-    for j in 0..columns {
-        offsets[j + 1] += offsets[j];
+}
+
+/// The entries of the transpose of `shapes` whose columns start at
+/// `offsets`, each `q << 32 | i`, in ascending `i` within each column.
+/// The scatter runs on the pool, each entry placed by its column's atomic
+/// cursor, and then each column is sorted: a column's entries are
+/// distinct, and ascending `q` is ascending `i` (the rows are stored in
+/// order), so the result is that of a serial counting sort for any number
+/// of threads.
+fn column_entries(shapes: &NodalShapes, offsets: &[usize]) -> Vec<u64> {
+    let columns = offsets.len() - 1;
+    let cursor: Vec<AtomicUsize> = offsets[..columns]
+        .par_iter()
+        .map(|&o| AtomicUsize::new(o))
+        .collect();
+    let slots: Vec<AtomicU64> = (0..shapes.nodes.len())
+        .into_par_iter()
+        .map(|_| AtomicU64::new(0))
+        .collect();
+    (0..shapes.len()).into_par_iter().for_each(|i| {
+        for q in shapes.row(i) {
+            let k = cursor[shapes.nodes[q]].fetch_add(1, Ordering::Relaxed);
+            slots[k].store((q as u64) << 32 | i as u64, Ordering::Relaxed);
+        }
+    });
+    // In place (the same size and alignment): no second buffer.
+    let mut entries: Vec<u64> = slots.into_iter().map(AtomicU64::into_inner).collect();
+    for_segments(&mut entries, offsets, &|_, column| column.sort_unstable());
+    entries
+}
+
+/// Calls `f(j, segment)` on the pool for each segment `j` of `data`,
+/// `offsets[j]..offsets[j + 1]` (`offsets` ascending, its last entry at
+/// most `data.len()`), splitting the segments in halves recursively.
+pub(crate) fn for_segments<T: Send>(
+    data: &mut [T],
+    offsets: &[usize],
+    f: &(impl Fn(usize, &mut [T]) + Sync),
+) {
+    fn split<T: Send>(
+        data: &mut [T],
+        base: usize,
+        first: usize,
+        offsets: &[usize],
+        f: &(impl Fn(usize, &mut [T]) + Sync),
+    ) {
+        // `data` holds segments first..first + offsets.len() - 1, starting
+        // at `base` in the whole.
+        let count = offsets.len() - 1;
+        if count <= 256 {
+            let mut rest = data;
+            for j in 0..count {
+                let (head, tail) = rest.split_at_mut(offsets[j + 1] - offsets[j]);
+                f(first + j, head);
+                rest = tail;
+            }
+            return;
+        }
+        let mid = count / 2;
+        let (left, right) = data.split_at_mut(offsets[mid] - base);
+        rayon::join(
+            || split(left, base, first, &offsets[..=mid], f),
+            || split(right, offsets[mid], first + mid, &offsets[mid..], f),
+        );
     }
+    let start = offsets[0];
+    let end = offsets[offsets.len() - 1];
+    split(&mut data[start..end], start, 0, offsets, f);
 }
 
 /// The transpose of the nodal shape functions and their gradients: for
@@ -97,21 +171,17 @@ impl NodalOperator {
     /// entries beside it (BENCHMARKS.md, memory).
     pub fn rebuild(&mut self, shapes: &NodalShapes, columns: usize) {
         column_offsets(shapes, columns, &mut self.offsets);
-        let mut next = self.offsets[..columns].to_vec();
+        let entries = column_entries(shapes, &self.offsets);
         let total = shapes.nodes.len();
         refill(&mut self.nodes, total, 0);
         refill(&mut self.grad, total, [0.0; 3]);
         refill(&mut self.phi, total, 0.0);
-        for i in 0..shapes.len() {
-            for q in shapes.row(i) {
-                let j = shapes.nodes[q];
-                let k = next[j];
-                self.nodes[k] = i;
-                self.grad[k] = shapes.grad[q];
-                self.phi[k] = shapes.phi[q];
-                next[j] += 1;
-            }
-        }
+        (&mut self.nodes, &mut self.grad, &mut self.phi, &entries)
+            .into_par_iter()
+            .for_each(|(node, grad, phi, &e)| {
+                let (q, i) = entry_parts(e);
+                (*node, *grad, *phi) = (i, shapes.grad[q], shapes.phi[q]);
+            });
     }
 
     /// `out = Hᵀ y`, the transpose of the defect operator `H = I − Φ` with
@@ -258,6 +328,83 @@ mod tests {
                     .expect("the entry is in row i of the shapes");
                 assert_eq!(shapes.grad[k], op.grad[q]);
                 assert_eq!(shapes.phi[k], op.phi[q]);
+            }
+        }
+    }
+
+    /// The plain twin of [`transpose`]: the serial counting sort.
+    fn serial_transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<u64>) {
+        let mut offsets = vec![0; columns + 1];
+        for &j in &shapes.nodes {
+            offsets[j + 1] += 1;
+        }
+        for j in 0..columns {
+            offsets[j + 1] += offsets[j];
+        }
+        let mut next = offsets.clone();
+        let mut entries = vec![0; shapes.nodes.len()];
+        for i in 0..shapes.len() {
+            for q in shapes.row(i) {
+                let j = shapes.nodes[q];
+                entries[next[j]] = (q as u64) << 32 | i as u64;
+                next[j] += 1;
+            }
+        }
+        (offsets, entries)
+    }
+
+    /// The transpose on the pool (atomic cursors, then each column sorted)
+    /// is its serial twin exactly, on 1, 2 and 5 threads, with columns past
+    /// the rows (mirror images) left empty; the operator built from it
+    /// holds the same entries.
+    #[test]
+    fn the_parallel_transpose_is_the_serial_one_on_any_threads() {
+        let (shapes, _, _, _) = setup();
+        let columns = shapes.len() + 7;
+        let want = serial_transpose(&shapes, columns);
+        for threads in [1, 2, 5] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (got, op) = pool.install(|| {
+                (
+                    transpose(&shapes, columns),
+                    NodalOperator::build(&shapes, columns),
+                )
+            });
+            assert!(got == want, "{threads} threads");
+            assert_eq!(op.offsets, want.0, "{threads} threads");
+            for (k, &e) in want.1.iter().enumerate() {
+                let (q, i) = entry_parts(e);
+                assert_eq!(
+                    (op.nodes[k], op.grad[k], op.phi[k]),
+                    (i, shapes.grad[q], shapes.phi[q])
+                );
+            }
+        }
+    }
+
+    /// Each segment is visited once, with its index, whatever its length
+    /// (empty ones included) and however many there are.
+    #[test]
+    fn every_segment_is_visited_once() {
+        for count in [0usize, 1, 3, 256, 257, 1000] {
+            // Lengths 0, 1, 2, 0, 1, 2, ...
+            let offsets: Vec<usize> = (0..=count)
+                .scan(0, |at, j| {
+                    let start = *at;
+                    *at += j % 3;
+                    Some(start)
+                })
+                .collect();
+            let mut data = vec![usize::MAX; offsets[count]];
+            for_segments(&mut data, &offsets, &|j, seg| {
+                assert_eq!(seg.len(), offsets[j + 1] - offsets[j]);
+                seg.iter_mut().for_each(|x| *x = j);
+            });
+            for j in 0..count {
+                assert!(data[offsets[j]..offsets[j + 1]].iter().all(|&x| x == j));
             }
         }
     }
