@@ -127,11 +127,12 @@ fn invert4(m: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
     inv
 }
 
+/// `a · b`, summed on the pool in the fixed order of [`super::sums`].
 fn dot(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| x[0] * y[0] + x[1] * y[1] + x[2] * y[2])
-        .sum()
+    super::sums::sum(a.len().min(b.len()), |j| {
+        let (x, y) = (a[j], b[j]);
+        x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+    })
 }
 
 fn norm3(v: [f64; 3]) -> f64 {

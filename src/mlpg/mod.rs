@@ -42,6 +42,7 @@ pub mod shift;
 pub mod solver;
 pub mod sphere;
 pub mod step;
+mod sums;
 pub mod weak;
 
 #[cfg(test)]

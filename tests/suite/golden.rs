@@ -18,7 +18,15 @@
 //! default `taylor3d` case was re-recorded when the conforming correction's
 //! conjugate gradients began to stop at 1e-5 (was 1e-8) and to start from
 //! the last build's multipliers (its finals moved in the eighth digit;
-//! BENCHMARKS.md, "The conforming correction's stop").
+//! BENCHMARKS.md, "The conforming correction's stop"). Both `taylor3d`
+//! cases were re-recorded again the same day when the 3-D solver's sums
+//! over the nodes (kinetic energy, the step's tallies, the anvil's
+//! dissipation, the conjugate gradients' dot products) began to run on the
+//! pool in fixed blocks of 1024 nodes (src/mlpg/sums.rs): the paper's case
+//! moved only in its kinetic energy, smoothing dissipation and energy
+//! error (the motion kept its bits); the default case moved through the
+//! dot products of its conforming correction. The penetration case (under
+//! 1024 nodes, one block) kept its bits.
 //!
 //! `plate_impact` was added on 2026-11-28 (its uniaxial solver has no
 //! compiled copies; the digest is the same in each), with the ceramic set
@@ -148,17 +156,17 @@ fn cases() -> Vec<Golden> {
                 0x0000_0000_0000_0000,
                 0x3fd3_65ba_8cd2_686c,
                 0x4078_8979_5a51_d59f,
-                0x4064_8a2b_099a_7e04,
+                0x4064_8a2b_099a_7e06,
                 0x4048_8b89_d815_a4c1,
-                0x4013_d80c_d210_c1c0,
+                0x4013_d80c_d210_c300,
                 0x4015_4fea_4aaf_d64e,
-                0x3f8c_6b4b_1651_ea5a,
+                0x3f8c_6b4b_1651_edd5,
                 0x0000_0000_0000_0000,
                 0x3f79_4433_d2c0_c9b5,
                 0x0000_0000_0000_0000,
                 0x4047_ae74_ace9_7f49,
             ],
-            history: 0x6602_a8af_ebaf_02d9,
+            history: 0xaf00_6dbc_0a07_738c,
             rows: 26,
         },
         Golden {
@@ -167,23 +175,23 @@ fn cases() -> Vec<Golden> {
             sets: &[("particles_radial", 4.0), ("end_time", 5e-6)],
             finals: &[
                 0x3fa2_f97b_440c_7a57,
-                0x3f72_242d_99e0_9136,
-                0x3f95_d444_ec5b_e0ec,
-                0x4066_92e2_dd6f_ef0f,
+                0x3f72_242d_99e0_9133,
+                0x3f95_d444_ec5b_e0af,
+                0x4066_92e2_dd6f_ef13,
                 0x0000_0000_0000_0000,
-                0x3fd7_a749_7cad_c3a2,
-                0x4079_fc41_1b08_f2a4,
-                0x4064_c3a6_a117_2586,
-                0x4048_c659_da3e_409d,
-                0x3ff2_b3b1_0e36_e280,
-                0x4012_39db_3123_76ac,
-                0x3f6b_fced_ec17_646b,
+                0x3fd7_a749_7cad_c3a4,
+                0x4079_fc41_1b08_f2a3,
+                0x4064_c3a6_a117_2589,
+                0x4048_c659_da3e_409e,
+                0x3ff2_b3b1_0e36_a880,
+                0x4012_39db_3123_76aa,
+                0x3f6b_fced_ec16_e14e,
                 0x0000_0000_0000_0000,
-                0x3f7c_2544_2156_9d67,
+                0x3f7c_2544_2156_9ac0,
                 0x0000_0000_0000_0000,
-                0x4047_4db1_371a_12cc,
+                0x4047_4db1_371a_12d2,
             ],
-            history: 0x6663_0727_e27a_8d8f,
+            history: 0xcca0_0298_b90b_61ce,
             rows: 51,
         },
         Golden {

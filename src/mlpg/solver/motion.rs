@@ -310,20 +310,32 @@ pub(super) fn settle(
     last_release: &mut f64,
     time: f64,
 ) -> Result<()> {
-    for (i, m) in moves.iter().enumerate() {
-        *dissipation += m.held + m.lost;
-        if let Some(t) = m.released {
-            *last_release = last_release.max(t);
-        }
-        if let Some(z) = m.through {
-            return Err(Error::ThroughBoundary {
-                particle: i,
-                boundary: "anvil",
-                time,
-                position: z,
-            });
-        }
-    }
+    // (dissipation, latest release) of the nodes, the first node through
+    // the anvil stopping the sum, in the fixed order of `sums`.
+    let join = |a: Result<(f64, f64)>, b: Result<(f64, f64)>| {
+        let ((d, r), (e, s)) = (a?, b?);
+        Ok((d + e, r.max(s)))
+    };
+    let (lost, released) = crate::mlpg::sums::ordered(
+        moves.len(),
+        || Ok((0.0, f64::NEG_INFINITY)),
+        |acc, i| {
+            let (d, r) = acc?;
+            let m = &moves[i];
+            if let Some(z) = m.through {
+                return Err(Error::ThroughBoundary {
+                    particle: i,
+                    boundary: "anvil",
+                    time,
+                    position: z,
+                });
+            }
+            Ok((d + (m.held + m.lost), m.released.map_or(r, |t| r.max(t))))
+        },
+        join,
+    )?;
+    *dissipation += lost;
+    *last_release = last_release.max(released);
     Ok(())
 }
 
@@ -334,9 +346,9 @@ pub(super) fn check_planes(pos: &[[f64; 3]], plane: &[u8], time: f64) -> Result<
         return Ok(());
     }
     match pos
-        .iter()
+        .par_iter()
         .enumerate()
-        .find(|(_, x)| x[0] < 0.0 || x[1] < 0.0)
+        .find_first(|(_, x)| x[0] < 0.0 || x[1] < 0.0)
     {
         Some((i, x)) => Err(Error::ThroughBoundary {
             particle: i,

@@ -199,8 +199,8 @@ impl Mlpg3d {
     fn end_step(&mut self, t: &Tally, d_min: f64) -> Result<()> {
         if let Some(i) = self
             .pos
-            .iter()
-            .position(|x| !x.iter().all(|v| v.is_finite()))
+            .par_iter()
+            .position_first(|x| !x.iter().all(|v| v.is_finite()))
         {
             return Err(Error::NonFinite {
                 field: "position",
@@ -218,7 +218,7 @@ impl Mlpg3d {
         }
         self.dt = self.stable_dt(t.worst_speed, d_min);
         check_time_step(self.dt, self.dt0, self.time)?;
-        let touching = self.contact.iter().any(|&c| c);
+        let touching = self.contact.par_iter().any(|&c| c);
         if self.anvil && -t.momentum / t.mass <= 0.0 && !touching {
             self.at_rest = true;
         }

@@ -158,22 +158,31 @@ pub(super) fn update_material(
         );
 }
 
-/// The sums of the step over the nodes, in node order (the same bits for
-/// any number of threads), or the first node's error at `time`.
+/// The sums of the step over the nodes, on the pool in the fixed order of
+/// [`crate::mlpg::sums`] (the same bits for any number of threads), or the
+/// first node's error at `time`.
 pub(super) fn sum(
     results: &[std::result::Result<Tally, (usize, Error)>],
     time: f64,
 ) -> Result<Tally> {
-    let mut t = Tally::default();
-    for r in results {
-        let s = r.as_ref().map_err(|(_, e)| at_time(e.clone(), time))?;
-        t.internal += s.internal;
-        t.plastic += s.plastic;
-        t.damping += s.damping;
-        t.kinetic += s.kinetic;
-        t.momentum += s.momentum;
-        t.mass += s.mass;
-        t.worst_speed = t.worst_speed.max(s.worst_speed);
-    }
-    Ok(t)
+    let add = |t: Tally, s: &Tally| Tally {
+        internal: t.internal + s.internal,
+        plastic: t.plastic + s.plastic,
+        damping: t.damping + s.damping,
+        kinetic: t.kinetic + s.kinetic,
+        momentum: t.momentum + s.momentum,
+        mass: t.mass + s.mass,
+        worst_speed: t.worst_speed.max(s.worst_speed),
+    };
+    crate::mlpg::sums::ordered(
+        results.len(),
+        || Ok(Tally::default()),
+        |t, i| {
+            let s = results[i]
+                .as_ref()
+                .map_err(|(_, e)| at_time(e.clone(), time))?;
+            Ok(add(t?, s))
+        },
+        |a: Result<Tally>, b| Ok(add(a?, &b?)),
+    )
 }

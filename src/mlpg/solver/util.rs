@@ -50,8 +50,10 @@ pub(super) fn kinetic1(v: [f64; 3], m: f64) -> f64 {
     0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 }
 
+/// The kinetic energy of the nodes, summed on the pool in the fixed order
+/// of [`crate::mlpg::sums`].
 pub(super) fn kinetic(v: &[[f64; 3]], m: &[f64]) -> f64 {
-    v.iter().zip(m).map(|(v, m)| kinetic1(*v, *m)).sum()
+    crate::mlpg::sums::sum(v.len().min(m.len()), |i| kinetic1(v[i], m[i]))
 }
 
 pub(super) fn norm(a: [f64; 3]) -> f64 {
