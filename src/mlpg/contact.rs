@@ -26,7 +26,8 @@
 //! 4.79 µs, two pulverized nodes of the plate's top surface 0.16 mm apart,
 //! and runs to 6.56 µs with these contacts).
 
-use crate::neighbours::cell_list;
+use crate::neighbours::Cells;
+use rayon::prelude::*;
 
 /// The pairs `(i, j)`, `i < j`, of nodes of different bodies (`group`)
 /// closer than `reach`, in ascending order, written into `out`. Only the
@@ -59,14 +60,41 @@ pub fn pairs(pos: &[[f64; 3]], group: &[u8], reach: f64, out: &mut Vec<(usize, u
         return;
     }
     let sub: Vec<[f64; 3]> = index.iter().map(|&i| pos[i]).collect();
-    let list = cell_list(&sub, reach);
-    for (a, &i) in index.iter().enumerate() {
-        for &b in list.of(a) {
-            let j = index[b];
-            if j > i && group[j] != group[i] && distance(&pos[i], &pos[j]) < reach {
-                out.push((i, j));
+    let Some(cells) = Cells::new(&sub, reach) else {
+        return;
+    };
+    pairs_in_order(index.len(), &cells, &sub, out, |a, b| {
+        let (i, j) = (index[a], index[b]);
+        (j > i && group[j] != group[i] && distance(&pos[i], &pos[j]) < reach).then_some((i, j))
+    });
+}
+
+/// Appends to `out`, in ascending order of `a` and then of the neighbour
+/// `b`, the pairs `keep(a, b)` gives for each point `a` of `0..n` and each
+/// `b` within the radius of `cells` of it. The points run on the pool in
+/// blocks of 1024, each block's pairs in order, then the blocks in order:
+/// the result of a serial pass for any number of threads.
+fn pairs_in_order(
+    n: usize,
+    cells: &Cells<3>,
+    points: &[[f64; 3]],
+    out: &mut Vec<(usize, usize)>,
+    keep: impl Fn(usize, usize) -> Option<(usize, usize)> + Sync,
+) {
+    const BLOCK: usize = 1024;
+    let blocks: Vec<Vec<(usize, usize)>> = (0..n.div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|k| {
+            let (mut found, mut row) = (Vec::new(), Vec::new());
+            for a in k * BLOCK..n.min((k + 1) * BLOCK) {
+                cells.sorted_into(&points[a], &mut row);
+                found.extend(row.iter().filter_map(|&b| keep(a, b)));
             }
-        }
+            found
+        })
+        .collect();
+    for block in blocks {
+        out.extend_from_slice(&block);
     }
 }
 
@@ -84,18 +112,16 @@ pub fn loose_pairs(
     if !loose.iter().any(|&l| l) {
         return;
     }
-    let list = cell_list(pos, reach);
-    for i in 0..pos.len() {
-        for &j in list.of(i) {
-            if j > i
-                && (loose[i] || loose[j])
-                && group.get(i) == group.get(j)
-                && distance(&pos[i], &pos[j]) < reach
-            {
-                out.push((i, j));
-            }
-        }
-    }
+    let Some(cells) = Cells::new(pos, reach) else {
+        return;
+    };
+    pairs_in_order(pos.len(), &cells, pos, out, |i, j| {
+        (j > i
+            && (loose[i] || loose[j])
+            && group.get(i) == group.get(j)
+            && distance(&pos[i], &pos[j]) < reach)
+            .then_some((i, j))
+    });
 }
 
 /// Resolves the approaching pairs in order: removes each one's relative
@@ -167,16 +193,19 @@ fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 mod tests {
     use super::*;
 
-    /// Two random clouds, one per body, overlapping: the pairs are those of
-    /// the brute-force search.
+    /// Two random clouds, one per body, overlapping: the pairs, and the
+    /// loose pairs with every third node loose, are those of the
+    /// brute-force search (over several blocks of the search on the pool).
     #[test]
     fn pairs_are_the_brute_force_ones() {
         let mut rnd = crate::test_rng::rng(12345);
         let mut pos = Vec::new();
         let mut group = Vec::new();
+        // Overlapping bodies, so that the nodes searched (about 2000) span
+        // two blocks of the search on the pool.
         for g in 0..2u8 {
-            for _ in 0..400 {
-                let z = if g == 0 { rnd() } else { 0.8 + rnd() };
+            for _ in 0..1500 {
+                let z = if g == 0 { rnd() } else { 0.5 + rnd() };
                 pos.push([rnd(), rnd(), z]);
                 group.push(g);
             }
@@ -193,6 +222,23 @@ mod tests {
             }
         }
         assert!(want.len() > 10, "{}", want.len());
+        assert_eq!(got, want);
+        // Loose pairs over three blocks, every third node loose.
+        let loose: Vec<bool> = (0..pos.len()).map(|i| i % 3 == 0).collect();
+        let mut got = Vec::new();
+        loose_pairs(&pos, &group, &loose, reach, &mut got);
+        let mut want = Vec::new();
+        for i in 0..pos.len() {
+            for j in i + 1..pos.len() {
+                if (loose[i] || loose[j])
+                    && group[i] == group[j]
+                    && distance(&pos[i], &pos[j]) < reach
+                {
+                    want.push((i, j));
+                }
+            }
+        }
+        assert!(want.len() > 100, "{}", want.len());
         assert_eq!(got, want);
     }
 
