@@ -2,18 +2,22 @@
 //! room from one build to the next, so that a build allocates only when
 //! its arrays outgrow it (BENCHMARKS.md, memory).
 
-/// Empties `v` and fills it with `len` copies of `value`. When `v` has no
-/// room for `len`, its old buffer is freed before the new one is allocated
-/// (no moment with both), with an eighth more room than `len`: rows grow a
-/// little as a body is compressed, and the doubling of `Vec`'s own growth
-/// would hold twice the array.
-pub(crate) fn refill<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
+use rayon::prelude::*;
+
+/// Empties `v` and fills it with `len` copies of `value`, on the pool (the
+/// arrays of a build hold tens of bytes a neighbour: a serial fill was a
+/// serial part of every build). When `v` has no room for `len`, its old
+/// buffer is freed before the new one is allocated (no moment with both),
+/// with an eighth more room than `len`: rows grow a little as a body is
+/// compressed, and the doubling of `Vec`'s own growth would hold twice the
+/// array.
+pub(crate) fn refill<T: Clone + Send>(v: &mut Vec<T>, len: usize, value: T) {
     v.clear();
     if v.capacity() < len {
         *v = Vec::new();
         v.reserve_exact(len + len / 8);
     }
-    v.resize(len, value);
+    v.par_extend(rayon::iter::repeat_n(value, len));
 }
 
 #[cfg(test)]
