@@ -18,7 +18,7 @@
 //! default `taylor3d` case was re-recorded when the conforming correction's
 //! conjugate gradients began to stop at 1e-5 (was 1e-8) and to start from
 //! the last build's multipliers (its finals moved in the eighth digit;
-//! BENCHMARKS.md, "The conforming correction's stop"). Both `taylor3d`
+//! docs/notes/2026-11-28-conforming-stop-and-serial.md). Both `taylor3d`
 //! cases were re-recorded again the same day when the 3-D solver's sums
 //! over the nodes (kinetic energy, the step's tallies, the anvil's
 //! dissipation, the conjugate gradients' dot products) began to run on the
