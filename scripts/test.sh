@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: formatting, lints, the doc links, Rust unit and
-# integration tests (release-optimised physics), the C examples and the fmpy
-# checks. Installs what it needs; run from anywhere.
+# integration tests (release-optimised physics), the C examples, the fmpy
+# checks and the Python package's tests. Installs what it needs; run from
+# anywhere.
 #
 # `bash scripts/test.sh --quick`: the fast tier for the edit-compile-test
 # loop (formatting, the unit tests, and the golden bits, saved states,
@@ -21,6 +22,12 @@ fi
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
+# The Python virtual environment (.venv, scripts/venv.sh) is made in the
+# background while cargo compiles: its downloads take a minute of mostly
+# waiting. The FMU step waits for it.
+venv_log=$(mktemp)
+bash scripts/venv.sh > "$venv_log" 2>&1 &
+venv_pid=$!
 # Every step builds with the profile of the tests (`ci`), so that the build
 # scripts and procedural macros are compiled once for all of them.
 echo "== cargo clippy"
@@ -66,6 +73,12 @@ if [ -f examples_c/Makefile ]; then
   echo "== C examples"
   make -j2 -C examples_c test
 fi
+if ! wait $venv_pid; then
+  cat "$venv_log"
+  echo "== the Python virtual environment (scripts/venv.sh) failed"
+  exit 1
+fi
+cat "$venv_log"
 if [ -f tests/fmu/run.sh ]; then
   echo "== FMU checks (fmpy)"
   # Packaged by the example that shares the tests' build (xtask's code),
@@ -83,4 +96,9 @@ if ! wait $fuzz_pid; then
 fi
 trap - EXIT
 tail -n 5 "$fuzz_log"
+# After the fuzzer, so that the thread-overlap test finds both cores free.
+# The extension is built by maturin on the tests' build (MI_PROFILE=ci, the
+# workspace's default members: python/tests/run.sh).
+echo "== Python package"
+bash python/tests/run.sh
 echo "== all tests passed"

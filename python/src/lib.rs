@@ -268,16 +268,12 @@ impl Simulation {
                 Flow::Done => Ok(()),
                 Flow::Stopped(e) => Err(raise(py, &e)),
                 Flow::Cancelled => {
-                    let e = Error::Cancelled {
-                        time: s.sim.time(),
-                    };
+                    let e = Error::Cancelled { time: s.sim.time() };
                     s.stopped = Some(e.clone());
                     Err(raise(py, &e))
                 }
                 Flow::Python(err) => {
-                    s.stopped = Some(Error::Cancelled {
-                        time: s.sim.time(),
-                    });
+                    s.stopped = Some(Error::Cancelled { time: s.sim.time() });
                     Err(err)
                 }
             }
@@ -474,7 +470,12 @@ impl Simulation {
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         self.check(py)?;
         let d = PyDict::new(py);
-        for (spec, v) in self.sim.observable_specs().iter().zip(self.sim.observables()) {
+        for (spec, v) in self
+            .sim
+            .observable_specs()
+            .iter()
+            .zip(self.sim.observables())
+        {
             if spec.is_bool() {
                 d.set_item(spec.name, v != 0.0)?;
             } else {

@@ -113,3 +113,26 @@ def test_the_shot_rule():
     assert mi.shot_status({"outcome": "finished", "shot_outcome": 2.0, "projectile_velocity": 12.0}) == ("stopped", 0.0)
     assert mi.shot_status({"outcome": "finished", "shot_outcome": 0.0, "projectile_velocity": 90.0}) == ("unsettled", 90.0)
     assert mi.shot_status({"outcome": "SpacingCollapse", "shot_outcome": 1.0, "projectile_velocity": 1.0}) == ("error", None)
+
+
+def test_the_example_script_runs_the_sweep_through_the_package(tmp_path):
+    """examples/ballistic_limit.py --package: its table is the package's
+    shots, and its fit the package's."""
+    import csv
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+    speeds = [400.0, 1000.0, 1300.0, 1600.0]
+    args = ["--package", "--speeds", ",".join(map(str, speeds)), "--particles-radial", "3",
+            "--set", "plate_diameter=0.02", "--end-time", "2e-5", "--workers", "2",
+            "--out", str(tmp_path / "shots.csv"), "--no-plot"]
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "ballistic_limit.py"), *args],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    limit = mi.ballistic_limit(speeds, particles_radial=3, plate_diameter=0.02, end_time=2e-5, frame=False)
+    with open(tmp_path / "shots.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [(float(x["V_mps"]), x["status"], float(x["projectile_velocity"])) for x in rows] == [
+        (s["V_mps"], s["status"], s["projectile_velocity"]) for s in limit.shots]
+    assert f"ballistic limit V_bl = {limit.v_bl:.1f} +- {limit.v_bl_err:.1f} m/s" in r.stdout
