@@ -7,13 +7,13 @@
 //!
 //! - scenes built from a name or a TOML file, the material and scheme
 //!   choices and the parameters, in the command line's order and with its
-//!   messages ([`build_scene`]);
+//!   messages (`build_scene`);
 //! - the run with the interpreter lock released while the solver steps, on
 //!   the global thread pool or on one of its own (`threads=`);
 //! - results as dicts and numpy arrays;
 //! - each core error raised as the exception class of its name
 //!   (`meshless_impact.errors`), and a panic caught at the boundary
-//!   ([`guard`]), as the C ABI does: none reaches Python.
+//!   (`guard`), as the C ABI does: none reaches Python.
 //!
 //! It holds no global state: separate `Simulation`s run in parallel.
 
