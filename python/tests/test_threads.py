@@ -40,12 +40,32 @@ def measure():
     return t1 - t0, t2 - t1
 
 
+def test_the_interpreter_runs_while_a_simulation_steps():
+    """While a run steps on one thread, Python code runs on another: the
+    lock is released (whatever the load on the machine)."""
+    sim = mi.Simulation("taylor", threads=1, **CASE)
+    done = threading.Event()
+    ticks = 0
+
+    def run():
+        sim.run()
+        done.set()
+
+    t = threading.Thread(target=run)
+    start = time.perf_counter()
+    t.start()
+    while not done.is_set():
+        ticks += 1
+    t.join()
+    assert sim.finished and ticks > 1000 * (time.perf_counter() - start), ticks
+
+
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores")
 def test_two_simulations_on_two_threads_overlap():
-    # The machine is shared (other jobs, the test command's fuzzer): the
-    # best of three tries is held to the bound.
+    # The machine may be shared (other jobs): the best of up to five tries
+    # is held to the bound.
     ratios = []
-    for _ in range(3):
+    for _ in range(5):
         seq, par = measure()
         ratios.append(par / seq)
         if ratios[-1] <= BOUND:
