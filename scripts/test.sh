@@ -24,7 +24,18 @@ echo "== cargo fmt --check"
 cargo fmt --all -- --check
 # The Python virtual environment (.venv, scripts/venv.sh) is made in the
 # background while cargo compiles: its downloads take a minute of mostly
-# waiting. The FMU step waits for it.
+# waiting. The FMU step waits for it. Its interpreter is made here first:
+# every cargo build names it to pyo3 as maturin does when it builds the
+# extension for it (python/tests/run.sh), so that pyo3's build
+# configuration is the same in every build and maturin finds the
+# extension built (measured: a 5.6 s install, against 18.5 s when maturin
+# compiled pyo3 again).
+[ -x .venv/bin/python3 ] || python3 -m venv .venv
+export PYO3_PYTHON="$PWD/.venv/bin/python3"
+export PYTHON_SYS_EXECUTABLE="$PYO3_PYTHON" PYO3_BUILD_EXTENSION_MODULE=1
+PYO3_ENVIRONMENT_SIGNATURE=$("$PYO3_PYTHON" -c 'import platform, sys
+print(f"{platform.python_implementation().lower()}-{sys.version_info[0]}.{sys.version_info[1]}-{64 if sys.maxsize > 2**32 else 32}bit")')
+export PYO3_ENVIRONMENT_SIGNATURE
 venv_log=$(mktemp)
 bash scripts/venv.sh > "$venv_log" 2>&1 &
 venv_pid=$!

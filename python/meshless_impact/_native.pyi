@@ -43,12 +43,13 @@ class Simulation:
         threads: Optional[int] = None,
         **params: Union[float, str],
     ) -> None: ...
-    def run(self, progress: Optional[Progress] = None) -> None:
-        """Runs to the end condition. `progress(time, end_time, steps)` is
-        called about every 0.1 s and at the end; returning False cancels
-        the run (:class:`~meshless_impact.errors.Cancelled`). Ctrl-C
-        cancels it too."""
-    def advance_to(self, t: float, progress: Optional[Progress] = None) -> None:
+    def run(self, progress: Union[bool, Progress, None] = False) -> None:
+        """Runs to the end condition. `progress`: True shows a progress
+        line on standard error; a callable `progress(time, end_time, steps)`
+        is called about every 0.1 s and at the end, and returning False
+        cancels the run (:class:`~meshless_impact.errors.Cancelled`).
+        Ctrl-C cancels it too."""
+    def advance_to(self, t: float, progress: Union[bool, Progress, None] = False) -> None:
         """Steps until the time reaches `t` (s) or the end condition holds;
         the last step is not shortened."""
     def step(self) -> None:

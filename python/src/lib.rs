@@ -281,6 +281,37 @@ impl Simulation {
     }
 }
 
+/// The `progress` argument of `run` and `advance_to`: `False` or `None`
+/// (none), `True` (a line on standard error, `meshless_impact._progress`),
+/// or a callable `progress(time, end_time, steps)`.
+#[derive(FromPyObject)]
+enum Progress {
+    Flag(bool),
+    Callback(Option<Py<PyAny>>),
+}
+
+impl From<bool> for Progress {
+    fn from(b: bool) -> Self {
+        Progress::Flag(b)
+    }
+}
+
+impl Simulation {
+    /// [`Simulation::drive`] with the `progress` argument resolved.
+    fn drive_with(&mut self, py: Python<'_>, until: Option<f64>, progress: Progress) -> PyResult<()> {
+        match progress {
+            Progress::Flag(false) | Progress::Callback(None) => self.drive(py, until, None),
+            Progress::Callback(Some(cb)) => self.drive(py, until, Some(cb)),
+            Progress::Flag(true) => {
+                let line = py.import("meshless_impact._progress")?;
+                let r = self.drive(py, until, Some(line.getattr("show")?.unbind()));
+                line.getattr("done")?.call0()?;
+                r
+            }
+        }
+    }
+}
+
 /// The loop of [`Simulation::drive`], run without the interpreter lock.
 fn drive_loop(sim: &mut Core, until: Option<f64>, progress: Option<&Py<PyAny>>) -> Flow {
     let mut last = Instant::now();
@@ -372,15 +403,15 @@ impl Simulation {
     }
 
     /// Runs to the end condition (see the package's docs for `progress`).
-    #[pyo3(signature = (progress=None))]
-    fn run(&mut self, py: Python<'_>, progress: Option<Py<PyAny>>) -> PyResult<()> {
-        self.drive(py, None, progress)
+    #[pyo3(signature = (progress = Progress::Flag(false)), text_signature = "(self, progress=False)")]
+    fn run(&mut self, py: Python<'_>, progress: Progress) -> PyResult<()> {
+        self.drive_with(py, None, progress)
     }
 
     /// Steps until the time reaches `t` or the end condition holds.
-    #[pyo3(signature = (t, progress=None))]
-    fn advance_to(&mut self, py: Python<'_>, t: f64, progress: Option<Py<PyAny>>) -> PyResult<()> {
-        self.drive(py, Some(t), progress)
+    #[pyo3(signature = (t, progress = Progress::Flag(false)), text_signature = "(self, t, progress=False)")]
+    fn advance_to(&mut self, py: Python<'_>, t: f64, progress: Progress) -> PyResult<()> {
+        self.drive_with(py, Some(t), progress)
     }
 
     /// Takes one step.

@@ -96,3 +96,14 @@ def test_saved_state_continues_with_the_same_bits():
     b.run()
     assert a.observables() == b.observables()
     assert np.array_equal(bits(a.field("velocity")), bits(b.field("velocity")))
+
+
+def test_progress_true_shows_a_line_and_changes_nothing(capfd):
+    params = CASES["taylor"]
+    a = mi.Simulation("taylor", **params)
+    a.run(progress=True)
+    err = capfd.readouterr().err
+    assert err.startswith("\rt = ") and err.endswith(f"{a.steps} steps\n"), err
+    b = mi.Simulation("taylor", **params)
+    b.run()
+    assert a.observables() == b.observables()
