@@ -5,6 +5,8 @@ with the same bits. The figure goes in BENCHMARKS.md ("Python: two runs on
 two threads"); `python python/tests/test_threads.py` prints it."""
 
 import os
+import subprocess
+import sys
 import threading
 import time
 
@@ -60,10 +62,28 @@ def test_the_interpreter_runs_while_a_simulation_steps():
     assert sim.finished and ticks > 1000 * (time.perf_counter() - start), ticks
 
 
+SPIN = "import time\nt = time.perf_counter()\nn = 0\nwhile time.perf_counter() - t < 0.5:\n    n += 1\nprint(n)"
+
+
+def free_cores():
+    """About how many cores this process can have now: the work of two
+    processes spinning at once over that of one alone (the machine may be
+    shared with other jobs)."""
+    def spin(k):
+        ps = [subprocess.Popen([sys.executable, "-c", SPIN], stdout=subprocess.PIPE, text=True) for _ in range(k)]
+        return sum(int(p.communicate()[0]) for p in ps)
+    return spin(2) / spin(1)
+
+
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores")
 def test_two_simulations_on_two_threads_overlap():
-    # The machine may be shared (other jobs): the best of up to five tries
-    # is held to the bound.
+    # On a machine shared with other jobs two cores may not be free: the
+    # bound is checked only where two processes get about two cores' work
+    # done (the test above checks the lock's release on any machine); the
+    # best of up to five tries is held to it.
+    cores = free_cores()
+    if cores < 1.7:
+        pytest.skip(f"about {cores:.2f} cores free (other jobs): the overlap needs two")
     ratios = []
     for _ in range(5):
         seq, par = measure()
@@ -74,6 +94,7 @@ def test_two_simulations_on_two_threads_overlap():
 
 
 if __name__ == "__main__":
+    print(f"about {free_cores():.2f} cores free")
     for _ in range(5):
         seq, par = measure()
         print(f"sequential {seq:.3f} s, two threads {par:.3f} s, ratio {par / seq:.3f}")
