@@ -298,7 +298,12 @@ impl From<bool> for Progress {
 
 impl Simulation {
     /// [`Simulation::drive`] with the `progress` argument resolved.
-    fn drive_with(&mut self, py: Python<'_>, until: Option<f64>, progress: Progress) -> PyResult<()> {
+    fn drive_with(
+        &mut self,
+        py: Python<'_>,
+        until: Option<f64>,
+        progress: Progress,
+    ) -> PyResult<()> {
         match progress {
             Progress::Flag(false) | Progress::Callback(None) => self.drive(py, until, None),
             Progress::Callback(Some(cb)) => self.drive(py, until, Some(cb)),
