@@ -43,8 +43,11 @@ venv_pid=$!
 # scripts and procedural macros are compiled once for all of them.
 echo "== cargo clippy"
 cargo clippy --all-targets --profile ci -- -D warnings
-# The library and the program without the report (cargo feature `report`).
-cargo clippy --all-targets --profile ci --no-default-features -- -D warnings
+# The library and the program without the report (cargo feature `report`);
+# the Python extension keeps its `extension-module`, so that pyo3 is checked
+# once for both runs.
+cargo clippy --all-targets --profile ci --no-default-features \
+  --features meshless-impact-python/extension-module -- -D warnings
 echo "== cargo doc (broken or private links fail)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --profile ci
 echo "== cargo test (profile ci: release optimisation, fast build)"

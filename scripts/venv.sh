@@ -19,5 +19,7 @@ fi
 echo "== creating $VENV ($(echo $PINS))"
 [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
 "$VENV/bin/pip" install --quiet --upgrade pip
+# No byte-code compiled at install: the tests import a small part of what
+# is installed (pandas, matplotlib), and Python compiles that when imported.
 # shellcheck disable=SC2086
-"$VENV/bin/pip" install --quiet $PINS
+"$VENV/bin/pip" install --quiet --no-compile $PINS
