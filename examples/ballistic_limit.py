@@ -8,6 +8,12 @@ plots them with the fit.
 One shot per process: locally with a process pool by default, or on a Dask
 cluster with --scheduler ADDRESS (as examples/sweep_fmu.py).
 
+With --package the shots run through the Python package instead of the FMU
+(`pip install ./python`; docs/guide/python.md): its
+meshless_impact.ballistic_limit runs the sweep on a thread pool (or the
+Dask cluster), decides each shot's status by the same rule and fits the
+same curve, and this script prints, writes and plots what it returns.
+
 Each shot runs with run_until = outcome: it ends as soon as the scene
 decides its outcome from the state (the output shot_outcome; README,
 "The shot's outcome"), with end_time as the cap. Its status:
@@ -38,6 +44,8 @@ Examples:
   python examples/ballistic_limit.py --speeds 800,1000,1200,1500 --particles-radial 4 \\
       --plate-thickness 0.004 --end-time 2e-5 --out shots.csv --plot shots.svg
   python examples/ballistic_limit.py --scheduler tcp://10.0.0.5:8786 --speeds 500:2500:100
+  python examples/ballistic_limit.py --package --speeds 400:1600:150 --particles-radial 3 \\
+      --set plate_diameter=0.02 --end-time 2e-5
 """
 
 import argparse
@@ -278,6 +286,32 @@ def escape(text):
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
+def run_package(speeds, common, args):
+    """The sweep through the Python package (--package): the rows of
+    meshless_impact.ballistic_limit in this script's columns, and its fit
+    (None where it could not fit)."""
+    import meshless_impact as mi
+
+    client = None
+    if args.scheduler:
+        from dask.distributed import Client
+
+        client = Client(args.scheduler)
+    defaults = {name: p["value"] for name, p in mi.params("penetration").items()}
+    result = mi.ballistic_limit(speeds, client=client, workers=args.workers, fit_unsettled=args.fit_unsettled,
+                                frame=False, **common)
+    if client is not None:
+        client.close()
+    for r in result.shots:
+        params = {**defaults, **common, "impact_speed": r["V_mps"]}
+        r["capture_speed_mps"] = capture_speed(params)
+        r["end_time_s"] = params["end_time"]
+        r["time_s"] = r["time"]
+        if r["Vr_mps"] is None:
+            r["Vr_mps"] = ""
+    return result.shots, result.fit
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--fmu", default=str(DEFAULT_FMU), help="FMU to run (FMI 3 or FMI 2); default %(default)s")
@@ -304,7 +338,11 @@ def main(argv=None):
     ap.add_argument("--plot", default="ballistic_limit.svg",
                     help="plot path (default %(default)s; any format with matplotlib, .svg without)")
     ap.add_argument("--no-plot", action="store_true", help="no plot")
+    ap.add_argument("--package", action="store_true",
+                    help="run the shots through the Python package (meshless_impact.ballistic_limit), not the FMU")
     args = ap.parse_args(argv)
+    if args.package:
+        return main_package(args, ap)
 
     from fmpy import read_model_description
 
@@ -344,6 +382,31 @@ def main(argv=None):
             shots[k] = p
             rows[k] = classify(r, {**defaults, **p})
 
+    return report(rows, args, wall, title=f"Ballistic limit, {Path(args.fmu).stem}")
+
+
+def main_package(args, ap):
+    """main() with --package: the shots through meshless_impact."""
+    import meshless_impact as mi
+
+    names = set(mi.params("penetration"))
+    common = parse_sets(args.set, names, ap)
+    for name, value in (("particles_radial", args.particles_radial), ("end_time", args.end_time),
+                        ("plate_thickness", args.plate_thickness)):
+        if value is not None:
+            common[name] = value
+    try:
+        speeds = parse_speeds(args.speeds)
+    except ValueError as e:
+        ap.error(str(e))
+    t0 = time.perf_counter()
+    rows, fit = run_package(speeds, common, args)
+    return report(rows, args, time.perf_counter() - t0, title="Ballistic limit, meshless_impact", fit=fit)
+
+
+def report(rows, args, wall, title, fit=False):
+    """Prints the table, writes the CSV, fits (unless `fit` is given: the
+    package's) and plots; the exit status."""
     print_table(rows)
     print(f"{len(rows)} shots in {wall:.1f} s -> {args.out}")
     with open(args.out, "w", newline="") as f:
@@ -365,7 +428,10 @@ def main(argv=None):
     fitted = {"through", "stopped"} | ({"unsettled"} if args.fit_unsettled else set())
     data = [(r["V_mps"], r["Vr_mps"]) for r in rows if r["status"] in fitted]
     try:
-        fit = lambert_jonas.fit(data)
+        if fit is False:
+            fit = lambert_jonas.fit(data)
+        elif fit is None:
+            lambert_jonas.fit(data)  # the package could not fit: the reason
         print(f"ballistic limit V_bl = {fit.v_bl:.1f} +- {fit.v_bl_err:.1f} m/s (shots bracket "
               f"{fit.bracket[0]:.1f}-{fit.bracket[1]:.1f}), a = {fit.a:.4f} +- {fit.a_err:.4f}, "
               f"p = {fit.p:.3f} +- {fit.p_err:.3f}, "
@@ -376,7 +442,6 @@ def main(argv=None):
     if args.no_plot:
         print("no plot (--no-plot)")
     else:
-        title = f"Ballistic limit, {Path(args.fmu).stem}"
         if args.fit_unsettled and unsettled:
             title += " (unsettled shots fitted: not residual velocities)"
         print(plot(args.plot, rows, fit, title))

@@ -15,9 +15,11 @@ stops with a spacing collapse at 8.5 µs): the fit is run on them
 import csv
 import importlib.util
 import math
+import os
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 from dask.distributed import LocalCluster
 
@@ -40,8 +42,11 @@ OUTPUTS = ["projectile_velocity", "projectile_extent", "projectile_clearance", "
 
 
 def run_script(*args):
-    """Runs the sweep as users do: `python examples/ballistic_limit.py ...`."""
-    r = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=300)
+    """Runs the sweep as users do: `python examples/ballistic_limit.py ...`,
+    without matplotlib (tests/fmu/without_matplotlib): the plot is the
+    script's own SVG."""
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parent / "without_matplotlib")}
+    r = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=300, env=env)
     return r.returncode, r.stdout + r.stderr
 
 
