@@ -1,28 +1,43 @@
 //! Sums over the nodes on the pool, in a fixed order: the nodes in blocks
 //! of [`BLOCK`], each block summed in node order by one thread, then the
-//! blocks' sums in block order. The blocks do not depend on the number of
-//! threads, so neither do the bits; the serial part is one addition per
-//! block.
-
-use rayon::prelude::*;
+//! blocks' sums pairwise over a fixed binary tree (the halves of the blocks,
+//! then their halves, ...). Neither the blocks nor the tree depend on the
+//! number of threads, so neither do the bits; nothing is allocated (a step
+//! between rebuilds allocates nothing, `tests/mlpg_alloc.rs`), and the
+//! serial part is one addition per level of the tree.
 
 /// Nodes per block.
 pub const BLOCK: usize = 1024;
 
 /// `fold` of `f(i)` over `0..n` from `zero`, block by block on the pool,
-/// then `join` of the blocks' results in order (the first `Err` in node
-/// order wins where `T` is a `Result`, as a serial pass would stop there).
+/// then `join` of the blocks' results over the fixed tree, the left half
+/// first (the first `Err` in node order wins where `T` is a `Result`, as a
+/// serial pass would stop there).
 pub(crate) fn ordered<T: Send>(
     n: usize,
     zero: impl Fn() -> T + Sync,
     fold: impl Fn(T, usize) -> T + Sync,
-    join: impl Fn(T, T) -> T,
+    join: impl Fn(T, T) -> T + Sync,
 ) -> T {
-    let blocks: Vec<T> = (0..n.div_ceil(BLOCK))
-        .into_par_iter()
-        .map(|b| (b * BLOCK..n.min((b + 1) * BLOCK)).fold(zero(), &fold))
-        .collect();
-    blocks.into_iter().fold(zero(), join)
+    fn tree<T: Send>(
+        blocks: std::ops::Range<usize>,
+        n: usize,
+        zero: &(impl Fn() -> T + Sync),
+        fold: &(impl Fn(T, usize) -> T + Sync),
+        join: &(impl Fn(T, T) -> T + Sync),
+    ) -> T {
+        if blocks.len() <= 1 {
+            let b = blocks.start;
+            return (b * BLOCK..n.min((b + 1) * BLOCK)).fold(zero(), fold);
+        }
+        let mid = blocks.start + blocks.len() / 2;
+        let (a, b) = rayon::join(
+            || tree(blocks.start..mid, n, zero, fold, join),
+            || tree(mid..blocks.end, n, zero, fold, join),
+        );
+        join(a, b)
+    }
+    tree(0..n.div_ceil(BLOCK).max(1), n, &zero, &fold, &join)
 }
 
 /// `Σ f(i)` over `0..n` in the order of [`ordered`].
@@ -34,17 +49,24 @@ pub(crate) fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
 mod tests {
     use super::*;
 
-    /// The blocked sum is the plain one block by block: the same bits on
-    /// 1, 2 and 3 threads, equal to a serial sum of the serial blocks'
-    /// sums, and within round-off of the serial sum in node order.
+    /// The blocked sum is its plain twin: the same bits on 1, 2 and 3
+    /// threads, equal to the serial blocks' sums added pairwise over the
+    /// same halves, and within round-off of the serial sum in node order.
     #[test]
     fn the_blocked_sum_has_the_same_bits_on_any_threads() {
         let mut rng = crate::test_rng::rng(3);
         let x: Vec<f64> = (0..5 * BLOCK + 17).map(|_| rng() - 0.3).collect();
-        let plain: f64 = x
-            .chunks(BLOCK)
-            .map(|c| c.iter().sum::<f64>())
-            .fold(0.0, |a, b| a + b);
+        // The plain twin: the serial blocks' sums, then pairwise over the
+        // same halves.
+        fn pairwise(s: &[f64]) -> f64 {
+            match s.len() {
+                0 => 0.0,
+                1 => s[0],
+                k => pairwise(&s[..k / 2]) + pairwise(&s[k / 2..]),
+            }
+        }
+        let blocks: Vec<f64> = x.chunks(BLOCK).map(|c| c.iter().sum::<f64>()).collect();
+        let plain = pairwise(&blocks);
         for threads in [1, 2, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
