@@ -348,15 +348,8 @@ def main(argv=None):
 
     md = read_model_description(args.fmu)
     defaults = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
-    common = {"run_until": RUN_UNTIL_OUTCOME, **parse_sets(args.set, set(defaults), ap)}
-    for name, value in (("particles_radial", args.particles_radial), ("end_time", args.end_time),
-                        ("plate_thickness", args.plate_thickness)):
-        if value is not None:
-            common[name] = value
-    try:
-        speeds = parse_speeds(args.speeds)
-    except ValueError as e:
-        ap.error(str(e))
+    common, speeds = shot_settings(args, set(defaults), ap)
+    common = {"run_until": RUN_UNTIL_OUTCOME, **common}
     end_time = common.get("end_time", defaults["end_time"])
     step = args.step or end_time / 100
     shots = [{**common, "impact_speed": v} for v in speeds]
@@ -385,11 +378,9 @@ def main(argv=None):
     return report(rows, args, wall, title=f"Ballistic limit, {Path(args.fmu).stem}")
 
 
-def main_package(args, ap):
-    """main() with --package: the shots through meshless_impact."""
-    import meshless_impact as mi
-
-    names = set(mi.params("penetration"))
+def shot_settings(args, names, ap):
+    """The settings every shot shares (--set over the parameters `names`,
+    then --particles-radial, --end-time, --plate-thickness) and the speeds."""
     common = parse_sets(args.set, names, ap)
     for name, value in (("particles_radial", args.particles_radial), ("end_time", args.end_time),
                         ("plate_thickness", args.plate_thickness)):
@@ -399,6 +390,14 @@ def main_package(args, ap):
         speeds = parse_speeds(args.speeds)
     except ValueError as e:
         ap.error(str(e))
+    return common, speeds
+
+
+def main_package(args, ap):
+    """main() with --package: the shots through meshless_impact."""
+    import meshless_impact as mi
+
+    common, speeds = shot_settings(args, set(mi.params("penetration")), ap)
     t0 = time.perf_counter()
     rows, fit = run_package(speeds, common, args)
     return report(rows, args, time.perf_counter() - t0, title="Ballistic limit, meshless_impact", fit=fit)
