@@ -3,7 +3,7 @@
 the FMU tests use it: the module of the Python package,
 python/meshless_impact/lambert_jonas.py (one fit for the package's
 `ballistic_limit` and the FMU sweep), loaded from the checkout so that it
-runs without the package installed and without numpy.
+runs without the package installed (numpy is all it needs).
 
     python examples/lambert_jonas.py shots.csv     # columns V_mps, Vr_mps
 """

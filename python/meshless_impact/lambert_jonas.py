@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The Lambert-Jonas ballistic-limit curve, fitted to (impact speed, residual
-speed) pairs, in plain Python (no numpy or scipy).
+speed) pairs with numpy.
 
     V_r = a (V^p - V_bl^p)^(1/p)   for V > V_bl,   V_r = 0 below it.
 
@@ -9,11 +9,14 @@ testing: velocity representation", BRL report 1852. V_bl is the ballistic
 limit, `a` at most 1 (the residual speed approaches a V far above the
 limit), `p` typically 2 to 3.
 
-The fit: for a given (V_bl, p), the best `a` is linear least squares over
-the perforating shots; (V_bl, p) minimise the squared residual speeds by a
-grid search refined with Nelder-Mead. Shots that did not perforate
-(V_r = 0) bound V_bl from below: V_bl is searched between the fastest of
-them and the slowest perforating shot.
+The fit is nonlinear least squares over the residual speeds of all shots.
+For a given (V_bl, p) the best `a` is linear least squares (variable
+projection), so only (V_bl, p) are searched: first on a 40 x 41 grid,
+evaluated at once over numpy arrays, then refined from the grid's best
+point by Levenberg-Marquardt (numpy.linalg.solve on the damped normal
+equations, the Jacobian by central differences). Shots that did not
+perforate (V_r = 0) bound V_bl from below: V_bl is kept between the fastest
+of them and the slowest perforating shot, p within `p_range`.
 
 Uncertainty: the shots bracket V_bl (`bracket`: the fastest stopped shot
 and the slowest perforating one, whatever the curve), and the jackknife
@@ -23,8 +26,8 @@ shots remain; sqrt((n - 1)/n sum (x_i - mean)^2) over the n refits).
 
 This module is the one fit of the project: `meshless_impact.ballistic_limit`
 calls it, and `examples/ballistic_limit.py` (the sweep of the penetration
-FMU) loads it through `examples/lambert_jonas.py`. It needs nothing but the
-standard library. On its own:
+FMU) loads it through `examples/lambert_jonas.py`. It needs numpy (a
+dependency of the package, and pinned in the tests' venv). On its own:
 
     python examples/lambert_jonas.py shots.csv     # columns V_mps, Vr_mps
 """
@@ -36,6 +39,8 @@ import math
 import sys
 from dataclasses import dataclass
 from typing import Iterable, Tuple
+
+import numpy as np
 
 
 @dataclass
@@ -62,48 +67,64 @@ class Fit:
 
 
 def _g(v, v_bl, p):
-    return (v**p - v_bl**p) ** (1.0 / p) if v > v_bl else 0.0
+    """(V^p - V_bl^p)^(1/p) where V > V_bl, else 0; numpy broadcasting
+    over v (shots, last axis) and v_bl, p (candidates)."""
+    u = np.power(v, p) - np.power(v_bl, p)
+    return np.where(u > 0, np.power(np.maximum(u, 0.0), 1.0 / p), 0.0)
 
 
-def _best_a(shots, v_bl, p):
-    """The least-squares `a` for (v_bl, p) and the sum of squared residuals."""
-    num = sum(vr * _g(v, v_bl, p) for v, vr in shots)
-    den = sum(_g(v, v_bl, p) ** 2 for v, vr in shots)
-    a = num / den if den > 0 else 0.0
-    sse = sum((vr - a * _g(v, v_bl, p)) ** 2 for v, vr in shots)
-    return a, sse
+def _best_a(v, vr, v_bl, p):
+    """The least-squares `a` for each candidate (v_bl, p) (arrays of the
+    same shape) and its residual speeds (that shape plus the shots' axis)."""
+    g = _g(v, np.asarray(v_bl, dtype=float)[..., None], np.asarray(p, dtype=float)[..., None])
+    num = (g * vr).sum(axis=-1)
+    den = (g * g).sum(axis=-1)
+    a = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
+    return a, vr - a[..., None] * g
 
 
-def _nelder_mead(f, x0, step, iters=400, tol=1e-12):
-    """Minimises f over 2-D points from x0 with initial steps `step`."""
-    pts = [list(x0), [x0[0] + step[0], x0[1]], [x0[0], x0[1] + step[1]]]
-    vals = [f(x) for x in pts]
-    for _ in range(iters):
-        order = sorted(range(3), key=lambda k: vals[k])
-        pts = [pts[k] for k in order]
-        vals = [vals[k] for k in order]
-        if abs(vals[2] - vals[0]) <= tol * (1.0 + abs(vals[0])):
+def _levenberg_marquardt(residuals, x0, lower, upper, iterations=200):
+    """Minimises |residuals(x)|^2 over x in the box [lower, upper] from x0:
+    damped Gauss-Newton steps on variables scaled to the box, the Jacobian
+    by central differences, each step clipped to the box and taken only if
+    it lowers the sum of squares."""
+    scale = upper - lower
+    x = np.clip(np.asarray(x0, dtype=float), lower, upper)
+    r = residuals(x)
+    sse = float(r @ r)
+    damping = 1e-3
+    for _ in range(iterations):
+        jac = np.empty((r.size, x.size))
+        for d in range(x.size):
+            h = 1e-7 * scale[d]
+            up = x.copy()
+            down = x.copy()
+            up[d] = min(x[d] + h, upper[d])
+            down[d] = max(x[d] - h, lower[d])
+            jac[:, d] = (residuals(up) - residuals(down)) / ((up[d] - down[d]) / scale[d])
+        normal = jac.T @ jac
+        gradient = jac.T @ r
+        improved = False
+        while damping < 1e12:
+            lhs = normal + damping * np.diag(np.maximum(np.diag(normal), 1e-300))
+            try:
+                step = -np.linalg.solve(lhs, gradient)
+            except np.linalg.LinAlgError:
+                damping *= 10.0
+                continue
+            trial = np.clip(x + step * scale, lower, upper)
+            rt = residuals(trial)
+            st = float(rt @ rt)
+            if np.isfinite(st) and st < sse:
+                moved = np.max(np.abs(trial - x) / scale)
+                x, r, sse = trial, rt, st
+                damping = max(damping / 10.0, 1e-12)
+                improved = True
+                break
+            damping *= 10.0
+        if not improved or moved < 1e-13 or sse == 0.0:
             break
-        c = [(pts[0][d] + pts[1][d]) / 2 for d in range(2)]
-        r = [c[d] + (c[d] - pts[2][d]) for d in range(2)]
-        fr = f(r)
-        if fr < vals[0]:
-            e = [c[d] + 2 * (c[d] - pts[2][d]) for d in range(2)]
-            fe = f(e)
-            pts[2], vals[2] = (e, fe) if fe < fr else (r, fr)
-        elif fr < vals[1]:
-            pts[2], vals[2] = r, fr
-        else:
-            k = [c[d] + 0.5 * (pts[2][d] - c[d]) for d in range(2)]
-            fk = f(k)
-            if fk < vals[2]:
-                pts[2], vals[2] = k, fk
-            else:
-                for j in (1, 2):
-                    pts[j] = [pts[0][d] + 0.5 * (pts[j][d] - pts[0][d]) for d in range(2)]
-                    vals[j] = f(pts[j])
-    best = min(range(3), key=lambda k: vals[k])
-    return pts[best], vals[best]
+    return x, sse
 
 
 def fit(given: Iterable[Tuple[float, float]], p_range: Tuple[float, float] = (1.0, 6.0)) -> Fit:
@@ -123,8 +144,8 @@ def fit(given: Iterable[Tuple[float, float]], p_range: Tuple[float, float] = (1.
     def err(values):
         if n < 2:
             return math.nan
-        mean = sum(values) / n
-        return math.sqrt((n - 1) / n * sum((x - mean) ** 2 for x in values))
+        x = np.asarray(values)
+        return float(np.sqrt((n - 1) / n * np.sum((x - x.mean()) ** 2)))
 
     best.v_bl_err = err([f.v_bl for f in refits])
     best.a_err = err([f.a for f in refits])
@@ -134,40 +155,38 @@ def fit(given: Iterable[Tuple[float, float]], p_range: Tuple[float, float] = (1.
 
 def _fit(shots, p_range):
     """The least-squares curve of `shots` ([`fit`] without the errors)."""
-    shots = [(float(v), float(vr)) for v, vr in shots]
     for v, vr in shots:
         if not (math.isfinite(v) and math.isfinite(vr)) or v <= 0 or vr < 0:
             raise ValueError(f"shot (V = {v}, V_r = {vr}): speeds must be finite, V > 0, V_r >= 0")
-    through = sorted(v for v, vr in shots if vr > 0)
-    stopped = [v for v, vr in shots if vr == 0]
-    if len(through) < 2:
-        raise ValueError(f"{len(through)} perforating shots; the fit needs at least 2")
-    lo = max(stopped, default=0.0)
-    hi = through[0]
+    v = np.array([s[0] for s in shots], dtype=float)
+    vr = np.array([s[1] for s in shots], dtype=float)
+    through = np.sort(v[vr > 0])
+    stopped = v[vr == 0]
+    if through.size < 2:
+        raise ValueError(f"{through.size} perforating shots; the fit needs at least 2")
+    lo = float(stopped.max()) if stopped.size else 0.0
+    hi = float(through[0])
     if lo >= hi:
         raise ValueError(
             f"a stopped shot at {lo} m/s is faster than a perforating one at {hi} m/s"
         )
     plo, phi = p_range
+    lower = np.array([lo, plo])
+    upper = np.array([hi * (1 - 1e-12), phi])
 
-    def clamp(x):
-        return [min(max(x[0], lo), hi * (1 - 1e-12)), min(max(x[1], plo), phi)]
-
-    def cost(x):
-        x = clamp(x)
-        return _best_a(shots, x[0], x[1])[1]
-
-    # A grid over (V_bl, p), then Nelder-Mead from its best point.
-    grid = [
-        [lo + (hi - lo) * i / 40, plo + (phi - plo) * j / 40]
-        for i in range(40)
-        for j in range(41)
-    ]
-    start = min(grid, key=cost)
-    x, _ = _nelder_mead(cost, start, [(hi - lo) / 40, (phi - plo) / 40])
-    v_bl, p = clamp(x)
-    a, sse = _best_a(shots, v_bl, p)
-    return Fit(a=a, p=p, v_bl=v_bl, rms=math.sqrt(sse / len(shots)), bracket=(lo, hi))
+    # The grid over (V_bl, p), all candidates at once, then
+    # Levenberg-Marquardt from its best point.
+    vb, pp = np.meshgrid(lo + (hi - lo) * np.arange(40) / 40, plo + (phi - plo) * np.arange(41) / 40,
+                         indexing="ij")
+    _, res = _best_a(v, vr, vb, pp)
+    sse = np.sum(res * res, axis=-1)
+    start = np.unravel_index(np.argmin(sse), sse.shape)
+    x, _ = _levenberg_marquardt(lambda x: _best_a(v, vr, x[0], x[1])[1],
+                                np.array([vb[start], pp[start]]), lower, upper)
+    v_bl, p = float(x[0]), float(x[1])
+    a, res = _best_a(v, vr, v_bl, p)
+    sse = float(res @ res)
+    return Fit(a=float(a), p=p, v_bl=v_bl, rms=math.sqrt(sse / len(shots)), bracket=(lo, hi))
 
 
 def main(argv):

@@ -51,6 +51,30 @@ def test_scatter_of_two_percent_moves_the_limit_little():
         assert abs(f.residual_speed(v) - vr) < 0.03 * max(TRUE.residual_speed(v), 1.0) + 5.0
 
 
+def test_the_fit_is_the_least_squares_minimum():
+    """An independent oracle: the sum of squared residual speeds, computed
+    here point by point in plain Python, is nowhere smaller on a fine grid
+    of (V_bl, a, p) around the fit of the scattered shots."""
+    scatter = [0.0, 0.0, 0.0, 0.02, -0.02, 0.015, -0.01, 0.02, -0.015]
+    data = shots(TRUE, scatter)
+    f = lj.fit(data)
+
+    def sse(v_bl, a, p):
+        c = lj.Fit(a=a, p=p, v_bl=v_bl, rms=0.0)
+        return sum((vr - c.residual_speed(v)) ** 2 for v, vr in data)
+
+    best = sse(f.v_bl, f.a, f.p)
+    assert math.isclose(best, len(data) * f.rms**2, rel_tol=1e-9)
+    for i in range(-4, 5):
+        for j in range(-4, 5):
+            for k in range(-4, 5):
+                v_bl = f.v_bl * (1 + 2e-3 * i)
+                if not f.bracket[0] <= v_bl < f.bracket[1]:
+                    continue
+                other = sse(v_bl, f.a * (1 + 2e-3 * j), f.p * (1 + 5e-3 * k))
+                assert other >= best * (1 - 1e-9), (i, j, k, other, best)
+
+
 def test_the_errors_are_nil_for_exact_shots_and_cover_the_truth_with_scatter():
     """Exact shots: the jackknife errors vanish (to the fit's own
     tolerance) and the shots bracket the limit. With +-2 % scatter the
