@@ -178,19 +178,41 @@ pub(crate) struct Cells<'a, const D: usize> {
 /// Most cells in the grid (4 Mi: 32 MiB of cell starts).
 const MAX_CELLS: f64 = 4_194_304.0;
 
+/// Points per task of the grid's parallel passes.
+const BLOCK: usize = 4096;
+
+/// Cells per task of the parallel fill of the cell starts.
+const CELL_CHUNK: usize = 1 << 16;
+
 impl<'a, const D: usize> Cells<'a, D> {
     /// The grid, or `None` for no points.
     pub(crate) fn new(points: &'a [[f64; D]], radius: f64) -> Option<Self> {
         if points.is_empty() {
             return None;
         }
-        let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
-        for p in points {
-            for d in 0..D {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
+        // The bounding box, on the pool (min and max are exact in any order).
+        let (lo, hi) = points
+            .par_iter()
+            .with_min_len(BLOCK)
+            .fold(
+                || ([f64::INFINITY; D], [f64::NEG_INFINITY; D]),
+                |(mut lo, mut hi), p| {
+                    for d in 0..D {
+                        lo[d] = lo[d].min(p[d]);
+                        hi[d] = hi[d].max(p[d]);
+                    }
+                    (lo, hi)
+                },
+            )
+            .reduce(
+                || ([f64::INFINITY; D], [f64::NEG_INFINITY; D]),
+                |a, b| {
+                    (
+                        std::array::from_fn(|d| a.0[d].min(b.0[d])),
+                        std::array::from_fn(|d| a.1[d].max(b.1[d])),
+                    )
+                },
+            );
         // Cells no smaller than the radius (so the block of 3^D cells around
         // a point holds all its neighbours), and no more than MAX_CELLS in
         // all: one particle flung far away makes the cells coarser (more
@@ -213,23 +235,48 @@ impl<'a, const D: usize> Cells<'a, D> {
             lo,
             cell,
             dims,
-            start: vec![0; total + 1],
-            sorted: vec![0; points.len()],
+            start: Vec::new(),
+            sorted: Vec::new(),
             r2: radius * radius,
         };
-        // Counting sort of the points into cells, ascending within a cell.
-        let cells: Vec<usize> = points.iter().map(|p| grid.id(grid.cell_of(p))).collect();
-        for &c in &cells {
-            grid.start[c + 1] += 1;
-        }
-        for c in 0..total {
-            grid.start[c + 1] += grid.start[c];
-        }
-        let mut fill = grid.start.clone();
-        for (i, &c) in cells.iter().enumerate() {
-            grid.sorted[fill[c]] = i;
-            fill[c] += 1;
-        }
+        // The points sorted by (cell, index), on the pool: the keys are
+        // distinct, so the order is the one a serial counting sort gives.
+        // A cell number and a point index each fit in 32 bits (at most
+        // MAX_CELLS cells; the callers' node counts are far below 2^32).
+        assert!(
+            points.len() < 1 << 32,
+            "Cells: {} points, at most 2^32",
+            points.len()
+        );
+        let mut keys: Vec<u64> = points
+            .par_iter()
+            .enumerate()
+            .with_min_len(BLOCK)
+            .map(|(i, p)| (grid.id(grid.cell_of(p)) as u64) << 32 | i as u64)
+            .collect();
+        keys.par_sort_unstable();
+        grid.sorted = keys
+            .par_iter()
+            .with_min_len(BLOCK)
+            .map(|&k| (k & 0xffff_ffff) as usize)
+            .collect();
+        // start[c]: the number of points in cells before c, by chunks of
+        // cells, each from a binary search for its first cell.
+        let cell_of_key = |k: u64| (k >> 32) as usize;
+        grid.start = vec![0; total + 1];
+        grid.start
+            .par_chunks_mut(CELL_CHUNK)
+            .enumerate()
+            .for_each(|(chunk, start)| {
+                let first = chunk * CELL_CHUNK;
+                let mut k = keys.partition_point(|&key| cell_of_key(key) < first);
+                for (c, s) in (first..).zip(start.iter_mut()) {
+                    while k < keys.len() && cell_of_key(keys[k]) < c {
+                        k += 1;
+                    }
+                    *s = k;
+                }
+            });
         Some(grid)
     }
 

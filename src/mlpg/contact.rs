@@ -29,6 +29,9 @@
 use crate::neighbours::Cells;
 use rayon::prelude::*;
 
+/// Nodes per task of the searches on the pool.
+const BLOCK: usize = 1024;
+
 /// The pairs `(i, j)`, `i < j`, of nodes of different bodies (`group`)
 /// closer than `reach`, in ascending order, written into `out`. Only the
 /// nodes in the overlap of two bodies' bounding boxes (grown by `reach`)
@@ -39,14 +42,30 @@ pub fn pairs(pos: &[[f64; 3]], group: &[u8], reach: f64, out: &mut Vec<(usize, u
     if bodies < 2 {
         return;
     }
-    let mut boxes = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); bodies];
-    for (x, &g) in pos.iter().zip(group) {
-        let b = &mut boxes[g as usize];
-        for d in 0..3 {
-            b.0[d] = b.0[d].min(x[d]);
-            b.1[d] = b.1[d].max(x[d]);
-        }
-    }
+    // Each body's bounding box, on the pool (min and max are exact in any
+    // order).
+    let empty = || vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); bodies];
+    let boxes = pos
+        .par_iter()
+        .zip(group)
+        .with_min_len(BLOCK)
+        .fold(empty, |mut boxes, (x, &g)| {
+            let b = &mut boxes[g as usize];
+            for d in 0..3 {
+                b.0[d] = b.0[d].min(x[d]);
+                b.1[d] = b.1[d].max(x[d]);
+            }
+            boxes
+        })
+        .reduce(empty, |mut a, b| {
+            for (a, b) in a.iter_mut().zip(&b) {
+                for d in 0..3 {
+                    a.0[d] = a.0[d].min(b.0[d]);
+                    a.1[d] = a.1[d].max(b.1[d]);
+                }
+            }
+            a
+        });
     // Nodes that lie, grown by `reach`, in the box of another body.
     let near = |x: &[f64; 3], g: u8| {
         boxes.iter().enumerate().any(|(h, b)| {
@@ -54,12 +73,14 @@ pub fn pairs(pos: &[[f64; 3]], group: &[u8], reach: f64, out: &mut Vec<(usize, u
         })
     };
     let index: Vec<usize> = (0..pos.len())
+        .into_par_iter()
+        .with_min_len(BLOCK)
         .filter(|&i| near(&pos[i], group[i]))
         .collect();
     if index.is_empty() {
         return;
     }
-    let sub: Vec<[f64; 3]> = index.iter().map(|&i| pos[i]).collect();
+    let sub: Vec<[f64; 3]> = index.par_iter().map(|&i| pos[i]).collect();
     let Some(cells) = Cells::new(&sub, reach) else {
         return;
     };
@@ -81,7 +102,6 @@ fn pairs_in_order(
     out: &mut Vec<(usize, usize)>,
     keep: impl Fn(usize, usize) -> Option<(usize, usize)> + Sync,
 ) {
-    const BLOCK: usize = 1024;
     let blocks: Vec<Vec<(usize, usize)>> = (0..n.div_ceil(BLOCK))
         .into_par_iter()
         .map(|k| {
