@@ -36,6 +36,7 @@
 
 use super::mls::NodalShapes;
 use super::nodal::{entry_parts, for_segments, transpose};
+use crate::isa::{Isa, hot};
 use rayon::prelude::*;
 
 /// Where the solver stops the conjugate gradients: when the largest inner
@@ -81,11 +82,21 @@ impl Columns {
     }
 
     /// The entry `q` and the row `i` of the `k`-th entry.
+    #[inline(always)]
     fn at(&self, k: usize) -> (usize, usize) {
         entry_parts(self.entries[k])
     }
 }
 
+/// `(1, x − centre)`: the linear basis at `x` about `centre`, unscaled
+/// (`u_J` of [`System`]).
+#[inline(always)]
+fn offset(x: [f64; 3], centre: [f64; 3]) -> [f64; 4] {
+    [1.0, x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]]
+}
+
+/// `(1, (x − centre) / h)`: the linear basis scaled by the row's size, for
+/// a well-conditioned moment matrix.
 fn basis(x: [f64; 3], centre: [f64; 3], h: f64) -> [f64; 4] {
     [
         1.0,
@@ -140,26 +151,32 @@ fn norm3(v: [f64; 3]) -> f64 {
 }
 
 /// `e_q = μ_J [J inner] − λ_iᵀ p_J` of one entry `q = (i, J)`, with
-/// `p = p_J` in row `i`'s basis.
+/// `p = u_J` in row `i`'s basis and `lambda` = `G_i T_i` ([`System`]).
 fn entry(p: [f64; 4], inner: bool, mu: [f64; 3], lambda: &[[f64; 3]; 4]) -> [f64; 3] {
     let own = if inner { mu } else { [0.0; 3] };
     std::array::from_fn(|c| own[c] - (0..4).map(|a| p[a] * lambda[a][c]).sum::<f64>())
 }
 
 /// The operator of the multipliers.
+///
+/// With `u_J = (1, x_J − x_i)` and `D_i = diag(1, 1/h_i, 1/h_i, 1/h_i)`,
+/// `p_J = D_i u_J`, so `λ_iᵀ p_J = (G_i T_i)ᵀ u_J` with
+/// `G_i = D_i M_i⁻¹ D_i` and `T_i = Σ_K u_K μ_Kᵀ`: the system holds `G_i`
+/// (the inverse taken of the scaled, well-conditioned `M_i`), and the
+/// iterations divide by nothing.
 struct System<'a> {
     shapes: &'a NodalShapes,
     points: &'a [[f64; 3]],
     volume: &'a [f64],
     inner: &'a [bool],
-    scale: Vec<f64>,
-    minv: Vec<[[f64; 4]; 4]>,
+    g: Vec<[[f64; 4]; 4]>,
     columns: &'a Columns,
 }
 
 impl<'a> System<'a> {
     /// The system of `shapes` (rows over the first `shapes.len()` of
-    /// `points`) with its columns: each row's scale and `M_i⁻¹`.
+    /// `points`) with its columns: each row's `G_i`, from the row's size
+    /// `h_i` (its farthest node) and `M_i⁻¹`.
     fn new(
         shapes: &'a NodalShapes,
         points: &'a [[f64; 3]],
@@ -168,32 +185,29 @@ impl<'a> System<'a> {
         columns: &'a Columns,
     ) -> Self {
         let n = shapes.len();
-        let scale: Vec<f64> = (0..n)
+        let g: Vec<[[f64; 4]; 4]> = (0..n)
             .into_par_iter()
             .map(|i| {
-                shapes
+                let h = shapes
                     .row(i)
                     .map(|q| {
                         let (a, b) = (points[shapes.nodes[q]], points[i]);
                         norm3([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
                     })
                     .fold(0.0, f64::max)
-                    .max(f64::MIN_POSITIVE)
-            })
-            .collect();
-        let minv: Vec<[[f64; 4]; 4]> = (0..n)
-            .into_par_iter()
-            .map(|i| {
+                    .max(f64::MIN_POSITIVE);
                 let mut m = [[0.0; 4]; 4];
                 for q in shapes.row(i) {
-                    let p = basis(points[shapes.nodes[q]], points[i], scale[i]);
+                    let p = basis(points[shapes.nodes[q]], points[i], h);
                     for a in 0..4 {
                         for b in 0..4 {
                             m[a][b] += p[a] * p[b];
                         }
                     }
                 }
-                invert4(m)
+                let minv = invert4(m);
+                let d = [1.0, 1.0 / h, 1.0 / h, 1.0 / h];
+                std::array::from_fn(|a| std::array::from_fn(|b| d[a] * minv[a][b] * d[b]))
             })
             .collect();
         System {
@@ -201,30 +215,43 @@ impl<'a> System<'a> {
             points,
             volume,
             inner,
-            scale,
-            minv,
+            g,
             columns,
         }
     }
 
-    /// `λ_i = M_i⁻¹ Σ_J p_J μ_J` over the inner nodes of row `i`.
+    /// `G_i T_i` with `T_i = Σ_J u_J μ_Jᵀ` over the inner nodes of row `i`:
+    /// `λ_iᵀ p_J = (G_i T_i)ᵀ u_J`. The sum runs in two halves (the
+    /// row's even and odd entries, added at the end), four basis values
+    /// to a vector: two chains of additions instead of one.
+    #[inline(always)]
     fn lambda(&self, i: usize, mu: &[[f64; 3]]) -> [[f64; 3]; 4] {
         let s = self.shapes;
-        let (xi, h) = (self.points[i], self.scale[i]);
-        let mut sum = [[0.0; 3]; 4];
-        for q in s.row(i) {
-            let j = s.nodes[q];
+        let xi = self.points[i];
+        // t[c][a]: component c of the multipliers, basis value a.
+        let add = |t: &mut [[f64; 4]; 3], j: usize| {
             if self.inner[j] {
-                let p = basis(self.points[j], xi, h);
-                for a in 0..4 {
-                    for c in 0..3 {
-                        sum[a][c] += p[a] * mu[j][c];
+                let (u, m) = (offset(self.points[j], xi), mu[j]);
+                for c in 0..3 {
+                    for a in 0..4 {
+                        t[c][a] += u[a] * m[c];
                     }
                 }
             }
+        };
+        let (mut even, mut odd) = ([[0.0; 4]; 3], [[0.0; 4]; 3]);
+        let pairs = s.nodes[s.row(i)].chunks_exact(2);
+        if let [j] = pairs.remainder() {
+            add(&mut even, *j);
         }
-        let m = &self.minv[i];
-        std::array::from_fn(|a| std::array::from_fn(|c| (0..4).map(|b| m[a][b] * sum[b][c]).sum()))
+        for pair in pairs {
+            add(&mut even, pair[0]);
+            add(&mut odd, pair[1]);
+        }
+        let g = &self.g[i];
+        std::array::from_fn(|a| {
+            std::array::from_fn(|c| (0..4).map(|b| g[a][b] * (even[c][b] + odd[c][b])).sum())
+        })
     }
 
     /// `e_q = μ_J [J inner] − λ_iᵀ p_J` for every entry `q = (i, J)`.
@@ -242,17 +269,18 @@ impl<'a> System<'a> {
             out
         };
         rows.into_par_iter().for_each(|(i, out)| {
-            let (xi, h) = (self.points[i], self.scale[i]);
+            let xi = self.points[i];
             let lambda = self.lambda(i, mu);
             for (k, q) in s.row(i).enumerate() {
                 let j = s.nodes[q];
-                let p = basis(self.points[j], xi, h);
+                let p = offset(self.points[j], xi);
                 out[k] = entry(p, self.inner[j], mu[j], &lambda);
             }
         });
     }
 
     /// The Jacobi preconditioner `A_JJ = Σ_i V_i² (1 − p_Jᵀ M_i⁻¹ p_J)`
+    /// (`p_Jᵀ M_i⁻¹ p_J = u_Jᵀ G_i u_J`)
     /// (inner `J` only; the same three values for each axis): the sums of
     /// [`System::gather`] with power 2 over the entries `1 − p_Jᵀ M_i⁻¹ p_J`,
     /// each computed where it is summed (no buffer of `3 nnz` values).
@@ -267,8 +295,8 @@ impl<'a> System<'a> {
                 }
                 for k in c.offsets[j]..c.offsets[j + 1] {
                     let i = c.at(k).1;
-                    let p = basis(self.points[j], self.points[i], self.scale[i]);
-                    let m = &self.minv[i];
+                    let p = offset(self.points[j], self.points[i]);
+                    let m = &self.g[i];
                     let pmp: f64 = (0..4)
                         .map(|x| (0..4).map(|y| p[x] * m[x][y] * p[y]).sum::<f64>())
                         .sum();
@@ -312,8 +340,9 @@ impl<'a> System<'a> {
 struct Fused {
     /// `D_J` (zero off the inner nodes).
     diag: Vec<f64>,
-    /// `w_i` (4 × 3 per row).
-    w: Vec<[[f64; 3]; 4]>,
+    /// `w_i` (4 × 3 per row, each basis value's three components padded
+    /// to four: one vector).
+    w: Vec<[[f64; 4]; 4]>,
 }
 
 impl Fused {
@@ -332,33 +361,79 @@ impl Fused {
             .collect();
         Fused {
             diag,
-            w: vec![[[0.0; 3]; 4]; sys.shapes.len()],
+            w: vec![[[0.0; 4]; 4]; sys.shapes.len()],
         }
     }
 
-    /// `y = A mu`.
-    fn apply(&mut self, sys: &System, mu: &[[f64; 3]], y: &mut [[f64; 3]]) {
-        self.w.par_iter_mut().enumerate().for_each(|(i, wi)| {
+    /// `y = A mu`, in the compiled copy `isa` (every copy gives the same
+    /// bits: [`crate::isa`]).
+    fn apply(&mut self, isa: Isa, sys: &System, mu: &[[f64; 3]], y: &mut [[f64; 3]]) {
+        self.w
+            .par_chunks_mut(ROWS)
+            .enumerate()
+            .for_each(|(k, w)| row_pass(isa, sys, mu, k * ROWS, w));
+        let (diag, w) = (&self.diag[..], &self.w[..]);
+        y.par_chunks_mut(ROWS)
+            .enumerate()
+            .for_each(|(k, y)| column_pass(isa, sys, diag, w, mu, k * ROWS, y));
+    }
+}
+
+/// Rows (and columns) per task of [`Fused::apply`].
+const ROWS: usize = 256;
+
+hot! {
+    /// `w_i = V_i² λ_i(μ)` for the rows `first..first + w.len()`: the
+    /// first pass of [`Fused::apply`].
+    fn row_pass(sys: &System<'_>, mu: &[[f64; 3]], first: usize, w: &mut [[[f64; 4]; 4]]) {
+        for (i, wi) in (first..).zip(w.iter_mut()) {
             let (lambda, v2) = (sys.lambda(i, mu), sys.volume[i].powi(2));
-            *wi = std::array::from_fn(|a| std::array::from_fn(|c| v2 * lambda[a][c]));
-        });
-        let (c, w) = (sys.columns, &self.w);
-        y.par_iter_mut().enumerate().for_each(|(j, yj)| {
+            *wi = std::array::from_fn(|a| {
+                let l = lambda[a];
+                [v2 * l[0], v2 * l[1], v2 * l[2], 0.0]
+            });
+        }
+    }
+}
+
+hot! {
+    /// `y_J = [J inner] (D_J μ_J − Σ_i u_iJᵀ w_i)` for the columns
+    /// `first..first + y.len()`: the second pass of [`Fused::apply`]. The
+    /// sum runs in two halves (the column's even and odd entries, added at
+    /// the end), the three components (and a padding lane) in one vector.
+    fn column_pass(
+        sys: &System<'_>,
+        diag: &[f64],
+        w: &[[[f64; 4]; 4]],
+        mu: &[[f64; 3]],
+        first: usize,
+        y: &mut [[f64; 3]],
+    ) {
+        let c = sys.columns;
+        for (j, yj) in (first..).zip(y.iter_mut()) {
             *yj = [0.0; 3];
             if !sys.inner[j] {
-                return;
+                continue;
             }
             let xj = sys.points[j];
-            let mut t = [0.0; 3];
-            for k in c.offsets[j]..c.offsets[j + 1] {
-                let i = c.at(k).1;
-                let p = basis(xj, sys.points[i], sys.scale[i]);
-                for d in 0..3 {
-                    t[d] += (0..4).map(|a| p[a] * w[i][a][d]).sum::<f64>();
+            let add = |t: &mut [f64; 4], e: u64| {
+                let i = entry_parts(e).1;
+                let (p, wi) = (offset(xj, sys.points[i]), &w[i]);
+                for l in 0..4 {
+                    t[l] += (p[0] * wi[0][l] + p[1] * wi[1][l]) + (p[2] * wi[2][l] + p[3] * wi[3][l]);
                 }
+            };
+            let (mut even, mut odd) = ([0.0; 4], [0.0; 4]);
+            let pairs = c.entries[c.offsets[j]..c.offsets[j + 1]].chunks_exact(2);
+            if let [e] = pairs.remainder() {
+                add(&mut even, *e);
             }
-            *yj = std::array::from_fn(|d| self.diag[j] * mu[j][d] - t[d]);
-        });
+            for pair in pairs {
+                add(&mut even, pair[0]);
+                add(&mut odd, pair[1]);
+            }
+            *yj = std::array::from_fn(|d| diag[j] * mu[j][d] - (even[d] + odd[d]));
+        }
     }
 }
 
@@ -375,6 +450,7 @@ impl Fused {
 /// (on `taylor3d` at 10 across the start's residual is on average a sixth
 /// of the cold one, from 0.02 to 0.93 of it).
 pub fn conform(
+    isa: Isa,
     shapes: &mut NodalShapes,
     points: &[[f64; 3]],
     volume: &[f64],
@@ -441,7 +517,7 @@ pub fn conform(
     let mut fused = Fused::new(&sys);
     let mut ap = vec![[0.0; 3]; n];
     if mu.iter().flatten().any(|&m| m != 0.0) {
-        fused.apply(&sys, mu, &mut ap);
+        fused.apply(isa, &sys, mu, &mut ap);
         let warm: Vec<[f64; 3]> = r
             .par_iter()
             .zip(&ap)
@@ -462,7 +538,7 @@ pub fn conform(
     let mut rz = dot(&r, &z);
     let mut iterations = 0;
     while inner_max(&r) > goal && iterations < CONFORM_ITERATIONS {
-        fused.apply(&sys, &p, &mut ap);
+        fused.apply(isa, &sys, &p, &mut ap);
         let pap = dot(&p, &ap);
         if pap <= 0.0 {
             break;
@@ -491,13 +567,12 @@ pub fn conform(
     // g_q += V_i e_q, row by row in place (no buffer of the 3 nnz e_q):
     // the λ_i first, while the system holds the shapes.
     let lambda: Vec<[[f64; 3]; 4]> = (0..n).into_par_iter().map(|i| sys.lambda(i, mu)).collect();
-    let System { scale, .. } = sys;
     let (offsets, nodes) = (&shapes.offsets, &shapes.nodes);
     for_segments(&mut shapes.grad, offsets, &|i, grad| {
         let v = volume[i];
         for (g, q) in grad.iter_mut().zip(offsets[i]..offsets[i + 1]) {
             let j = nodes[q];
-            let p = basis(points[j], points[i], scale[i]);
+            let p = offset(points[j], points[i]);
             let e = entry(p, inner[j], mu[j], &lambda[i]);
             for d in 0..3 {
                 g[d] += v * e[d];
@@ -552,7 +627,8 @@ mod tests {
 
     /// The fused operator of the conjugate gradients is its plain twin
     /// (the entries, then the column sums) to round-off, on a 4-ring rod
-    /// with pseudo-random multipliers.
+    /// with pseudo-random multipliers, and each compiled copy of it gives
+    /// the same bits.
     #[test]
     fn the_fused_operator_is_the_plain_one() {
         let lat = NodeLattice::cylinder_with(
@@ -579,7 +655,13 @@ mod tests {
         let mut plain = vec![[0.0; 3]; n];
         sys.gather(&e, 2, &mut plain);
         let mut fused = vec![[0.0; 3]; n];
-        Fused::new(&sys).apply(&sys, &mu, &mut fused);
+        Fused::new(&sys).apply(Isa::BASELINE, &sys, &mu, &mut fused);
+        // Every compiled copy gives the baseline's bits.
+        for isa in Isa::available() {
+            let mut copy = vec![[0.0; 3]; n];
+            Fused::new(&sys).apply(isa, &sys, &mu, &mut copy);
+            assert_eq!(copy, fused, "the {} copy", isa.name());
+        }
         let scale = plain.iter().map(|&v| norm3(v)).fold(0.0, f64::max);
         assert!(scale > 0.0);
         for j in 0..n {
@@ -614,6 +696,7 @@ mod tests {
         let plain = inner_force(&shapes, &lat);
         let inner: Vec<bool> = lat.surfaces.iter().map(|s| s.interior()).collect();
         let c = conform(
+            Isa::best(),
             &mut shapes,
             pts,
             &lat.volume,
@@ -669,7 +752,7 @@ mod tests {
         let sup = Supports::compute(&lat.position, SupportParams::default()).unwrap();
         let solve = |pts: &[[f64; 3]], mu: &mut Vec<[f64; 3]>| {
             let mut shapes = NodalShapes::build(pts, &sup).unwrap();
-            let c = conform(&mut shapes, pts, &lat.volume, &inner, tol, mu);
+            let c = conform(Isa::best(), &mut shapes, pts, &lat.volume, &inner, tol, mu);
             (c, inner_force(&shapes, &lat))
         };
         let mut mu = Vec::new();

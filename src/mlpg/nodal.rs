@@ -48,6 +48,7 @@ pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Ve
 }
 
 /// The entry `q` and the row `i` of a transposed entry `q << 32 | i`.
+#[inline(always)]
 pub(crate) fn entry_parts(e: u64) -> (usize, usize) {
     ((e >> 32) as usize, (e & 0xffff_ffff) as usize)
 }

@@ -27,26 +27,36 @@ pub(super) struct Geometry {
 /// What [`Mlpg3d::named_pairs`] finds.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct NamedPairs {
+    /// The smallest distance between named nodes (its square while the
+    /// pairs are visited).
     pub(super) nearest: f64,
+    /// A pair has left the range of the supports.
     pub(super) recompute: bool,
-    pub(super) strain: f64,
+    /// A pair has moved by more than [`RodSetup::rebuild_strain`] of its
+    /// length at the last build.
+    pub(super) strained: bool,
 }
 
 impl NamedPairs {
     const NONE: NamedPairs = NamedPairs {
         nearest: f64::INFINITY,
         recompute: false,
-        strain: 0.0,
+        strained: false,
     };
 
     pub(super) fn join(a: Self, b: Self) -> Self {
         NamedPairs {
             nearest: a.nearest.min(b.nearest),
             recompute: a.recompute || b.recompute,
-            strain: a.strain.max(b.strain),
+            strained: a.strained || b.strained,
         }
     }
 }
+
+/// The margin of the squared pre-tests of [`Mlpg3d::named_pairs`]: far
+/// above the round-off of the exact tests, so a pair the pre-test passes
+/// passes them.
+const PRE_TEST_MARGIN: f64 = 1e-9;
 
 impl Mlpg3d {
     /// The smallest current distance between a node and one it names.
@@ -119,6 +129,7 @@ impl Mlpg3d {
             }
             g.multipliers.clone_from(&self.built_multipliers);
             let c = conform(
+                self.isa,
                 &mut g.shapes,
                 pts,
                 &volume,
@@ -250,32 +261,59 @@ impl Mlpg3d {
 
     /// One pass over the named pairs at the current positions `x` (the
     /// positions at the last build `b`; both the real nodes', then their
-    /// images'): the
-    /// smallest distance (the spacing check), whether a pair has left the
-    /// range of [`Supports::recompute_reason`] (the supports are
-    /// recomputed), and the largest relative motion of a pair since the
-    /// last build ([`REBUILD_STRAIN`]). Minima, maxima and an "any": the
-    /// same for any number of threads.
+    /// images'): the smallest distance (the spacing check), whether a pair
+    /// has left the range of [`Supports::recompute_reason`] (the supports
+    /// are recomputed), and whether a pair has moved since the last build
+    /// by more than [`RodSetup::rebuild_strain`] of its length then
+    /// ([`REBUILD_STRAIN`]). Minima and "any"s: the same for any number of
+    /// threads.
+    ///
+    /// The two tests compare squares first, with a margin
+    /// ([`PRE_TEST_MARGIN`]): only a pair near a bound (or one with a
+    /// non-finite position) takes the exact test's square root and
+    /// division, so the answers are the exact tests' (the smallest
+    /// distance is the root of the smallest square: the root is monotone
+    /// and correctly rounded).
     pub(super) fn named_pairs(&self, x: &[[f64; 3]], b: &[[f64; 3]]) -> NamedPairs {
         let sup = self.supports();
         let limit = 0.5 * (1.0 + sup.params.factor);
-        (0..self.pos.len())
+        let rebuild = self.setup.rebuild_strain;
+        let (within, beyond) = (
+            limit * limit * (1.0 - PRE_TEST_MARGIN),
+            (1.0 + PRE_TEST_MARGIN) / (limit * limit),
+        );
+        let still = rebuild * rebuild * (1.0 - PRE_TEST_MARGIN);
+        let dot = |a: [f64; 3]| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        let pairs = (0..self.pos.len())
             .into_par_iter()
             .map(|i| {
                 let lo = sup.named.offsets[i];
                 let mut out = NamedPairs::NONE;
                 for (q, &j) in sup.named.of(i).iter().enumerate() {
-                    let d = distance(&x[i], &x[j]);
-                    out.nearest = out.nearest.min(d);
-                    let ratio = d / sup.named_distance[lo + q];
-                    out.recompute |= ratio > limit || ratio < 1.0 / limit;
                     let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
+                    let d2 = dot(now);
+                    out.nearest = out.nearest.min(d2);
+                    let named = sup.named_distance[lo + q];
+                    let n2 = named * named;
+                    // Inside the squared bounds (false for a NaN).
+                    let inside = d2 <= within * n2 && d2 >= beyond * n2;
+                    if !out.recompute && !inside {
+                        let ratio = distance(&x[i], &x[j]) / named;
+                        out.recompute = ratio > limit || ratio < 1.0 / limit;
+                    }
                     let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
-                    let strain = norm(std::array::from_fn(|d| now[d] - then[d])) / norm(then);
-                    out.strain = out.strain.max(strain);
+                    let moved: [f64; 3] = std::array::from_fn(|d| now[d] - then[d]);
+                    let small = dot(moved) <= still * dot(then);
+                    if !out.strained && !small {
+                        out.strained = norm(moved) / norm(then) > rebuild;
+                    }
                 }
                 out
             })
-            .reduce(|| NamedPairs::NONE, NamedPairs::join)
+            .reduce(|| NamedPairs::NONE, NamedPairs::join);
+        NamedPairs {
+            nearest: pairs.nearest.sqrt(),
+            ..pairs
+        }
     }
 }

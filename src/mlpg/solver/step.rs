@@ -178,7 +178,7 @@ impl Mlpg3d {
             });
         }
         let supports = pairs.recompute;
-        if supports || pairs.strain > self.setup.rebuild_strain {
+        if supports || pairs.strained {
             if supports {
                 self.supports_at.clone_from(&self.pos);
             }
