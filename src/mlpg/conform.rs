@@ -42,12 +42,14 @@ use rayon::prelude::*;
 /// Where the solver stops the conjugate gradients: when the largest inner
 /// `|a_J|` is below this fraction of the largest `|a_J|` over all nodes.
 ///
-/// Chosen by measurement (docs/notes/2026-11-28-conforming-stop-and-serial.md):
-/// on `taylor3d` at 6 and 10 nodes across, 1e-5 against 1e-8 moves
-/// the length and the face radius by at most 5e-5 of their values (the
-/// scheme's own error there is 0.1-0.9 %), and with the warm start of
-/// [`conform`] takes 73.6 iterations a build at 10 across against 239.6.
-pub const CONFORM_TOLERANCE: f64 = 1e-5;
+/// Chosen by measurement (docs/notes/2026-11-28-conforming-stop-and-serial.md,
+/// docs/notes/2026-11-29-cell-grids-and-the-iterations.md): on `taylor3d`
+/// to rest at 6 and 10 nodes across, 1e-4 against 1e-5 moves the length by
+/// at most 4.7e-7 and the face radius by at most 1.6e-5 of their values
+/// (the scheme's own errors there are 0.1-0.9 %; 1e-5 against 1e-8 moved
+/// them by 7.3e-6 and 4.8e-5), and takes 32 iterations a build at 10
+/// across against 74 (a run 15 % shorter).
+pub const CONFORM_TOLERANCE: f64 = 1e-4;
 
 /// The most conjugate-gradient iterations; past them the correction is
 /// the partial one reached ([`Conformed::after`] says how far).
@@ -777,10 +779,12 @@ mod tests {
             "{warm:?} against {cold:?}"
         );
         // Both meet the stop: the inner nodes' load under a uniform stress,
-        // over 1 Δ² under 1 Pa (1.30 before the correction; the stop is
-        // 1e-5 of the largest |a_J|, a surface node's, of order Δ²).
+        // over 1 Δ² under 1 Pa (1.30 before the correction), is the inner
+        // residual, at most the stop times the largest |a_J| (a surface
+        // node's, a few Δ²): measured 2.41 and 2.38 times the stop from
+        // zero and from the warm start (and below 1e-4 at a stop of 1e-5).
         assert!(
-            cold_force < 1e-4 && warm_force < 1e-4,
+            cold_force < 10.0 * tol && warm_force < 10.0 * tol,
             "{cold_force:e} {warm_force:e}"
         );
         // A start that is not finite, or worse than zero, is dropped: the
