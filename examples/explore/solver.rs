@@ -197,36 +197,33 @@ trait Profiled {
     fn report(&self) -> (usize, String, std::time::Duration);
 }
 
-impl Profiled for Mlpg3d {
-    fn done(&self) -> bool {
-        self.finished()
-    }
-    fn step_count(&self) -> u64 {
-        self.steps()
-    }
-    fn step_once(&mut self) {
-        self.step().unwrap()
-    }
-    fn report(&self) -> (usize, String, std::time::Duration) {
-        let p = self.profile();
-        (self.particles(), p.table(), p.serial_total())
-    }
+/// [`Profiled`] for a run type with `finished`, `steps` and `step`, its
+/// report from `$report`.
+macro_rules! profiled {
+    ($run:ty, |$s:ident| $report:expr) => {
+        impl Profiled for $run {
+            fn done(&self) -> bool {
+                self.finished()
+            }
+            fn step_count(&self) -> u64 {
+                self.steps()
+            }
+            fn step_once(&mut self) {
+                self.step().unwrap()
+            }
+            fn report(&self) -> (usize, String, std::time::Duration) {
+                let $s = self;
+                $report
+            }
+        }
+    };
 }
 
-impl Profiled for Penetration {
-    fn done(&self) -> bool {
-        self.finished()
-    }
-    fn step_count(&self) -> u64 {
-        self.steps()
-    }
-    fn step_once(&mut self) {
-        self.step().unwrap()
-    }
-    fn report(&self) -> (usize, String, std::time::Duration) {
-        self.run().report()
-    }
-}
+profiled!(Mlpg3d, |run| {
+    let p = run.profile();
+    (run.particles(), p.table(), p.serial_total())
+});
+profiled!(Penetration, |run| run.run().report());
 
 /// The process's processor time (user and system) from /proc/self/stat.
 fn process_cpu() -> f64 {
