@@ -170,7 +170,7 @@ pub mod internals {
         pub use crate::mlpg::weak::VOIGT;
         pub use crate::mlpg::{
             Body, Cylinder, Mlpg3d, NodalShapes, NodeLattice, RodSetup, SphereRule, SupportParams,
-            Supports, TestSphere, TractionOperator,
+            Supports, Surfaces, TestSphere, TractionOperator,
         };
         pub use crate::scene::penetration::penetration;
     }

@@ -62,6 +62,11 @@ const EXPLORATIONS: &[(&str, &str, fn())] = &[
         solver::explore_wilkins3d_face,
     ),
     (
+        "wilkins3d_ring",
+        "the Wilkins bar in 3-D to rest: its face's largest radius and its outer ring's mean (MI_SET)",
+        solver::explore_wilkins3d_ring,
+    ),
+    (
         "energy_jump",
         "where a jump of the energy error comes from (MI_SCENE_FILE, MI_SET, MI_JUMP)",
         solver::explore_energy_jump,

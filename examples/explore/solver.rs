@@ -3,7 +3,7 @@
 
 use crate::rod::*;
 use meshless_impact::internals::mlpg::{
-    Cylinder, Mlpg3d, Penetration, RodSetup, WeakForm, penetration,
+    Cylinder, Mlpg3d, Penetration, RodSetup, Surfaces, WeakForm, penetration,
 };
 use meshless_impact::{Scene, Taylor3dParams};
 
@@ -334,6 +334,60 @@ pub fn explore_wilkins3d_face() {
         }
     };
     println!("stop at {:.3} us: {err:?}", s.time() * 1e6);
+}
+
+/// Exploration: the Wilkins bar in 3-D (`MI_SCENE_FILE`, `MI_SET` as in
+/// `explore_taylor3d_stop`) stepped to rest, then its impact face: the
+/// largest distance from the axis over the face's nodes (the observable
+/// `mushroom_radius`), and over the face's outer ring (the nodes on both
+/// the face and the mantle) its largest, smallest and mean distance and
+/// the spread of those radii by azimuth. The ring's mean is the radius an
+/// axisymmetric solver measures (its ring is one particle); the largest
+/// over the face is that plus the ring's scatter.
+pub fn explore_wilkins3d_ring() {
+    let scene = wilkins_or_env_scene();
+    let mut s = build3d(&scene);
+    let t0 = std::time::Instant::now();
+    while !s.finished() {
+        s.step().unwrap();
+    }
+    let rod = s.rod();
+    let lattice = s.lattice();
+    let x = s.positions();
+    let r = |i: usize| x[i][0].hypot(x[i][1]);
+    let ring: Vec<usize> = lattice
+        .sets
+        .face
+        .iter()
+        .copied()
+        .filter(|&i| lattice.surfaces[i].has(Surfaces::MANTLE))
+        .collect();
+    let radii: Vec<f64> = ring.iter().map(|&i| r(i)).collect();
+    let mean = radii.iter().sum::<f64>() / radii.len() as f64;
+    let (lo, hi) = radii
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+    let sd = (radii.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / radii.len() as f64).sqrt();
+    let face_max = lattice.sets.face.iter().map(|&i| r(i)).fold(0.0, f64::max);
+    println!(
+        "{} nodes, at rest {} at {:.2} us, {:.1} s: length {:.4} mm; face radius (largest over the \
+         face) {:.4} mm (check {:.4}); outer ring of {} nodes: mean {:.4} mm, sd {:.4} mm, \
+         smallest {:.4} mm, largest {:.4} mm; spread {:.4}; energy error {:.4}",
+        s.particles(),
+        s.at_rest(),
+        s.time() * 1e6,
+        t0.elapsed().as_secs_f64(),
+        rod.rod_length * 1e3,
+        rod.mushroom_radius * 1e3,
+        face_max * 1e3,
+        ring.len(),
+        mean * 1e3,
+        sd * 1e3,
+        lo * 1e3,
+        hi * 1e3,
+        s.mushroom_radius_spread(),
+        s.energies().error
+    );
 }
 
 /// Exploration: where a jump of the energy error comes from. The scene

@@ -2,7 +2,7 @@
 //! be written.
 
 use super::stop::Stop;
-use meshless_impact::{Error, ObservableSpec, Simulation};
+use meshless_impact::{Error, ObservableSpec, Scene, Simulation};
 use std::fs::{File, OpenOptions};
 use std::io::{ErrorKind, Write};
 use std::path::Path;
@@ -83,8 +83,12 @@ pub(crate) fn write_csv_records(
 /// `particles`, `steps`, `end_time`, `wall_time_s`, and `outcome`:
 /// `"finished"`, or the name of the error that stopped the run, whose
 /// message is then `error` (the values are those of the state at the stop,
-/// outside the solver's domain of validity).
+/// outside the solver's domain of validity). The scene's references of the
+/// observables follow as objects by observable name: `reference`, or, where
+/// the scene has a converged continuum reference beside the experiment's
+/// (test 7), `reference_continuum` and `reference_experiment`.
 pub(crate) fn final_json(
+    scene: &Scene,
     specs: &[ObservableSpec],
     values: &[f64],
     particles: usize,
@@ -112,6 +116,20 @@ pub(crate) fn final_json(
     );
     if let Some(e) = stopped {
         m.insert("error".into(), e.to_string().into());
+    }
+    let of = |get: &dyn Fn(&str) -> Option<f64>| -> serde_json::Map<String, serde_json::Value> {
+        specs
+            .iter()
+            .filter_map(|s| get(s.name).map(|r| (s.name.to_string(), serde_json::json!(r))))
+            .collect()
+    };
+    let primary = of(&|name| scene.reference_of(name));
+    if scene.has_continuum_reference() {
+        let continuum = of(&|name| scene.continuum_reference_of(name));
+        m.insert("reference_continuum".into(), continuum.into());
+        m.insert("reference_experiment".into(), primary.into());
+    } else if !primary.is_empty() {
+        m.insert("reference".into(), primary.into());
     }
     serde_json::Value::Object(m)
 }

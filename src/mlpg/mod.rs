@@ -48,7 +48,7 @@ pub mod weak;
 #[cfg(test)]
 mod measure;
 
-pub use lattice::{Cylinder, NodeLattice};
+pub use lattice::{Cylinder, NodeLattice, Surfaces};
 pub use mls::{NodalShapes, SupportParams, Supports};
 pub use solver::{Body, Mlpg3d, RodSetup};
 pub use sphere::{SphereRule, TestSphere};

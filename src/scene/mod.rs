@@ -141,6 +141,12 @@ impl SceneKind {
     }
 }
 
+/// The suffix of a reference that is the converged continuum solution with
+/// the scene's own constants (`mushroom_radius_continuum`), beside the
+/// reference under the observable's own name, which for the rod scenes is
+/// the experiment's.
+pub const CONTINUUM_SUFFIX: &str = "_continuum";
+
 /// A complete, validated-on-demand description of one run: a kind of scene
 /// and a value for each parameter of its table.
 ///
@@ -580,6 +586,28 @@ impl Scene {
         }
         *self = next;
         Ok(())
+    }
+    /// The reference under the observable `name` itself (for the rod
+    /// scenes the experiment's), if the scene has one.
+    pub fn reference_of(&self, name: &str) -> Option<f64> {
+        self.reference.get(name).copied()
+    }
+
+    /// The converged continuum reference of the observable `name`
+    /// (`NAME_continuum` in the reference table), if the scene has one.
+    pub fn continuum_reference_of(&self, name: &str) -> Option<f64> {
+        self.reference
+            .get(&format!("{name}{CONTINUUM_SUFFIX}"))
+            .copied()
+    }
+
+    /// Whether the scene has both an experiment's and a converged
+    /// continuum reference for some observable: its tables then show both.
+    pub fn has_continuum_reference(&self) -> bool {
+        self.reference.keys().any(|k| {
+            k.strip_suffix(CONTINUUM_SUFFIX)
+                .is_some_and(|name| self.reference.contains_key(name))
+        })
     }
 
     /// Current value of a parameter.

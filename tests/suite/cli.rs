@@ -741,3 +741,87 @@ fn the_scheme_by_name_gives_the_bits_of_the_rust_api() {
         "{text}"
     );
 }
+
+/// The main job's table and JSON name both references where a scene has
+/// both (test 7: the converged continuum answer of LS-DYNA, 34.5 mm and
+/// 5.31 mm, and House et al.'s experiment, 34.6 mm and 4.75 mm; Batra &
+/// Zhang 2008), each with its own error, and say why they differ; a scene
+/// with one reference (Table 1 test 1) keeps the one column.
+#[test]
+fn the_table_and_json_show_the_continuum_and_the_experiment() {
+    let dir = scratch("references");
+    let json = dir.join("out.json");
+    let out = bin()
+        .args(SMALL_RUN)
+        .args(["--json", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let header = text
+        .lines()
+        .find(|l| l.starts_with("observable"))
+        .unwrap_or_else(|| panic!("no table header: {text}"));
+    let columns: Vec<&str> = header.split_whitespace().collect();
+    assert_eq!(
+        columns,
+        [
+            "observable",
+            "value",
+            "continuum",
+            "error",
+            "experiment",
+            "error",
+            "unit"
+        ],
+        "{text}"
+    );
+    let face = text
+        .lines()
+        .find(|l| l.starts_with("mushroom_radius "))
+        .unwrap();
+    let cells: Vec<&str> = face.split_whitespace().collect();
+    assert_eq!((cells[2], cells[4]), ("0.005310", "0.004750"), "{face}");
+    assert!(text.contains("continuum: the converged solution"), "{text}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let radius = v["mushroom_radius"].as_f64().unwrap();
+    for (cell, reference) in [(cells[3], 5.31e-3), (cells[5], 4.75e-3)] {
+        let printed: f64 = cell.trim_end_matches('%').parse().unwrap();
+        let want = 100.0 * (radius - reference) / reference;
+        assert!(
+            (printed - want).abs() <= 0.005,
+            "{cell} against {want}: {face}"
+        );
+    }
+    assert_eq!(v["reference_continuum"]["mushroom_radius"], 5.31e-3);
+    assert_eq!(v["reference_continuum"]["rod_length"], 34.5e-3);
+    assert_eq!(v["reference_experiment"]["mushroom_radius"], 4.75e-3);
+    assert_eq!(v["reference_experiment"]["rod_length"], 34.6e-3);
+    assert!(v.get("reference").is_none(), "{v}");
+    // Table 1 test 1: the experiment only.
+    let out = bin()
+        .args([
+            "run",
+            "table1-1",
+            "--set",
+            "particles_radial=4",
+            "--set",
+            "end_time=3e-6",
+        ])
+        .args(["--json", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines()
+            .any(|l| l.split_whitespace().collect::<Vec<_>>()
+                == ["observable", "value", "reference", "error", "unit"]),
+        "{text}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v["reference"]["mushroom_radius"].as_f64().unwrap() > 0.0);
+    assert!(v.get("reference_continuum").is_none(), "{v}");
+}
