@@ -162,6 +162,7 @@ pub mod internals {
         pub use crate::mlpg::mls::distance;
         pub use crate::mlpg::nodal::NodalOperator;
         pub use crate::mlpg::penetration::{Penetration, PenetrationSetup};
+        pub use crate::mlpg::scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
         pub use crate::mlpg::solver::{SMOOTHING, WeakForm};
         pub use crate::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
         pub use crate::mlpg::step::{

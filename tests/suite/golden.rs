@@ -28,6 +28,14 @@
 //! dot products of its conforming correction. The penetration case (under
 //! 1024 nodes, one block) kept its bits.
 //!
+//! **`scheme = paper` in 3-D keeps new bits, not the seed-method bits.**
+//! The scheme work pinned the paper's 3-D case with the seed's method
+//! (8909997); the sums over the nodes in fixed blocks moved its energies
+//! in the last digits (above). The new bits are kept, and
+//! [`the_papers_3d_scheme_is_still_the_seeds_method`] shows that the scheme
+//! is still the seed's method: the same choices, the motion's finals with
+//! the seed-method bits, and the energies within round-off of them.
+//!
 //! `plate_impact` was added on 2026-11-28 (its uniaxial solver has no
 //! compiled copies; the digest is the same in each), with the ceramic set
 //! whose target spalls, so that crack growth and pulverization in tension
@@ -282,4 +290,96 @@ fn golden_runs_keep_their_bits_in_every_copy() {
         }
     }
     assert!(failed.is_empty(), "bits changed in: {failed:?}");
+}
+
+/// `scheme = paper` in 3-D is still the seed's MLPG mixed method, although
+/// its golden case was re-recorded (2026-11-28, issue 52) when the 3-D
+/// solver's sums over the nodes began to run in fixed blocks on the pool.
+/// Two checks, each of which fails if the scheme stops being the seed's:
+/// - its choices: the scheme decodes to the seed's forces (the local weak
+///   form over test spheres, eq. 10), the order-1 velocity smoothing with
+///   the solver's α, Lagrangian nodes (no shifting) and the aligned ring
+///   lattice;
+/// - its motion: the golden case's final observables of the motion (every
+///   one but the energies) keep, bit for bit, the seed-method bits that
+///   the scheme work recorded (8909997, 2026-11-28, before any speed
+///   work), and the three energies that are sums over the nodes (kinetic
+///   energy, smoothing dissipation, energy error) differ from those only
+///   by the order of summation: within 1e-12 relative for the two sums
+///   (a reordered sum of 1147 terms moves by at most about n ε = 1.3e-13
+///   of itself; measured 2 and 320 ulp, 4e-16 and 7e-14) and 1e-11 for the
+///   energy error, a difference 72 times smaller than the energies it
+///   subtracts (measured 2e-13).
+#[test]
+fn the_papers_3d_scheme_is_still_the_seeds_method() {
+    use meshless_impact::internals::mlpg::{
+        Forces, Lattice, MlpgScheme, SMOOTHING, SmoothingOrder,
+    };
+    let mut scene = Scene::builtin("taylor3d").unwrap();
+    scene.set("scheme", 1.0).unwrap();
+    let scheme = MlpgScheme::decode(|name| scene.get(name)).unwrap();
+    assert_eq!(
+        scheme,
+        MlpgScheme {
+            forces: Forces::Sphere,
+            order: SmoothingOrder::One,
+            smoothing: SMOOTHING,
+            shifting: 0.0,
+            lattice: Lattice::Aligned,
+        }
+    );
+    /// The paper's case's finals as the scheme work recorded them.
+    const SEED_METHOD: [u64; 16] = [
+        0x3fa2_f927_0a94_7978,
+        0x3f71_e945_8eba_27ed,
+        0x3f99_9bc6_5688_88ab,
+        0x4066_975b_c674_8c02,
+        0x0000_0000_0000_0000,
+        0x3fd3_65ba_8cd2_686c,
+        0x4078_8979_5a51_d59f,
+        0x4064_8a2b_099a_7e04,
+        0x4048_8b89_d815_a4c1,
+        0x4013_d80c_d210_c1c0,
+        0x4015_4fea_4aaf_d64e,
+        0x3f8c_6b4b_1651_ea5a,
+        0x0000_0000_0000_0000,
+        0x3f79_4433_d2c0_c9b5,
+        0x0000_0000_0000_0000,
+        0x4047_ae74_ace9_7f49,
+    ];
+    let case = cases()
+        .into_iter()
+        .find(|c| c.name.starts_with("taylor3d, scheme = paper"))
+        .unwrap();
+    let names: Vec<&str> = Simulation::new(Scene::builtin("taylor3d").unwrap())
+        .unwrap()
+        .observable_specs()
+        .iter()
+        .map(|s| s.name)
+        .collect();
+    let sums = [
+        ("kinetic_energy", 1e-12),
+        ("smoothing_dissipation", 1e-12),
+        ("energy_error", 1e-11),
+    ];
+    for isa in copies() {
+        let (finals, _, _) = digest(case.scene, case.sets, isa);
+        assert_eq!(finals.len(), SEED_METHOD.len());
+        for (k, name) in names.iter().enumerate() {
+            let (now, seed) = (f64::from_bits(finals[k]), f64::from_bits(SEED_METHOD[k]));
+            match sums.iter().find(|(n, _)| n == name) {
+                Some(&(_, bound)) => assert!(
+                    (now - seed).abs() <= bound * seed.abs(),
+                    "{name} [{}]: {now:e} against the seed method's {seed:e}",
+                    isa.name()
+                ),
+                None => assert_eq!(
+                    finals[k],
+                    SEED_METHOD[k],
+                    "{name} [{}]: {now:e} against the seed method's {seed:e}",
+                    isa.name()
+                ),
+            }
+        }
+    }
 }
