@@ -72,7 +72,7 @@ impl Table1Row {
     /// experiment's under the observable's own name, the paper's MSPH
     /// results with `_msph`, and, for test 7, the converged continuum
     /// solution with the same Johnson-Cook constants with `_continuum`
-    /// ([`TEST7_CONTINUUM`]).
+    /// (`TEST7_CONTINUUM`).
     pub fn reference(&self) -> BTreeMap<String, f64> {
         let mut r = BTreeMap::from([
             ("rod_length".to_string(), self.lf_test),
