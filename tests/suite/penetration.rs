@@ -508,3 +508,46 @@ fn a_clamped_rim_holds_its_ring_still() {
     assert!(o(&clamped, "projectile_velocity") < o(&free, "projectile_velocity"));
     assert!(o(&clamped, "energy_error") < 0.05);
 }
+
+/// What node shifting books over a run with the conservative carry (the
+/// seed's case at 4 across to 8 µs: the projectile through the plate's
+/// front half, the nodes of the crater shifting): the kinetic energy that
+/// the carry changed, a part of the smoothing dissipation, is at most
+/// 1e-3 of the impact energy and smaller than the run's energy error
+/// (what the balance fails to account for), so the booking hides no loss
+/// of energy larger than the balance's own error. Measured (153 steps):
+/// −6.41 J, −4.27e-4 of the 15.0 kJ impact energy (the carry created a
+/// little energy, net), at most 8.0e-6 of it in one step, against the
+/// run's energy error of 4.73e-3 (0.09 of it) and the smoothing's 7.4 %.
+#[test]
+fn what_shifting_books_over_a_run_is_bounded() {
+    use meshless_impact::internals::mlpg::penetration;
+    let mut scene = seed_scene();
+    scene.set("particles_radial", 4.0).unwrap();
+    scene.set("end_time", 8e-6).unwrap();
+    let mut run = penetration(&scene).unwrap();
+    let initial = run.energies().initial;
+    let (mut most, mut steps) = (0.0f64, 0u64);
+    while !run.finished() {
+        let before = run.run().shift_dissipation();
+        run.step().unwrap();
+        most = most.max((run.run().shift_dissipation() - before).abs());
+        steps += 1;
+    }
+    let e = run.energies();
+    let booked = run.run().shift_dissipation();
+    println!(
+        "{steps} steps: shifting booked {booked:e} J = {:e} of the impact energy {initial:e} J \
+         (largest in one step {:e}); smoothing {:e}; energy error {:e}",
+        booked / initial,
+        most / initial,
+        e.smoothing / initial,
+        e.error
+    );
+    assert!(booked.abs() <= 1e-3 * initial, "{booked} J of {initial} J");
+    assert!(
+        booked.abs() < e.error * initial,
+        "{booked} J against the energy error {} of {initial} J",
+        e.error
+    );
+}

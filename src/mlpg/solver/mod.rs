@@ -214,6 +214,11 @@ pub struct Mlpg3d {
     damping_dissipation: f64,
     contact_dissipation: f64,
     smoothing_dissipation: f64,
+    /// The part of `smoothing_dissipation` that node shifting booked: the
+    /// kinetic energy its carry of the velocities changed (a state saved
+    /// before this tally loads with 0).
+    #[serde(default)]
+    shift_dissipation: f64,
     rebuilds: u64,
     at_rest: bool,
     /// The quiet end (saved as the time since which the run has been
@@ -379,6 +384,7 @@ impl Mlpg3d {
             damping_dissipation: 0.0,
             contact_dissipation: 0.0,
             smoothing_dissipation: 0.0,
+            shift_dissipation: 0.0,
             rebuilds: 0,
             at_rest: false,
             quiet_since: QuietEnd::default(),

@@ -80,6 +80,14 @@ impl Mlpg3d {
         }
     }
 
+    /// The part of the smoothing dissipation ([`Energies::smoothing`]) that
+    /// node shifting booked over the run so far (J; the whole body's in the
+    /// quarter model): the kinetic energy that carrying the moved nodes'
+    /// velocities changed.
+    pub fn shift_dissipation(&self) -> f64 {
+        self.multiplicity() * self.shift_dissipation
+    }
+
     /// How many copies of the modelled part make the body: 4 in the quarter
     /// model, else 1.
     pub fn multiplicity(&self) -> f64 {

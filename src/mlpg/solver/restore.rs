@@ -116,6 +116,7 @@ impl Mlpg3d {
                 self.damping_dissipation,
                 self.contact_dissipation,
                 self.smoothing_dissipation,
+                self.shift_dissipation,
                 self.quiet_since.since().unwrap_or(0.0),
                 self.last_release,
             ],

@@ -98,6 +98,7 @@ impl Mlpg3d {
             ke[1] = kinetic(fields.vel, frame.mass);
         }
         self.smoothing_dissipation += ke[0] - ke[1];
+        self.shift_dissipation += ke[0] - ke[1];
         Ok(())
     }
 }
