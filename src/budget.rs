@@ -1,7 +1,9 @@
 //! The memory budget: before a run allocates, its peak memory is estimated
-//! from its node count and the peak resident bytes per node that
-//! BENCHMARKS.md ("Memory per node") measures for its solver, and a run over
-//! the budget is refused with [`Error::MemoryBudget`].
+//! from its node count and the peak bytes a node of its solver (and, in
+//! 3-D, of its forces) measured over whole runs, and a run over the budget
+//! is refused with [`Error::MemoryBudget`]. The 3-D solver's bytes a node
+//! are held by a test between its heap's peak and twice it
+//! (`tests/mlpg_alloc.rs`; BENCHMARKS.md; docs/notes/2026-11-29-memory-bounds.md).
 //!
 //! The budget is [`DEFAULT_MEMORY_BUDGET`] (8 GiB, below the memory of the
 //! machines the project is measured on) unless the environment variable
@@ -26,15 +28,19 @@ const MOST: f64 = 1024.0 * 1024.0 * GIB;
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
 /// Bytes of a run before its nodes: the program, the thread pool, the
-/// tables (measured: the smallest runs peak at 6-14 MB).
+/// tables (measured: the smallest runs peak at 6-14 MB resident). What the
+/// allocator keeps resident beyond the heap's peak (4-22 MB in the 3-D
+/// runs of docs/notes/2026-11-29-memory-bounds.md) is in the margin of
+/// the bytes a node.
 const BASE: f64 = 16.0 * 1024.0 * 1024.0;
 
-/// How a kind of scene's memory grows with its nodes: the peak resident
-/// bytes per node of its solver, measured over whole runs (BENCHMARKS.md,
-/// "Memory per node"), with a margin.
+/// How a kind of scene's memory grows with its nodes: the peak bytes per
+/// node of its solver, measured over whole runs, with a margin (the 3-D
+/// solver's: the heap's peak counted by the allocator, `tests/mlpg_alloc.rs`;
+/// the others': the peak resident memory, BENCHMARKS.md, "Memory per node").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MemoryPerNode {
-    /// Peak resident bytes per node (particle) of the solver.
+    /// Peak bytes per node (particle) of the solver.
     pub bytes: f64,
 }
 
@@ -82,10 +88,16 @@ pub fn parse_budget(text: &str) -> Result<f64> {
     Ok(value)
 }
 
+/// The estimated peak memory (bytes) of a run of `nodes` nodes at
+/// `per_node`: the base and the nodes at their bytes.
+pub fn estimate(nodes: f64, per_node: MemoryPerNode) -> f64 {
+    BASE + nodes * per_node.bytes
+}
+
 /// Refuses a run of `nodes` nodes at `per_node` whose estimate exceeds
 /// `budget` (bytes).
 pub fn check_memory_with(nodes: f64, per_node: MemoryPerNode, budget: f64) -> Result<()> {
-    let estimate = BASE + nodes * per_node.bytes;
+    let estimate = estimate(nodes, per_node);
     if estimate <= budget {
         Ok(())
     } else {

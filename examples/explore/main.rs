@@ -7,9 +7,19 @@
 
 use std::process::ExitCode;
 
+mod heap_peak;
 mod mlpg;
 mod penetration;
 mod solver;
+
+// The counting allocator of `tests/mlpg_alloc.rs`: the heap explorations
+// read its counters (relaxed atomics; the 3-D steps allocate nothing
+// between rebuilds, so the others run as fast).
+#[path = "../../tests/heap/mod.rs"]
+#[allow(dead_code)]
+mod heap;
+#[global_allocator]
+static GLOBAL: heap::Counting = heap::Counting;
 
 // The fixtures the explorations share with the test suite, by their path.
 #[path = "../../tests/suite/mlpg/bar.rs"]
@@ -75,6 +85,16 @@ const EXPLORATIONS: &[(&str, &str, fn())] = &[
         "contact_by_rings",
         "the elastic rebound's contact time by rings, both forms (RINGS)",
         solver::explore_contact_by_rings,
+    ),
+    (
+        "heap_peak",
+        "a scene's heap peak per node against its memory estimate, and where (MI_SCENE, MI_SET, STEPS)",
+        heap_peak::heap_peak,
+    ),
+    (
+        "heap_by_part",
+        "the heap of taylor3d by part after its first step and its peak (PARTICLES_RADIAL, STEPS)",
+        heap_peak::heap_by_part,
     ),
     (
         "seed_case",

@@ -671,7 +671,28 @@ impl Scene {
         }
         let row = self.kind.row();
         (row.check)(self)?;
-        crate::budget::check_memory((row.nodes)(self), row.memory)
+        crate::budget::check_memory((row.nodes)(self), (row.memory)(self))
+    }
+
+    /// The run's node count as the memory budget estimates it from the
+    /// parameters, before anything is built.
+    pub fn estimated_nodes(&self) -> f64 {
+        (self.kind.row().nodes)(self)
+    }
+
+    /// The peak bytes a node of the run's solver (and scheme) that the
+    /// memory budget estimates: for the 3-D scenes, an upper bound on the
+    /// heap's peak a node within twice it (`tests/mlpg_alloc.rs`).
+    pub fn memory_per_node(&self) -> f64 {
+        (self.kind.row().memory)(self).bytes
+    }
+
+    /// The run's estimated peak memory (bytes) that the memory budget
+    /// checks ([`crate::memory_budget`]): a base for the program and
+    /// [`Scene::estimated_nodes`] at [`Scene::memory_per_node`].
+    pub fn memory_estimate(&self) -> f64 {
+        let row = self.kind.row();
+        crate::budget::estimate(self.estimated_nodes(), (row.memory)(self))
     }
 }
 

@@ -34,7 +34,7 @@ pub static ROW: SceneRow = SceneRow {
     nodes: |s| NohParams::from_values(s.values()).particles_radial,
     // Measured 0.67 kB a particle at 20 000 (BENCHMARKS.md, "Memory per
     // node").
-    memory: MemoryPerNode { bytes: 1000.0 },
+    memory: |_| MemoryPerNode { bytes: 1000.0 },
     build: |s: &Scene| {
         Ok(Box::new(NohSolver::new(NohParams::from_values(
             s.values(),

@@ -10,8 +10,7 @@
 use super::Scene;
 use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
 use super::registry::{SceneRow, no_variants, restore};
-use super::taylor3d::ring_lattice_nodes;
-use crate::budget::MemoryPerNode;
+use super::taylor3d::{RingLattice, mlpg_memory};
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
@@ -35,10 +34,9 @@ pub static ROW: SceneRow = SceneRow {
     variants: no_variants,
     check: |s| setup(s).map(|_| ()),
     nodes,
-    // Measured 34 kB a node over the seed's run at 4 across (whole body;
-    // 29 kB as a quarter): the contact pairs and the damaged plate's
-    // supports grow (BENCHMARKS.md, "Memory per node").
-    memory: MemoryPerNode { bytes: 40_000.0 },
+    // The 3-D MLPG solver's, by its forces: the contact and the damaged
+    // plate add little to the heap (docs/notes/2026-11-29-memory-bounds.md).
+    memory: mlpg_memory,
     build: |s: &Scene| Ok(Box::new(penetration(s)?)),
     restore: restore::<Penetration>,
     fmu: Some(super::registry::FmuIdentity {
@@ -266,18 +264,19 @@ const LEN: usize = BEFORE.len() + PLATE_CERAMIC.len() + AFTER.len();
 pub const PENETRATION_PARAMS: &[ParamSpec] = &concat::<LEN>(&[BEFORE, &PLATE_CERAMIC, AFTER]);
 
 /// The nodes of a run: the ring lattices of the projectile and the plate at
-/// the projectile's radial spacing (a quarter of them in the quarter model).
+/// the projectile's radial spacing (their quarters in the quarter model).
 fn nodes(s: &Scene) -> f64 {
     let v = |name: &str| s.get(name).expect("a penetration parameter");
     let radius = 0.5 * v("projectile_diameter");
     let spacing = radius / (v("particles_radial") - 1.0);
-    let nodes = ring_lattice_nodes(radius, v("projectile_length"), spacing)
-        + ring_lattice_nodes(0.5 * v("plate_diameter"), v("plate_thickness"), spacing);
-    if v("symmetry") >= 0.5 {
-        nodes / 4.0
-    } else {
-        nodes
-    }
+    let lattice = RingLattice::of(s);
+    // The plate's lattice is aligned whatever `lattice` says.
+    let plate = RingLattice {
+        staggered: false,
+        ..lattice
+    };
+    lattice.nodes(radius, v("projectile_length"), spacing)
+        + plate.nodes(0.5 * v("plate_diameter"), v("plate_thickness"), spacing)
 }
 
 /// The run of a `penetration` scene (its registry row's build, typed).

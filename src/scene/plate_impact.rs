@@ -42,7 +42,7 @@ pub static ROW: SceneRow = SceneRow {
     },
     // A cell holds its node, its material point and its fields: about
     // 0.4 kB (the ceramic point is the largest part); twice that for room.
-    memory: MemoryPerNode { bytes: 1000.0 },
+    memory: |_| MemoryPerNode { bytes: 1000.0 },
     build: |s: &Scene| Ok(Box::new(setup(s)?)),
     restore: restore::<PlateImpact>,
     fmu: Some(FmuIdentity {

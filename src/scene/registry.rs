@@ -64,9 +64,10 @@ pub struct SceneRow {
     /// The nodes (particles) a run of a valid scene of this kind will have,
     /// from its parameters alone (before anything is allocated).
     pub nodes: fn(&Scene) -> f64,
-    /// The peak memory per node of this kind's solver: with `nodes`, what
-    /// the memory budget checks ([`crate::budget`]).
-    pub memory: MemoryPerNode,
+    /// The peak memory per node of a run of a valid scene of this kind
+    /// (of its solver, and of its scheme where the schemes differ): with
+    /// `nodes`, what the memory budget checks ([`crate::budget`]).
+    pub memory: fn(&Scene) -> MemoryPerNode,
     /// Builds the initial state of a run of a valid scene of this kind.
     pub build: fn(&Scene) -> Result<Box<dyn Model>>,
     /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked

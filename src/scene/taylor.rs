@@ -72,7 +72,7 @@ pub static ROW: SceneRow = SceneRow {
     nodes: |s| TaylorParams::of(s).nodes(),
     // Measured 2.0 kB a node at 60 across (BENCHMARKS.md, "Memory per
     // node"); the neighbour lists grow as the rod spreads.
-    memory: MemoryPerNode { bytes: 4000.0 },
+    memory: |_| MemoryPerNode { bytes: 4000.0 },
     build: |s: &Scene| {
         let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
         Ok(Box::new(TaylorSolver::with_material(

@@ -42,14 +42,10 @@ pub static ROW: SceneRow = SceneRow {
         let p = Taylor3dParams::of(s);
         let radius = 0.5 * p.initial_diameter;
         let spacing = radius / (p.particles_radial - 1.0);
-        let nodes = ring_lattice_nodes(radius, p.initial_length, spacing);
-        if p.symmetry >= 0.5 {
-            nodes / 4.0
-        } else {
-            nodes
-        }
+        let lattice = RingLattice::of(s);
+        lattice.nodes(radius, p.initial_length, spacing)
     },
-    memory: RING_LATTICE_MEMORY,
+    memory: mlpg_memory,
     build: |s: &Scene| {
         let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
         Ok(Box::new(Taylor3dParams::of(s).build_with(material)?))
@@ -63,16 +59,80 @@ pub static ROW: SceneRow = SceneRow {
     }),
 };
 
-/// The peak memory per node of the 3-D MLPG solver: measured up to
-/// 14.9 kB a node over whole runs (BENCHMARKS.md, "Memory per node").
-pub(crate) const RING_LATTICE_MEMORY: MemoryPerNode = MemoryPerNode { bytes: 20_000.0 };
+/// The peak bytes a node of the 3-D MLPG solver (`taylor3d`,
+/// `penetration`) with the nodal forms (`weak_form` 1 and 2, both scenes'
+/// defaults). The heap's most live at once over whole runs, counted by the
+/// allocator (2026-11-29), is 4.51-6.10 kB a node: `taylor3d` 5.12 at 4
+/// across, 5.05 at 6, 4.89 at 10; `penetration` 4.51 at 3, 4.73 at 4, 4.81
+/// at 6 (the whole body), and as a quarter 6.10 at 3 and 5.67 at 8. This
+/// is 1.23-1.66 times those peaks (`tests/mlpg_alloc.rs` holds it between
+/// the peak and twice it); with the base it covers the peak resident
+/// memory of every run measured; and it admits a million-node `taylor3d` (34
+/// across) at the default budget of 8 GiB (docs/notes/2026-11-29-memory-bounds.md).
+/// It was 20 kB (`taylor3d`) and 40 kB (`penetration`) before.
+pub(crate) const NODAL_FORM_MEMORY: MemoryPerNode = MemoryPerNode { bytes: 7_500.0 };
 
-/// Nodes of the ring lattice of a cylinder ([`crate::mlpg::lattice`]) of
-/// `radius` and `length` at the radial `spacing`: `1 + 3 k (k + 1)` a layer
-/// for `k` rings, one layer a spacing.
-pub(crate) fn ring_lattice_nodes(radius: f64, length: f64, spacing: f64) -> f64 {
-    let k = (radius / spacing).round();
-    (1.0 + 3.0 * k * (k + 1.0)) * ((length / spacing).round() + 1.0)
+/// The same with the seed's local weak form over test spheres
+/// (`weak_form` 0, as in the scheme `paper`), whose heap is about twice
+/// the nodal forms': 7.73 kB a node at 3 across, 8.16 at 4, 8.82 at 6 and
+/// 9.63 at 10 with the scheme `paper` (it grows with the resolution, the
+/// peak in the first build), 10.30-11.33 kB at 3-10 across with
+/// `weak_form = 0` on the default scheme's other knobs, 8.41 kB for
+/// `penetration` at 3 across with `paper` (docs/notes/2026-11-29-memory-bounds.md).
+/// One figure for both forms could not be within twice both peaks.
+pub(crate) const SPHERE_FORM_MEMORY: MemoryPerNode = MemoryPerNode { bytes: 14_000.0 };
+
+/// The peak memory per node of a run of the 3-D MLPG solver, by its forces.
+pub(crate) fn mlpg_memory(s: &Scene) -> MemoryPerNode {
+    match s.get("weak_form") {
+        Ok(w) if w < 0.5 => SPHERE_FORM_MEMORY,
+        _ => NODAL_FORM_MEMORY,
+    }
+}
+
+/// The ring lattice of a 3-D scene's bodies, as far as its node count
+/// depends on it: whole or quarter (`symmetry`), aligned or staggered
+/// (`lattice`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RingLattice {
+    /// The quarter `x >= 0`, `y >= 0` (the quarter model).
+    pub quarter: bool,
+    /// The odd layers turned by half a node's angle.
+    pub staggered: bool,
+}
+
+impl RingLattice {
+    /// The lattice of a 3-D scene (one with `symmetry` and `lattice`).
+    pub fn of(s: &Scene) -> Self {
+        let v = |name: &str| s.get(name).expect("a 3-D scene's parameter");
+        RingLattice {
+            quarter: v("symmetry") >= 0.5,
+            staggered: v("lattice") >= 0.5,
+        }
+    }
+
+    /// Nodes of the ring lattice of a cylinder ([`crate::mlpg::lattice`])
+    /// of `radius` and `length` at the radial `spacing`, one layer a
+    /// spacing: `1 + 3 k (k + 1)` a layer for `k` rings; in the quarter,
+    /// the axis and, of ring `j`'s `6 j` nodes, those at angles in
+    /// [0, π/2] (the planes' nodes kept): `floor(1.5 j) + 1`, or
+    /// `floor(1.5 j - 0.5) + 1` on a staggered lattice's odd layers.
+    pub fn nodes(self, radius: f64, length: f64, spacing: f64) -> f64 {
+        let k = (radius / spacing).round() as usize;
+        let layers = (length / spacing).round().max(1.0) + 1.0;
+        if !self.quarter {
+            let k = k as f64;
+            return (1.0 + 3.0 * k * (k + 1.0)) * layers;
+        }
+        let layer = |turn: f64| {
+            1.0 + (1..=k)
+                .map(|j| (1.5 * j as f64 - turn).floor() + 1.0)
+                .sum::<f64>()
+        };
+        let (even, odd) = ((layers / 2.0).ceil(), (layers / 2.0).floor());
+        let turned = if self.staggered { 0.5 } else { 0.0 };
+        even * layer(0.0) + odd * layer(turned)
+    }
 }
 
 /// The material models of a `taylor3d` scene.
@@ -390,4 +450,49 @@ pub fn axisymmetric_twin(s: &Scene, particles_radial: f64) -> crate::Result<Scen
     twin.title = format!("{} (axisymmetric MSPH twin)", s.title);
     twin.reference = s.reference.clone();
     Ok(twin)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::{DEFAULT_MEMORY_BUDGET, check_memory_with};
+
+    /// The node count the memory budget estimates is the count a run
+    /// builds, for the whole body and the quarter on the aligned and the
+    /// staggered lattice, of both 3-D scenes.
+    #[test]
+    fn the_estimated_nodes_are_the_built_nodes() {
+        for (name, across) in [("taylor3d", 4.0), ("taylor3d", 7.0), ("penetration", 3.0)] {
+            for (symmetry, lattice) in [(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)] {
+                let mut s = Scene::builtin(name).unwrap();
+                s.set("particles_radial", across).unwrap();
+                s.set("symmetry", symmetry).unwrap();
+                s.set("lattice", lattice).unwrap();
+                // The quarter model takes the nodal form.
+                s.set("weak_form", 1.0).unwrap();
+                let run = crate::Simulation::new(s.clone()).unwrap();
+                assert_eq!(
+                    s.estimated_nodes(),
+                    run.particles() as f64,
+                    "{name} at {across} across, symmetry {symmetry}, lattice {lattice}"
+                );
+            }
+        }
+    }
+
+    /// A million-node `taylor3d` (34 across: 1 114 477 nodes) is admitted at
+    /// the default budget (8 GiB) with the default scheme, and refused
+    /// with the seed's test spheres (the scheme `paper`), whose heap per
+    /// node is about twice the nodal forms'.
+    #[test]
+    fn a_million_node_taylor3d_is_admitted_at_the_default_budget() {
+        let mut s = Scene::builtin("taylor3d").unwrap();
+        s.set("particles_radial", 34.0).unwrap();
+        assert_eq!(s.estimated_nodes(), 1_114_477.0);
+        check_memory_with(s.estimated_nodes(), mlpg_memory(&s), DEFAULT_MEMORY_BUDGET).unwrap();
+        s.set_str("scheme", "paper").unwrap();
+        let e = check_memory_with(s.estimated_nodes(), mlpg_memory(&s), DEFAULT_MEMORY_BUDGET)
+            .unwrap_err();
+        assert_eq!(e.name(), "MemoryBudget");
+    }
 }
