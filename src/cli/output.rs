@@ -2,7 +2,7 @@
 //! be written.
 
 use super::stop::Stop;
-use meshless_impact::{Error, ObservableSpec, Scene, Simulation};
+use meshless_impact::{Error, Simulation};
 use std::fs::{File, OpenOptions};
 use std::io::{ErrorKind, Write};
 use std::path::Path;
@@ -88,17 +88,14 @@ pub(crate) fn write_csv_records(
 /// the scene has a converged continuum reference beside the experiment's
 /// (test 7), `reference_continuum` and `reference_experiment`.
 pub(crate) fn final_json(
-    scene: &Scene,
-    specs: &[ObservableSpec],
-    values: &[f64],
-    particles: usize,
-    steps: u64,
-    end_time: f64,
+    sim: &Simulation,
     wall_time_s: f64,
     stopped: Option<&Error>,
 ) -> serde_json::Value {
+    let (scene, specs, values) = (sim.scene(), sim.observable_specs(), sim.observables());
+    let (particles, steps, end_time) = (sim.particles(), sim.steps(), sim.time());
     let mut m = serde_json::Map::new();
-    for (s, v) in specs.iter().zip(values) {
+    for (s, v) in specs.iter().zip(&values) {
         let val = if s.is_bool() {
             serde_json::Value::Bool(*v != 0.0)
         } else {

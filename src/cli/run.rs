@@ -146,16 +146,7 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
         failures.push(format!("--profile: {e}"));
     }
     if let Some(path) = &a.json {
-        let json = final_json(
-            sim.scene(),
-            sim.observable_specs(),
-            &sim.observables(),
-            sim.particles(),
-            sim.steps(),
-            sim.time(),
-            wall,
-            status.as_ref().err(),
-        );
+        let json = final_json(&sim, wall, status.as_ref().err());
         if let Err(e) = write_json(path, &json) {
             failures.push(format!("--json: {e}"));
         }

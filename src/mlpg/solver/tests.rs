@@ -119,7 +119,7 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             };
             let (p0, scale) = momentum(&run);
             let (ke0, booked0) = (kinetic(&run.vel, &run.mass), run.smoothing_dissipation);
-            let (pos0, vel0) = (run.pos.clone(), run.vel.clone());
+            let pos0 = run.pos.clone();
             let mut scratch = std::mem::take(&mut run.scratch);
             scratch.fit(n);
             scratch.fit_shift(n);
