@@ -327,13 +327,14 @@ fn rested(scene: &Scene) -> Mlpg3d {
 /// The Wilkins copper bar in 3-D with the plain nodal form on the aligned
 /// lattice and the order-1 smoothing (the scene file's choices before the
 /// staggered lattice; 6 nodes across the radius, 4732 nodes, with node
-/// shifting) comes to rest with no named stop, and its final length and impact-face radius
-/// are as close to the references (21.42 mm, 7.15 mm) as the axisymmetric
-/// solver's at the same spacing, 6 across with its large-strain scheme
-/// (VALIDATION.md: 22.28 mm, +4.0 %, and 6.33 mm, −11.5 %); measured
-/// 22.21 mm (+3.7 %) and 6.71 mm (−6.2 %). The energy balance holds within
-/// the issue's 5 % (measured 1.1 %). With the seed's test spheres the same
-/// bar stops with EnergyDrift at 55.6 µs.
+/// shifting) comes to rest with no named stop, and its final length and
+/// impact-face radius are at least as close to the references (21.42 mm,
+/// 7.15 mm) as the axisymmetric solver's at the same spacing, run here
+/// (`scenes/wilkins_copper_bilinear.toml` at 6 across: measured 22.28 mm,
+/// +4.0 %, and 6.29 mm, −12.0 %); measured in 3-D 22.21 mm (+3.7 %) and
+/// 6.71 mm (−6.2 %). The energy balance holds within the issue's 5 %
+/// (measured 1.1 %). With the seed's test spheres the same bar stops with
+/// EnergyDrift at 55.6 µs.
 #[test]
 fn the_wilkins_bar_in_3d_comes_to_rest_as_close_as_the_axisymmetric_one() {
     let scene = wilkins3d(&[
@@ -344,20 +345,41 @@ fn the_wilkins_bar_in_3d_comes_to_rest_as_close_as_the_axisymmetric_one() {
     assert_eq!(scene.get("particles_radial").unwrap(), 6.0);
     let s = rested(&scene);
     let rod = s.rod();
-    let length = rod.rod_length / 21.42e-3 - 1.0;
-    let radius = rod.mushroom_radius / 7.15e-3 - 1.0;
+    let (axi_length, axi_radius) = axisymmetric_wilkins(6.0);
+    let error = |value: f64, reference: f64| value / reference - 1.0;
+    let (length, radius) = (
+        error(rod.rod_length, 21.42e-3),
+        error(rod.mushroom_radius, 7.15e-3),
+    );
+    let (axi_length, axi_radius) = (error(axi_length, 21.42e-3), error(axi_radius, 7.15e-3));
     assert!(
-        length.abs() < 0.040,
-        "length {} ({length:+.4})",
+        length.abs() <= axi_length.abs(),
+        "length {} ({length:+.4}; axisymmetric {axi_length:+.4})",
         rod.rod_length
     );
     assert!(
-        radius.abs() < 0.115,
-        "face radius {} ({radius:+.4})",
+        radius.abs() <= axi_radius.abs(),
+        "face radius {} ({radius:+.4}; axisymmetric {axi_radius:+.4})",
         rod.mushroom_radius
     );
     let e = s.energies();
     assert!(e.error < 0.05, "energy error {}", e.error);
+}
+
+/// The axisymmetric solver's Wilkins bar (`scenes/wilkins_copper_bilinear.toml`,
+/// the 3-D scene file's preset, with its default scheme) at
+/// `particles_radial` across, to rest: its final length and face radius (m).
+fn axisymmetric_wilkins(particles_radial: f64) -> (f64, f64) {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let mut axi = Scene::from_file(format!("{dir}/scenes/wilkins_copper_bilinear.toml")).unwrap();
+    axi.set("particles_radial", particles_radial).unwrap();
+    let mut sim = meshless_impact::Simulation::new(axi).unwrap();
+    sim.run().unwrap();
+    assert_eq!(sim.observable("at_rest"), Some(1.0));
+    (
+        sim.observable("rod_length").unwrap(),
+        sim.observable("mushroom_radius").unwrap(),
+    )
 }
 
 /// The Wilkins bar in 3-D with conforming gradients (`weak_form = 2`,
@@ -382,16 +404,7 @@ fn conforming_gradients_bring_the_wilkins_bar_to_the_axisymmetric_solver() {
     assert_eq!(scene.get("particles_radial").unwrap(), 6.0);
     let s = rested(&scene);
     let rod = s.rod();
-    let dir = env!("CARGO_MANIFEST_DIR");
-    let mut axi = Scene::from_file(format!("{dir}/scenes/wilkins_copper_bilinear.toml")).unwrap();
-    axi.set("particles_radial", 6.0).unwrap();
-    let mut sim = meshless_impact::Simulation::new(axi).unwrap();
-    sim.run().unwrap();
-    assert_eq!(sim.observable("at_rest"), Some(1.0));
-    let (length, radius) = (
-        sim.observable("rod_length").unwrap(),
-        sim.observable("mushroom_radius").unwrap(),
-    );
+    let (length, radius) = axisymmetric_wilkins(6.0);
     let dl = rod.rod_length / length - 1.0;
     let dr = rod.mushroom_radius / radius - 1.0;
     println!(
@@ -429,11 +442,12 @@ fn assert_bar(s: &Mlpg3d, (dl, length): (f64, f64), (dr, radius): (f64, f64)) {
 /// The Wilkins bar in 3-D on the staggered lattice (`lattice = 1`), with
 /// conforming gradients (`weak_form = 2`) and the order-2 smoothing, at
 /// `particles_radial` nodes across: the run comes to rest with no named
-/// stop within the issue's bounds for the 3-D Wilkins bar against the
-/// converged references (length within 2 % of 21.42 mm, face radius
-/// within 5 % of 7.15 mm), its face symmetric within 2 % and its energy
-/// balance within 5 %. Returns the length and face radius (m).
-fn staggered_wilkins_bar(particles_radial: f64) -> (f64, f64) {
+/// stop within the criteria for the 3-D Wilkins bar against the
+/// converged references (VALIDATION.md: length within 2 % of 21.42 mm,
+/// face radius within 3 % of 7.15 mm), its face symmetric within 2 % and
+/// its energy balance within 5 %. Returns the length, the face radius
+/// and the outer ring's mean radius ([`Mlpg3d::ring_radius`]) (m).
+fn staggered_wilkins_bar(particles_radial: f64) -> (f64, f64, f64) {
     let scene = wilkins3d(&[
         ("particles_radial", particles_radial),
         ("weak_form", 2.0),
@@ -445,15 +459,17 @@ fn staggered_wilkins_bar(particles_radial: f64) -> (f64, f64) {
     let dl = rod.rod_length / 21.42e-3 - 1.0;
     let dr = rod.mushroom_radius / 7.15e-3 - 1.0;
     println!(
-        "{} nodes: {:.4} mm ({dl:+.4}), {:.4} mm ({dr:+.4}), spread {:.4}, energy {:.4}",
+        "{} nodes: {:.4} mm ({dl:+.4}), {:.4} mm ({dr:+.4}), ring {:.4} mm, spread {:.4}, \
+         energy {:.4}",
         s.particles(),
         rod.rod_length * 1e3,
         rod.mushroom_radius * 1e3,
+        s.ring_radius() * 1e3,
         s.mushroom_radius_spread(),
         s.energies().error
     );
-    assert_bar(&s, (dl, 0.02), (dr, 0.05));
-    (rod.rod_length, rod.mushroom_radius)
+    assert_bar(&s, (dl, 0.02), (dr, 0.03));
+    (rod.rod_length, rod.mushroom_radius, s.ring_radius())
 }
 
 /// The Wilkins bar as its scene file sets it ([`staggered_wilkins_bar`]
@@ -478,19 +494,39 @@ fn the_wilkins_bar_in_3d_meets_its_references_on_the_staggered_lattice() {
 }
 
 /// Refinement of [`staggered_wilkins_bar`] (`scripts/validate.sh`): at 8
-/// and 11 nodes across (12 168 and 33 762 nodes; about 1 and 7 minutes on
-/// two cores) the bar stays within the references' bounds, and its length
+/// and 11 nodes across (12 168 and 33 762 nodes; about 3.5 and 10 minutes
+/// on two cores) the bar stays within the references' bounds, its length
 /// moves toward 21.42 mm as the spacing shrinks (measured 21.66, 21.57,
-/// 21.52 mm at 6, 8, 11 across; face radius 7.22, 7.28, 7.35 mm).
+/// 21.52 mm at 6, 8, 11 across), and the 3-D and axisymmetric answers
+/// converge to each other: the face radius that the axisymmetric solver
+/// measures, the mean of the outer ring, at 11 across is within 1.5 % of
+/// the axisymmetric solver's at 41 across, run beside it (measured
+/// 7.296 mm against 7.232 mm, +0.88 %). The largest radius over the face
+/// (the observable `mushroom_radius`: 7.22, 7.28, 7.35 mm at 6, 8, 11
+/// across) adds the ring's scatter by azimuth, 0.8 % at 11 across, and is
+/// held to the 3 % of [`staggered_wilkins_bar`]; the axisymmetric face is
+/// itself still growing at 41 across (7.19 mm at 31; VALIDATION.md, "The
+/// 3-D Wilkins face under refinement").
 #[test]
-#[ignore = "heavy: about 9 minutes on two cores; scripts/validate.sh"]
+#[ignore = "heavy: about 14 minutes on two cores; scripts/validate.sh"]
 fn the_staggered_wilkins_bar_under_refinement() {
-    let (l8, _) = staggered_wilkins_bar(8.0);
-    let (l11, _) = staggered_wilkins_bar(11.0);
+    let (l8, _, _) = staggered_wilkins_bar(8.0);
+    let ((l11, _, ring11), (_, axi41)) = rayon::join(
+        || staggered_wilkins_bar(11.0),
+        || axisymmetric_wilkins(41.0),
+    );
     assert!(
         (l11 - 21.42e-3).abs() < (l8 - 21.42e-3).abs(),
         "length {l8} at 8 across, {l11} at 11"
     );
+    let apart = ring11 / axi41 - 1.0;
+    println!(
+        "face: the ring's mean at 11 across {:.4} mm, the axisymmetric solver at 41 across \
+         {:.4} mm ({apart:+.4})",
+        ring11 * 1e3,
+        axi41 * 1e3
+    );
+    assert!(apart.abs() < 0.015, "{ring11} against {axi41}");
 }
 
 /// Conforming gradients need the whole body: with the quarter model the
