@@ -32,6 +32,10 @@ pub(crate) enum Command {
         /// Coarse resolutions and a reduced stability matrix (about a minute).
         #[arg(long)]
         quick: bool,
+        /// Print the code's physics digest (the bits of small runs of every
+        /// solver, as the report records it) and write nothing.
+        #[arg(long)]
+        digest: bool,
     },
     /// List the parameters of a scene with units, defaults and allowed
     /// ranges: only those of its material models (see --strength, --eos,

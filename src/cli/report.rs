@@ -11,7 +11,11 @@ use std::io::Write;
 use std::path::PathBuf;
 
 #[cfg(feature = "report")]
-pub(crate) fn report(out: PathBuf, quick: bool) -> Result<(), Stop> {
+pub(crate) fn report(out: PathBuf, quick: bool, digest: bool) -> Result<(), Stop> {
+    if digest {
+        let d = crate::report::digest::physics_digest()?;
+        return outln!("{}", crate::report::digest::format(d));
+    }
     check_output_dir("--out", &out, "index.md")?;
     let r = crate::report::generate(&crate::report::ReportOptions {
         out: out.clone(),
@@ -26,7 +30,7 @@ pub(crate) fn report(out: PathBuf, quick: bool) -> Result<(), Stop> {
 }
 
 #[cfg(not(feature = "report"))]
-pub(crate) fn report(_out: PathBuf, _quick: bool) -> Result<(), Stop> {
+pub(crate) fn report(_out: PathBuf, _quick: bool, _digest: bool) -> Result<(), Stop> {
     Err(Stop::failed(
         "this program was built without the report (cargo feature `report`)".into(),
     ))

@@ -1,6 +1,7 @@
-//! Measurements behind the choices of this module (run with
-//! `cargo test --release --lib mlpg::measure -- --ignored --nocapture`),
-//! and the convergence tests of the nodal velocity gradients.
+//! The measurements behind the choices of this module, each asserting
+//! that the choice is still the one its table makes (print the tables with
+//! `cargo test --profile ci --lib mlpg::measure -- --nocapture`), and the
+//! convergence tests of the nodal velocity gradients.
 
 use super::mls::tests::jittered_cube;
 use super::mls::{NodalShapes, SupportParams, Supports, distance};
@@ -95,9 +96,20 @@ fn quadratic_velocity_gradient_converges() {
     assert!(order > 0.85 && e[2] < 2.5e-3, "{e:?} order {order}");
 }
 
+/// The table behind [`SupportParams::default`] (`cargo test --lib
+/// the_default_supports -- --nocapture` prints it): the gradient error of the
+/// quadratic field at h = 1/8 and 1/16 on the lattice jittered by 0.3 h,
+/// its order, and the mean number of covering nodes (the cost), for k
+/// named neighbours and the support factor. The default (k = 10, factor
+/// 1.5) is the choice the table was made for: of every choice that covers
+/// no more nodes (37.1), its error at h = 1/16 is the smallest (measured
+/// 4.43e-3; the next 5.39e-3 at k = 14, factor 1.25), and it converges at
+/// the first order that a linear basis gives on irregular nodes (measured
+/// 1.24; asserted above 0.85, as [`quadratic_velocity_gradient_converges`]).
 #[test]
-#[ignore = "measurement: prints the table behind SupportParams::default"]
-fn support_table() {
+fn the_default_supports_are_the_tables_choice() {
+    let default = SupportParams::default();
+    let mut rows = Vec::new();
     println!("k factor | err(h=1/8) err(h=1/16) order | covering nodes");
     for k in [6, 10, 14, 18, 26] {
         for factor in [1.1, 1.25, 1.5, 2.0] {
@@ -107,23 +119,74 @@ fn support_table() {
             };
             let a = gradient_error(9, 0.3, p);
             let b = gradient_error(17, 0.3, p);
+            let order = (a.0 / b.0).log2();
             println!(
-                "{k:2} {factor:4} | {:.2e} {:.2e} {:.2} | {:.1}",
-                a.0,
-                b.0,
-                (a.0 / b.0).log2(),
-                b.1
+                "{k:2} {factor:4} | {:.2e} {:.2e} {order:.2} | {:.1}",
+                a.0, b.0, b.1
+            );
+            rows.push((p, b.0, order, b.1));
+        }
+    }
+    let &(_, error, order, covering) = rows.iter().find(|r| r.0 == default).unwrap();
+    assert!(order > 0.85, "order {order}");
+    for (p, e, _, c) in &rows {
+        if *c <= covering && *p != default {
+            assert!(
+                error < *e,
+                "{p:?} covers {c:.1} nodes with error {e:.2e}, the default {covering:.1} with {error:.2e}"
             );
         }
     }
 }
 
+/// The table behind [`super::sphere::DEFAULT_RULE`] and
+/// [`super::sphere::BOUNDARY_RULE`] (the module docs of
+/// [`super::sphere`]; `cargo test --lib sphere_rules -- --nocapture`
+/// prints it), measured as the docs say, with k = 14 named neighbours
+/// (the supports' default when the rules were chosen): the default rule is
+/// the cheapest whose operator error is below 1e-3 (measured 7.05e-4 with
+/// 60 points; 1.29e-3 with 20), and the boundary rule the cheapest
+/// octahedron rule, which cuts into halves and quarters, below it
+/// (8.63e-4 with 216 points; 1.39e-3 with 96). At today's default k = 10
+/// the same rule's operator error is 1.9e-3 (printed after the table): the
+/// rule was not chosen again when the supports shrank (VALIDATION.md
+/// notes it; only `weak_form = 0`, the paper's scheme, uses test spheres,
+/// and changing the rule would move its seed-method bits).
 #[test]
-#[ignore = "measurement: prints the table behind sphere::DEFAULT_RULE"]
-fn sphere_rule_table() {
+fn sphere_rules_are_the_tables_choice() {
+    let rows = sphere_rule_table(SupportParams {
+        neighbours: 14,
+        factor: 1.5,
+    });
+    let meets = |r: &(Polyhedron, usize, TriangleRule, usize, f64, f64)| r.5 < 1e-3;
+    let cheapest = |octahedron: bool| {
+        rows.iter()
+            .filter(|r| !octahedron || r.0 == Polyhedron::Octahedron)
+            .filter(|r| meets(r))
+            .min_by_key(|r| r.3)
+            .map(|r| (r.0, r.1, r.2))
+    };
+    assert_eq!(cheapest(false), Some(super::sphere::DEFAULT_RULE));
+    assert_eq!(cheapest(true), Some(super::sphere::BOUNDARY_RULE));
+    let now = sphere_rule_table(SupportParams::default());
+    let (a, f, t) = super::sphere::DEFAULT_RULE;
+    let r = now.iter().find(|r| (r.0, r.1, r.2) == (a, f, t)).unwrap();
+    println!(
+        "with the supports' default (k = {}): the default rule's operator error {:.2e}",
+        SupportParams::default().neighbours,
+        r.5
+    );
+}
+
+/// The rows of the sphere-rule table with supports `params`: rule,
+/// points, field error, operator error.
+fn sphere_rule_table(
+    params: SupportParams,
+) -> Vec<(Polyhedron, usize, TriangleRule, usize, f64, f64)> {
+    let mut rows = Vec::new();
     let h = 1.0;
     let pts = jittered_cube(7, h, 0.3, 5);
-    let sup = Supports::compute(&pts, SupportParams::default()).unwrap();
+    let sup = Supports::compute(&pts, params).unwrap();
     let kappa = [0.2, 0.4, 0.4]; // |κ| h = 0.6
     let f = |p: &[f64; 3]| (kappa[0] * p[0] + kappa[1] * p[1] + kappa[2] * p[2]).exp();
     let stress: Vec<[f64; 6]> = pts
@@ -213,11 +276,13 @@ fn sphere_rule_table() {
                     .fold(0.0, f64::max)
             })
             .fold(0.0, f64::max);
+        let operator = operator_error(&op);
         println!(
-            "{base:?} f={fr} {tri:?}: {} triangles, {} points, error {err:.2e}, operator {:.2e}",
+            "{base:?} f={fr} {tri:?}: {} triangles, {} points, error {err:.2e}, operator {operator:.2e}",
             rule.len() / rule.per_triangle,
             rule.len(),
-            operator_error(&op)
         );
+        rows.push((base, fr, tri, rule.len(), err, operator));
     }
+    rows
 }

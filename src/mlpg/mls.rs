@@ -24,7 +24,7 @@
 //! field on the unit cube jittered by 0.3 h, over the nodes in [0.3, 0.7]³,
 //! relative to the largest gradient, and the mean number of nodes covering
 //! a node (the cost of every MLS evaluation is proportional to it;
-//! `mlpg::measure::support_table`):
+//! `mlpg::measure::the_default_supports_are_the_tables_choice`):
 //!
 //! | k | factor | h = 1/8 | h = 1/16 | covering |
 //! |---|---|---|---|---|

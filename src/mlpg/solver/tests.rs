@@ -332,23 +332,29 @@ fn a_run_restored_after_a_release_rebuilds_the_spheres_of_the_last_build() {
     assert!(bits(&back) == bits(&s), "the restored run differs");
 }
 
-/// Measurement: the sizes behind the flop count of BENCHMARKS.md ("3-D
-/// MLPG speed"): per node of `taylor3d` at impact (`PARTICLES_RADIAL`,
-/// default 10), the operator and shape rows, the quadrature points, and
-/// per point the candidates, those within `r_J` by the squared test and
-/// those covering it.
+/// The sizes behind the flop count of BENCHMARKS.md ("3-D MLPG speed"),
+/// printed, per node of `taylor3d` with the seed's test spheres (scheme
+/// paper) at impact (`PARTICLES_RADIAL`, default 4; the figures of
+/// BENCHMARKS.md are at 10): the operator and shape
+/// rows, the quadrature points, and per point the candidates, those within
+/// `r_J` by the squared test and those covering it. Asserted against a
+/// brute-force count over every pair of nodes: a node's shape row holds
+/// exactly the nodes whose supports cover it (to the 1e-9 margin of the
+/// covering test), and each whole test sphere has the default rule's
+/// points.
 #[test]
-#[ignore = "measurement: the sizes behind the 3-D flop count"]
 fn operator_sizes() {
     use crate::mlpg::mls::{PointShapes, candidates_first};
     let across: f64 = std::env::var("PARTICLES_RADIAL")
         .map(|s| s.parse().unwrap())
-        .unwrap_or(10.0);
-    let p = crate::scene::taylor3d::Taylor3dParams {
-        particles_radial: across,
-        ..Default::default()
-    };
-    let s = p.build().unwrap();
+        .unwrap_or(4.0);
+    // The seed's test-sphere form (scheme paper), whose sizes these are.
+    let mut scene = crate::Scene::builtin("taylor3d").unwrap();
+    scene.set("particles_radial", across).unwrap();
+    scene.set("scheme", 1.0).unwrap();
+    let s = crate::scene::taylor3d::Taylor3dParams::of(&scene)
+        .build()
+        .unwrap();
     let g = s.geometry.as_ref().unwrap();
     let sup = g.supports.as_ref().unwrap();
     let pts = &s.built_at;
@@ -376,6 +382,34 @@ fn operator_sizes() {
             covering += ps.covering();
         });
     }
+    // The brute-force oracle of the shape rows: every pair of nodes.
+    let mut misplaced = 0usize;
+    for i in 0..pts.len() {
+        let row = &g.shapes.nodes[g.shapes.offsets[i]..g.shapes.offsets[i + 1]];
+        for j in 0..pts.len() {
+            let d = distance(&pts[i], &pts[j]);
+            let inside = d < sup.radius[j] * (1.0 - 1e-9);
+            let outside = d > sup.radius[j] * (1.0 + 1e-9);
+            let held = row.binary_search(&j).is_ok();
+            if (inside && !held) || (outside && held) {
+                misplaced += 1;
+            }
+        }
+    }
+    assert_eq!(
+        misplaced, 0,
+        "shape-row entries against the brute-force count"
+    );
+    let per_whole = SphereRule::of(DEFAULT_RULE).len();
+    let mut whole_points = 0usize;
+    let mut whole_count = 0usize;
+    for i in 0..pts.len() {
+        if g.spheres[i].is_whole() {
+            whole_count += 1;
+            g.spheres[i].for_each_point(pts[i], &whole, &cut, |_, _, _| whole_points += 1);
+        }
+    }
+    assert_eq!(whole_points, whole_count * per_whole);
     let whole_spheres = g.spheres.iter().filter(|t| t.is_whole()).count();
     println!(
         "{} nodes ({whole_spheres} whole spheres): cell-list candidates {:.1}, gathered {:.1}, \
