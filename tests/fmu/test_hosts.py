@@ -1,7 +1,8 @@
 """Every FMU through three FMI hosts from PyPI, past its scene's end to the
 host's stop time (issue 65, item 8): fmpy (FMI 3 and FMI 2), ecos
 (`ecospy`; FMI 3 and FMI 2) and libcosim, the co-simulation engine of the
-Open Simulation Platform (`libcosimpy`; FMI 2: it loads FMI 1 and 2 only).
+Open Simulation Platform (`libcosimpy`; FMI 2 only: libcosimpy 0.0.6
+crashes loading an FMI 3 FMU, before it loads the FMU's library).
 Each run must reach the host's stop time, and the outputs the host holds
 there must be the command line's final values, bit for bit.
 
@@ -11,8 +12,8 @@ scene has ended now completes every step and holds its outputs
 (docs/guide/fmu.md, "After the scene's end").
 
 Every run is cheap: coarse lattices, short scenes. TaylorImpact runs to
-rest at 200 m/s, 4 particles across (rest at about 40 us; the case libcosim
-failed on), the other six to a short end_time. The scene ends inside a
+rest at 200 m/s, 4 particles across (rest at 42.1 us; the case libcosim
+failed on, at the default resolution), the other six to a short end_time. The scene ends inside a
 communication step, not on one, and the host goes on for a few steps past
 it."""
 

@@ -5,7 +5,7 @@ validate` and `fmutool -check`; the variables are the scene's parameter and
 observable tables (the CLI's `params taylor3d` and `observables taylor3d`);
 a run with a parameter set gives the command line's final values bit for
 bit, through FMI 3 and FMI 2; the FMU state rolls back exactly and moves
-between instances; the early stop; a bad value and a foreign state are
+between instances; the steps past the rest; a bad value and a foreign state are
 refused with their names."""
 
 import pytest
