@@ -30,8 +30,9 @@ decides its outcome from the state (the output shot_outcome; README,
              the fit unless --fit-unsettled is given (its V_r is then its
              velocity at the cap); with --extend K the script runs these
              shots again with twice the end time, up to K times (the
-             column time_s is the last communication point the host
-             recorded; the run ended within one communication step after it);
+             column time_s is when the shot ended: the FMU returns early
+             at its outcome, the host then runs on to end_time with the
+             outputs held);
   error      the FMU run stopped with an error (for example a named solver
              stop such as a particle spacing collapse): reported with the
              message and left out of the fit; the CSV has the outputs at the
@@ -112,10 +113,14 @@ def run_shot(fmu_path, params, end_time, step):
                            output=OUTPUTS, stop_time=end_time, output_interval=step,
                            early_return_allowed=True)
         row.update({name: float(res[name][-1]) for name in OUTPUTS})
-        t, v = res["time"], res["projectile_velocity"]
-        k = next(i for i in range(len(t)) if t[i] >= 0.9 * t[-1])
-        row["velocity_change_mps"] = abs(float(v[-1] - v[k]))
-        row["time_s"] = float(t[-1])
+        # The FMU holds its outputs past the scene's end and the host runs
+        # on to stop_time; with early return allowed it returned at the
+        # shot's end: the first row with the outcome decided (or the last).
+        t, v, outcome = res["time"], res["projectile_velocity"], res["shot_outcome"]
+        end = next((i for i in range(len(t)) if outcome[i] != 0), len(t) - 1)
+        k = next(i for i in range(end + 1) if t[i] >= 0.9 * t[end])
+        row["velocity_change_mps"] = abs(float(v[end] - v[k]))
+        row["time_s"] = float(t[end])
         row["error"] = ""
     except Exception as e:  # a solver stop or a bad value: reported, not fatal
         row["error"] = " | ".join(errors) or str(e)

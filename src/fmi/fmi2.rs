@@ -1,11 +1,12 @@
 //! The FMI 2.0 Co-Simulation functions (all 34 `fmi2*` symbols that a
 //! Co-Simulation importer resolves).
 //!
-//! Early stop: when the rod comes to rest (or `end_time` passes) during a
-//! communication step, `fmi2DoStep` returns `fmi2Discard`;
-//! `fmi2GetBooleanStatus(fmi2Terminated)` is then true and
-//! `fmi2GetRealStatus(fmi2LastSuccessfulTime)` is the time the run ended
-//! (at most the end of the step).
+//! The scene's end: when the rod comes to rest (or `end_time` passes) during
+//! a communication step, `fmi2DoStep` completes the step with `fmi2OK`, and
+//! every later step too; the outputs hold their final values for the rest
+//! of the host's run. No step is discarded: `fmi2Terminated` is false
+//! (the FMU does not ask to end the co-simulation) and
+//! `fmi2LastSuccessfulTime` is the FMU's time.
 
 use super::fmu::Fmu;
 use super::instance::{Instance, STEP_DISCARDED, Standard, Status, call, mask, with_instance};
@@ -430,9 +431,10 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
 }
 
 /// `fmi2DoStep`: advances to `currentCommunicationPoint +
-/// communicationStepSize`; `fmi2Discard` when the run ends (rod at rest or
-/// end_time) during the step or has already ended; `fmi2Error` when the step
-/// would end past a defined stopTime.
+/// communicationStepSize`; `fmi2OK` also when the scene ends (rod at rest or
+/// end_time) during the step or has already ended (the outputs then hold
+/// their final values); `fmi2Error` when the step would end past a defined
+/// stopTime or the solver stops.
 ///
 /// # Safety
 /// A live instance.
@@ -446,27 +448,12 @@ pub unsafe extern "C" fn fmi2DoStep(
     // SAFETY: FMI 2.0 contract.
     (unsafe {
         with_instance(c, |inst| {
-            let ended_before = inst.at_end();
             match inst.do_step(
                 "fmi2DoStep",
                 current_communication_point,
                 communication_step_size,
             ) {
-                Ok(out) if !out.terminate => {
-                    inst.set_time(current_communication_point + communication_step_size);
-                    Status::Ok
-                }
-                Ok(out) => {
-                    let last = if ended_before {
-                        current_communication_point
-                    } else {
-                        out.last_successful_time
-                    };
-                    inst.last_successful_time = last;
-                    inst.set_time(last);
-                    inst.state = STEP_DISCARDED;
-                    Status::Discard
-                }
+                Ok(_) => Status::Ok,
                 Err(s) => s,
             }
         })
@@ -515,7 +502,8 @@ unsafe fn status_query<T>(
     }
 }
 
-/// `fmi2GetStatus`: `fmi2DoStepStatus` (Discard after an early stop).
+/// `fmi2GetStatus`: `fmi2DoStepStatus` (Discard only in StepDiscarded, which
+/// a state saved by an earlier build of this FMU may restore).
 ///
 /// # Safety
 /// FMI 2.0 contract.
@@ -580,7 +568,9 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
     // SAFETY: forwarded.
     unsafe {
         status_query(c, "fmi2GetBooleanStatus", kind, value, |inst, k| {
-            (k == FMI2_TERMINATED).then_some(inst.at_end() as c_int)
+            // True only in StepDiscarded, which a state saved by an earlier
+            // build of this FMU (its early stop) may restore.
+            (k == FMI2_TERMINATED).then_some((inst.state == STEP_DISCARDED) as c_int)
         })
     }
 }

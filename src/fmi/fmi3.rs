@@ -2,10 +2,19 @@
 //! standard; the Model Exchange and Scheduled Execution ones report that this
 //! FMU does not support them).
 //!
-//! Early stop: when the rod comes to rest (or `end_time` passes) `fmi3DoStep`
-//! returns OK with `terminateSimulation = true`; when that happens before the
-//! end of the communication step and the host allowed early return,
-//! `earlyReturn = true` and `lastSuccessfulTime` is the time the run ended.
+//! The scene's end: when the rod comes to rest (or `end_time` passes)
+//! `fmi3DoStep` returns OK with `terminateSimulation = false`, and so does
+//! every later step; the outputs hold their final values for the rest of
+//! the host's run. `terminateSimulation = true` would ask the importer to
+//! stop the whole co-simulation (FMI 3.0.2, `fmi3DoStep`: "the FMU requests
+//! to stop the simulation"), which the FMU has no reason to ask: a rod at
+//! rest stays at rest. Without early return the step completes
+//! (`earlyReturn = false`, `lastSuccessfulTime` the end of the step). When
+//! the host allowed early return and the scene ends inside the step, the
+//! FMU returns there (`earlyReturn = true`, `lastSuccessfulTime` the
+//! scene's end): the standard's "request for a communication point at
+//! lastSuccessfulTime for any other reason", here the moment the outputs
+//! become final; the host steps on from it.
 
 use super::fmu::Fmu;
 use super::instance::{Instance, Standard, Status, call, mask, with_instance};
@@ -368,8 +377,9 @@ unsupported_fns! {
 }
 
 /// `fmi3DoStep`: advances to `currentCommunicationPoint +
-/// communicationStepSize`, taking as many solver steps as needed;
-/// `fmi3Error` when the step would end past a defined stopTime.
+/// communicationStepSize`, taking as many solver steps as needed, also
+/// past the scene's end (the outputs hold); `fmi3Error` when the step would
+/// end past a defined stopTime or the solver stops.
 ///
 /// # Safety
 /// FMI 3.0 contract: a live instance; the output pointers writable.
@@ -399,20 +409,16 @@ pub unsafe extern "C" fn fmi3DoStep(
                 current_communication_point,
                 communication_step_size,
             ) {
-                Ok(out) => {
-                    let early = out.early_return && inst.early_return_allowed;
-                    let last = if early {
-                        out.last_successful_time
-                    } else {
-                        current_communication_point + communication_step_size
-                    };
-                    inst.set_time(last);
+                Ok(reached) => {
                     // SAFETY (covered by the enclosing block): checked non-null
-                    // above; writable by the contract.
+                    // above; writable by the contract. No event and no
+                    // request to stop; an early return only at the scene's
+                    // end inside the step, when the host allowed it.
                     *event_handling_needed = 0;
-                    *terminate_simulation = out.terminate as u8;
-                    *early_return = early as u8;
-                    *last_successful_time = last;
+                    *terminate_simulation = 0;
+                    *early_return =
+                        (reached != current_communication_point + communication_step_size) as u8;
+                    *last_successful_time = reached;
                     Status::Ok
                 }
                 Err(s) => s,
@@ -605,8 +611,9 @@ mod tests {
     fn a_step_must_end_at_a_finite_later_time() {
         let error = Status::Error as c_int;
         let inst = stepping(0.0);
-        // To the end of the run and far beyond: the outputs hold.
-        assert_eq!(step(inst, 0.0, f64::MAX), (0, 1, f64::MAX));
+        // To the end of the run and far beyond: the step completes (no
+        // request to stop) and the outputs hold.
+        assert_eq!(step(inst, 0.0, f64::MAX), (0, 0, f64::MAX));
         assert_eq!(step(inst, f64::MAX, f64::MAX).0, error);
         let mut time = f64::NAN;
         // SAFETY: a live instance, freed once; one value reference and value.

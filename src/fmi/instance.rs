@@ -27,7 +27,8 @@ pub(crate) const INSTANTIATED: u32 = 1 << 0;
 pub(crate) const INITIALIZATION_MODE: u32 = 1 << 1;
 /// FMI 3 step mode / FMI 2 stepComplete.
 pub(crate) const STEP_MODE: u32 = 1 << 2;
-/// FMI 2 stepFailed after a doStep that returned Discard (early stop).
+/// FMI 2 stepFailed: reached only by restoring a state saved by an earlier
+/// build of this FMU, whose doStep returned Discard at the scene's end.
 pub(crate) const STEP_DISCARDED: u32 = 1 << 3;
 pub(crate) const TERMINATED: u32 = 1 << 4;
 pub(crate) const ANY_STATE: u32 =
@@ -67,14 +68,6 @@ fn state_name(state: u32) -> &'static str {
 pub(crate) enum Standard {
     Fmi3,
     Fmi2,
-}
-
-/// What the last doStep reported.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct StepOutcome {
-    pub terminate: bool,
-    pub early_return: bool,
-    pub last_successful_time: f64,
 }
 
 /// Why a startTime and stopTime are not an experiment: startTime must be
@@ -117,6 +110,8 @@ pub(crate) struct Instance {
     /// The run has ended (rod at rest or end_time reached).
     pub(super) at_end: bool,
     pub last_successful_time: f64,
+    /// FMI 3 `earlyReturnAllowed` (always false in FMI 2): return at the
+    /// scene's end when it lies inside a step.
     pub early_return_allowed: bool,
     /// Kept alive for `fmi2GetStringStatus`.
     pub status_string: CString,
@@ -225,7 +220,7 @@ impl Instance {
             && stop - self.start_time > sim.end_time()
         {
             let msg = format!(
-                "stopTime = {stop} s lies beyond end_time = {} s after the start: the run ends at end_time at the latest",
+                "stopTime = {stop} s lies beyond end_time = {} s after the start: the run ends at end_time at the latest, and the outputs hold their final values from then on",
                 sim.end_time()
             );
             self.log(Status::Warning, CAT_WARNING, &msg);
@@ -251,17 +246,6 @@ impl Instance {
         self.last_successful_time = 0.0;
         self.log(Status::Ok, CAT_EVENTS, "reset to the default parameters");
         Status::Ok
-    }
-
-    /// Moves the communication time after a step (FMI 3: to the last
-    /// successful time when returning early).
-    pub(crate) fn set_time(&mut self, t: f64) {
-        self.time = t;
-    }
-
-    /// Whether the run has ended (rod at rest or end_time).
-    pub(crate) fn at_end(&self) -> bool {
-        self.at_end
     }
 }
 

@@ -3,7 +3,7 @@
 //! getters and setters of types this FMU has none of, and the step.
 
 use super::fmu::{VarKind, VarType, Variable};
-use super::instance::{Instance, STEP_MODE, Standard, Status, StepOutcome, mask};
+use super::instance::{Instance, STEP_MODE, Standard, Status, mask};
 use super::log::{CAT_EVENTS, CAT_PROGRESS};
 use crate::ffi::{slice, slice_mut};
 
@@ -237,14 +237,12 @@ impl Instance {
         self.set(function, vrs, &vals, ty)
     }
 
-    /// Advances to `current + h`. Errors have been logged and moved the
-    /// instance to Terminated.
-    pub(crate) fn do_step(
-        &mut self,
-        function: &str,
-        current: f64,
-        h: f64,
-    ) -> Result<StepOutcome, Status> {
+    /// Advances to `current + h` and returns the FMU's time then: `current +
+    /// h`, also when the scene ends in the step or had ended before (the
+    /// outputs hold), except for an FMI 3 instance whose host allowed early
+    /// return, which returns at the scene's end when that lies inside the
+    /// step. Errors have been logged and moved the instance to Terminated.
+    pub(crate) fn do_step(&mut self, function: &str, current: f64, h: f64) -> Result<f64, Status> {
         self.check_state(function, mask::DO_STEP)?;
         if h.is_nan() || h <= 0.0 || h.is_infinite() {
             return Err(self.fail(&format!(
@@ -282,13 +280,11 @@ impl Instance {
             )));
         }
         if self.at_end {
-            // The rod is at rest (or end_time passed): outputs hold.
+            // The scene has ended (rod at rest, end_time reached): the step
+            // completes and the outputs hold their final values.
             self.time = target;
-            return Ok(StepOutcome {
-                terminate: true,
-                early_return: false,
-                last_successful_time: target,
-            });
+            self.last_successful_time = target;
+            return Ok(target);
         }
         let sim = self.sim.as_mut().expect("built at initialization");
         let result = sim.advance_to(target - self.start_time);
@@ -314,39 +310,36 @@ impl Instance {
                 ),
             );
         }
-        if !finished {
-            self.time = target;
-            self.last_successful_time = target;
-            return Ok(StepOutcome {
-                terminate: false,
-                early_return: false,
-                last_successful_time: target,
-            });
+        // The step completes whether or not the scene ended in it: once
+        // it has, the state stays at the scene's end and the outputs hold
+        // their final values for the rest of the host's run (docs/guide/fmu.md,
+        // "After the scene's end"). An FMI 3 host that allowed early return
+        // gets the scene's end as a communication point when it lies before
+        // the end of the step (beyond rounding).
+        let mut reached = target;
+        if finished {
+            self.at_end = true;
+            let sim = self.sim.as_ref().expect("built at initialization");
+            let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
+            let why = if at_rest {
+                "the rod is at rest"
+            } else {
+                "end_time reached"
+            };
+            self.log(
+                Status::Ok,
+                CAT_EVENTS,
+                &format!(
+                    "{why} at t = {sim_time:.6e} s after {steps} steps; outputs hold their final values"
+                ),
+            );
+            if self.early_return_allowed && sim_time < target - slack(current, h) {
+                reached = sim_time;
+            }
         }
-        self.at_end = true;
-        let sim = self.sim.as_ref().expect("built at initialization");
-        let at_rest = sim.observable("at_rest").unwrap_or(0.0) != 0.0;
-        let why = if at_rest {
-            "the rod is at rest"
-        } else {
-            "end_time reached"
-        };
-        self.log(
-            Status::Ok,
-            CAT_EVENTS,
-            &format!(
-                "{why} at t = {sim_time:.6e} s after {steps} steps; outputs hold their final values"
-            ),
-        );
-        // The run ended before the end of the step (beyond rounding).
-        let early = sim_time < target - slack(current, h);
-        let last = if early { sim_time } else { target };
-        self.last_successful_time = last;
-        Ok(StepOutcome {
-            terminate: true,
-            early_return: early,
-            last_successful_time: last,
-        })
+        self.time = reached;
+        self.last_successful_time = reached;
+        Ok(reached)
     }
 }
 
@@ -452,5 +445,72 @@ mod tests {
         // Without a stop time the same step is fine.
         let mut inst = start(None);
         assert!(inst.do_step("doStep", 0.0, 1.8e-6 * (1.0 + 1e-6)).is_ok());
+    }
+
+    /// Issue 65: a step into the scene's end and every step after it
+    /// complete (the FMU's time is the end of the step, the instance stays
+    /// in step mode), and the outputs hold the bits of the run to rest.
+    #[test]
+    fn steps_complete_past_the_scenes_end_and_the_outputs_hold() {
+        for standard in [Standard::Fmi3, Standard::Fmi2] {
+            let mut whole = coarse(standard);
+            assert_eq!(whole.enter_initialization_mode(), Status::Ok);
+            assert_eq!(whole.exit_initialization_mode(), Status::Ok);
+            let mut sim = crate::Simulation::new(whole.scene.clone()).unwrap();
+            sim.run().unwrap();
+            let bits = |v: Vec<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let final_bits = bits(sim.observables());
+            let rest = sim.time();
+            let (mut t, h) = (0.0, 1e-6);
+            while !whole.at_end {
+                assert_eq!(whole.do_step("doStep", t, h).unwrap(), t + h);
+                t += h;
+                assert_eq!(whole.time, t, "the step completes");
+                assert_eq!(whole.last_successful_time, t);
+            }
+            assert!(t > rest && t - h <= rest, "ended in the step into the rest");
+            for _ in 0..5 {
+                assert_eq!(whole.do_step("doStep", t, h).unwrap(), t + h);
+                t += h;
+                assert_eq!(whole.time, t);
+                assert_eq!(whole.state, STEP_MODE);
+                let s = whole.sim.as_ref().unwrap();
+                assert_eq!(bits(s.observables()), final_bits, "{standard:?}");
+                assert_eq!(s.time(), rest, "the state stays at the scene's end");
+            }
+        }
+    }
+
+    /// Issue 65: with early return allowed (FMI 3), the step into the
+    /// scene's end returns there (OK, the time the rest came), and the
+    /// host steps on from it with every step complete.
+    #[test]
+    fn early_return_at_the_scenes_end_then_steps_on() {
+        let mut inst = coarse(Standard::Fmi3);
+        inst.early_return_allowed = true;
+        assert_eq!(inst.enter_initialization_mode(), Status::Ok);
+        assert_eq!(inst.exit_initialization_mode(), Status::Ok);
+        let mut sim = crate::Simulation::new(inst.scene.clone()).unwrap();
+        sim.run().unwrap();
+        let (mut t, h) = (0.0, 1e-6);
+        while !inst.at_end {
+            t = inst.do_step("doStep", t, h).unwrap();
+        }
+        assert_eq!(
+            t,
+            sim.time(),
+            "returned at the rest, not at the end of the step"
+        );
+        assert!(t % h != 0.0);
+        for _ in 0..3 {
+            assert_eq!(inst.do_step("doStep", t, h).unwrap(), t + h);
+            t += h;
+            assert_eq!(inst.state, STEP_MODE);
+        }
+        let bits = |v: Vec<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(inst.sim.as_ref().unwrap().observables()),
+            bits(sim.observables())
+        );
     }
 }

@@ -16,8 +16,9 @@ even at the smallest resolution (its particle or node arrays, neighbour
 lists and history), so it would grow the RSS by more than 9 MiB over the 950
 measured cycles, and a library mapped anew without being unmapped costs
 megabytes per cycle; 4 MiB is 4.3 KiB per cycle. The growth measured on
-every FMU ranges from -0.5 to +0.9 MiB (glibc's allocator between two
-readings), so the bound has a margin of 4 over that noise.
+every FMU ranges from -0.5 to +1.04 MiB (glibc's allocator between two
+readings; 2026-11-27 and, all seven FMUs, 2026-11-29), so the bound has a
+margin of almost 4 over that noise.
 
 Reloading from the same unzip directory reuses the library: once a model
 has run, glibc keeps the library loaded after freeLibrary (its worker
@@ -89,12 +90,15 @@ def threads():
 
 def resolution_candidates(md):
     """The parameter to set in each cycle and the values to try for it, the
-    cheapest first: the first integer parameter (the resolution) from its
-    smallest allowed value up to its start value, else the first parameter at
-    its start value."""
+    cheapest first: the resolution `particles_radial` from its smallest
+    allowed value up to its start value, else the first parameter at its
+    start value. (Not the first integer parameter: FMI 2 declares an
+    enumeration an Integer too, and BallisticImpact's first, plate_ceramic
+    (since 2026-11-28), left its FMI 2 cycles at the default 6 nodes across
+    until 2026-11-29.)"""
     params = [v for v in md.modelVariables if v.causality == "parameter"]
     for v in params:
-        if v.type in ("Int32", "Integer") and v.min is not None:
+        if v.name == "particles_radial" and v.type in ("Int32", "Integer") and v.min is not None:
             lo, start = int(v.min), int(v.start)
             return v, list(range(lo, start + 1))
     v = params[0]

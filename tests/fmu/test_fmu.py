@@ -6,6 +6,7 @@ observables must be bit-identical. Everything except the one equality check at
 the defaults runs at particles_radial = 6 (see conftest.COARSE)."""
 
 import json
+import math
 import subprocess
 import sys
 import threading
@@ -23,8 +24,9 @@ from fmpy.fmi2 import (
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
-    fmi2Discard,
+    fmi2DoStepStatus,
     fmi2LastSuccessfulTime,
+    fmi2OK,
     fmi2Terminated,
 )
 from fmpy.fmi3 import FMU3Slave
@@ -146,16 +148,41 @@ def init2(m, params, **kw):
     return s
 
 
-def run3(m, params, step=1e-6, **kw):
-    """Steps an FMI 3 instance until it asks to terminate; final outputs."""
-    s = init3(m, params, **kw)
-    n = 0
+def step_past_the_end(s, m, step=1e-6, t0=0.0, end=None):
+    """Steps `s` (FMI 3 or FMI 2) from `t0` by `step` until its scene has
+    ended (the output `at_rest`, or the time `end`: the CLI's end time), and
+    once more. Every step completes: FMI 3 answers no event, no request to
+    stop, no early return and the end of the step as lastSuccessfulTime;
+    FMI 2 answers OK (fmpy raises otherwise), its status is OK and not
+    Terminated. The outputs of the last step are those of the one before
+    (they hold past the scene's end). Returns the outputs and the number of
+    steps."""
+    fmi3 = hasattr(s, "getFloat64")
+    rest = next((v.valueReference for v in m.outputs if v.name == "at_rest"), None)
+    n, ended = 0, False
     while True:
-        _, terminate, _, _ = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+        t = t0 + n * step
+        r = s.doStep(currentCommunicationPoint=t, communicationStepSize=step)
         n += 1
-        if terminate:
-            break
-    out = outputs(s, m)
+        if fmi3:
+            event, terminate, early, last = r
+            assert (event, terminate, early, last) == (False, False, False, t + step), r
+        else:
+            assert s.getStatus(fmi2DoStepStatus) == fmi2OK
+            assert not s.getBooleanStatus(fmi2Terminated)
+            assert s.getRealStatus(fmi2LastSuccessfulTime) == t + step
+        if ended:
+            assert outputs(s, m) == held
+            return held, n
+        ended = (end is not None and t + step >= end) or (rest is not None and bool(s.getBoolean([rest])[0]))
+        if ended:
+            held = outputs(s, m)
+
+
+def run3(m, params, step=1e-6, **kw):
+    """Steps an FMI 3 instance past the end of its scene; final outputs."""
+    s = init3(m, params, **kw)
+    out, _ = step_past_the_end(s, m, step)
     s.terminate()
     s.freeInstance()
     return out
@@ -166,7 +193,7 @@ def assert_state_rolls_back_and_resumes(m, init, params, step, k, ref):
     state got after `k` steps of `step` and set again steps to the same
     outputs; its serialized bytes (headed by the FMU's state header), in a
     new instance, run on to the end with the final values `ref` bit for
-    bit. Returns FMI 2's last successful time then (None through FMI 3)."""
+    bit, and hold them past the scene's end with every step complete."""
     fmi3 = init is init3
     s = init(m, params)
     for n in range(k):
@@ -185,25 +212,12 @@ def assert_state_rolls_back_and_resumes(m, init, params, step, k, ref):
     t = slave3(m, name="copy") if fmi3 else slave2(m, name="copy")
     restored = (t.deserializeFMUState if fmi3 else t.deSerializeFMUstate)(data)
     (t.setFMUState if fmi3 else t.setFMUstate)(restored)
-    n = k
-    while True:
-        try:
-            r = t.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
-        except FMICallException as e:  # FMI 2: the early stop
-            assert not fmi3 and e.status == fmi2Discard
-            break
-        n += 1
-        if fmi3 and r[1]:
-            break
-    for name, value in outputs(t, m).items():
+    # On past the end of the scene, every step complete, the outputs held.
+    held, _ = step_past_the_end(t, m, step, t0=k * step, end=ref["end_time"])
+    for name, value in held.items():
         assert value == ref[name], f"{name}: FMU {value!r} CLI {ref[name]!r}"
-    last = None
-    if not fmi3:
-        assert t.getBooleanStatus(fmi2Terminated)
-        last = t.getRealStatus(fmi2LastSuccessfulTime)
     for x in (s, t):
         x.freeInstance()
-    return last
 
 
 def coarse_cli(tmp_path_factory, *sets):
@@ -256,8 +270,23 @@ def test_defaults_equal_the_cli(fmu3, tmp_path_factory):
     assert r["mushroom_radius"][-1] == ref["mushroom_radius"]
     assert r["at_rest"][-1] and not r["at_rest"][0]
     assert abs(ref["rod_length"] - 34.58e-3) < 0.01e-3  # VALIDATION.md, "Right by default", test 7
-    # The run stopped at rest, well before stopTime (400 µs).
-    assert r["time"][-1] < 60e-6
+    # The run went on past the rest to stopTime (400 µs), the outputs held.
+    assert_held_past_the_end(r, ref, 400e-6)
+
+
+def assert_held_past_the_end(r, ref, stop):
+    """`simulate_fmu`'s result `r` of a Taylor FMU reached `stop`, past the
+    rod's rest; at_rest came at the communication point of the step that
+    reached the CLI's moment of rest (within one communication step: a
+    solver step is not shortened at a communication point) and the rod's
+    length held its final value from there on."""
+    t = r["time"]
+    assert t[-1] == pytest.approx(stop, rel=1e-12)
+    first = next(i for i, x in enumerate(r["at_rest"]) if x)
+    assert abs(t[first] - ref["end_time"]) < t[first] - t[first - 1]
+    assert t[first] < stop
+    assert all(x for x in r["at_rest"][first:])
+    assert all(x == ref["rod_length"] for x in r["rod_length"][first:])
 
 
 def test_fmi2_equals_fmi3_equals_cli(fmu3, fmu2, tmp_path_factory):
@@ -268,14 +297,19 @@ def test_fmi2_equals_fmi3_equals_cli(fmu3, fmu2, tmp_path_factory):
     for name in names:
         assert r3[name][-1] == r2[name][-1] == ref[name] or name == "at_rest", name
     assert r3["at_rest"][-1] and r2["at_rest"][-1]
-    # FMI 2 stops with fmi2Discard at the last successful time: the moment the
-    # rod came to rest, as the CLI reports it.
-    assert r2["time"][-1] == ref["end_time"]
-    # FMI 3 with early return allowed reports the same moment.
+    # Both run on past the rest to stopTime (400 µs), every step complete.
+    for r in (r3, r2):
+        assert_held_past_the_end(r, ref, 400e-6)
+    assert list(r3["time"]) == list(r2["time"])
+    # FMI 3 with early return allowed returns at the moment of rest, as the
+    # CLI reports it, and steps on from there to stopTime.
     r3e = simulate_fmu(str(fmu3.path), start_values={"particles_radial": COARSE}, output=["rod_length"],
                        early_return_allowed=True)
-    assert r3e["time"][-1] == ref["end_time"]
-    assert r3e["rod_length"][-1] == ref["rod_length"]
+    t = list(r3e["time"])
+    assert t.count(ref["end_time"]) == 1 and ref["end_time"] not in r3["time"]
+    assert r3e["rod_length"][t.index(ref["end_time"])] == ref["rod_length"]
+    assert r3e["time"][-1] == r3["time"][-1] and len(t) == len(r3["time"]) + 1
+    assert all(x == ref["rod_length"] for x in r3e["rod_length"][t.index(ref["end_time"]):])
 
 
 def test_start_values_act_in_the_physical_direction(fmu3, tmp_path_factory):
@@ -431,14 +465,16 @@ def test_two_interleaved_instances_equal_two_separate_runs(fmu3, tmp_path_factor
     a = init3(fmu3, {"particles_radial": COARSE}, name="a")
     b = init3(fmu3, {"particles_radial": COARSE, "impact_speed": 250.0}, name="b")
     step, n, done = 1e-6, 0, {}
+    rest = fmu3.vr("at_rest")
     while len(done) < 2:
         for name, s in (("a", a), ("b", b)):
-            if name in done:
-                continue
-            _, terminate, _, _ = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
-            if terminate:
+            # Both step on, the one at rest too (its outputs hold).
+            r = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
+            assert not r[1]
+            if name not in done and s.getBoolean([rest])[0]:
                 done[name] = outputs(s, fmu3)
         n += 1
+    assert outputs(a, fmu3) == done["a"] and outputs(b, fmu3) == done["b"]
     assert_equal_to_cli(done["a"], coarse_cli(tmp_path_factory))
     assert_equal_to_cli(done["b"], coarse_cli(tmp_path_factory, "impact_speed=250"))
     a.freeInstance()
@@ -460,18 +496,13 @@ def test_instances_run_in_parallel_threads(fmu3, tmp_path_factory):
     assert_equal_to_cli(results[250.0], coarse_cli(tmp_path_factory, "impact_speed=250"))
 
 
-def _step_until_end(s, step=1e-6):
-    n = 0
-    while True:
-        _, terminate, _, _ = s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
-        n += 1
-        if terminate:
-            return n
+def _step_until_end(s, m, step=1e-6):
+    return step_past_the_end(s, m, step)[1]
 
 
 def test_reset_then_second_run_is_bit_identical(fmu3):
     s = init3(fmu3, {"particles_radial": COARSE, "impact_speed": 220.0})
-    _step_until_end(s)
+    _step_until_end(s, fmu3)
     first = outputs(s, fmu3)
     s.terminate()
     s.reset()
@@ -482,7 +513,7 @@ def test_reset_then_second_run_is_bit_identical(fmu3):
     set_params(s, fmu3, {"particles_radial": COARSE, "impact_speed": 220.0})
     s.enterInitializationMode(startTime=0.0)
     s.exitInitializationMode()
-    _step_until_end(s)
+    _step_until_end(s, fmu3)
     second = outputs(s, fmu3)
     assert first == second
     assert np.array([first[k] for k in first]).tobytes() == np.array([second[k] for k in second]).tobytes()
@@ -511,7 +542,7 @@ def test_fmu_state_rolls_back_a_step_exactly_fmi3(fmu3):
     t.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
     assert outputs(t, fmu3) == after
     # Rolling back also recovers from the end of the run.
-    _step_until_end_from(t, 11 * step)
+    _step_until_end_from(t, fmu3, 11 * step)
     t.setFMUState(restored)
     t.doStep(currentCommunicationPoint=10 * step, communicationStepSize=step)
     assert outputs(t, fmu3) == after
@@ -520,13 +551,8 @@ def test_fmu_state_rolls_back_a_step_exactly_fmi3(fmu3):
         x.freeInstance()
 
 
-def _step_until_end_from(s, t0, step=1e-6):
-    n = 0
-    while True:
-        _, terminate, _, _ = s.doStep(currentCommunicationPoint=t0 + n * step, communicationStepSize=step)
-        n += 1
-        if terminate:
-            return
+def _step_until_end_from(s, m, t0, step=1e-6):
+    step_past_the_end(s, m, step, t0=t0)
 
 
 def test_fmu_state_rolls_back_a_step_exactly_fmi2(fmu2):
@@ -634,20 +660,28 @@ def test_fmu_states_with_a_byte_changed_are_refused_or_run_finite(fmu3):
     s.freeInstance()
 
 
-def test_fmi2_early_stop_reports_discard_terminated_and_last_time(fmu2, tmp_path_factory):
+def test_fmi2_steps_past_the_rest_complete_and_hold(fmu2, tmp_path_factory):
+    """FMI 2 (issue 65): the step into the rest and every step after it
+    answer fmi2OK (no fmi2Discard, which stopped libcosim), the status is
+    OK and not Terminated, the last successful time the end of the step,
+    and the outputs hold the CLI's final values; the host's stopTime is
+    reached."""
     ref = coarse_cli(tmp_path_factory)
-    s = init2(fmu2, {"particles_radial": COARSE})
-    step, n = 1e-6, 0
-    while True:
-        try:
-            s.doStep(currentCommunicationPoint=n * step, communicationStepSize=step)
-        except FMICallException as e:
-            assert e.status == fmi2Discard
-            break
+    s = slave2(fmu2)
+    set_params(s, fmu2, {"particles_radial": COARSE})
+    stop = 100e-6
+    s.setupExperiment(startTime=0.0, stopTime=stop)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    out, n = step_past_the_end(s, fmu2, 1e-6, end=ref["end_time"])
+    assert_equal_to_cli(out, ref)
+    assert n == math.ceil(ref["end_time"] / 1e-6) + 1
+    while n < 100:
+        s.doStep(currentCommunicationPoint=n * 1e-6, communicationStepSize=1e-6)
         n += 1
-    assert s.getBooleanStatus(fmi2Terminated)
-    assert s.getRealStatus(fmi2LastSuccessfulTime) == ref["end_time"]
-    assert_equal_to_cli(outputs(s, fmu2), ref)
+        assert outputs(s, fmu2) == out
+    assert s.getRealStatus(fmi2LastSuccessfulTime) == pytest.approx(stop, rel=1e-12)
+    assert not s.getBooleanStatus(fmi2Terminated)
     s.terminate()
     s.freeInstance()
 
@@ -664,7 +698,7 @@ def test_logging_respects_logging_on(fmu3, fmu2):
     s = init3(fmu3, {"particles_radial": COARSE})
     s.setDebugLogging(True, ["logEvents"])
     MESSAGES.clear()
-    _step_until_end(s)
+    _step_until_end(s, fmu3)
     assert messages("logProgress") == [] and len(messages("logEvents")) == 1
     with pytest.raises(FMICallException):
         s.setDebugLogging(True, ["noSuchCategory"])

@@ -147,14 +147,13 @@ unsafe extern "C" fn log3(
     }
 }
 
-/// Instance states of the standards (FMI 2 stepComplete is `Step`, its
-/// stepFailed `Discarded`).
+/// Instance states of the standards (FMI 2 stepComplete is `Step`; its
+/// stepFailed is never reached: no step is discarded, issue 65).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum St {
     Instantiated,
     Init,
     Step,
-    Discarded,
     Terminated,
 }
 
@@ -486,8 +485,10 @@ impl Fmu for Fmi3 {
             )
         };
         if code == OK {
+            // No event, and no request to stop: past the scene's end the
+            // outputs hold (issue 65).
             assert!(
-                event == 0 && term < 2 && early < 2,
+                event == 0 && term == 0 && early < 2,
                 "DoStep flags {event} {term} {early}"
             );
             if early == 0 {
@@ -539,24 +540,6 @@ impl Fmu for Fmi3 {
     unsafe fn free(self) {
         // SAFETY: a live instance (or NULL), not used afterwards.
         unsafe { fmi3::fmi3FreeInstance(self.0) }
-    }
-}
-
-impl Fmi2 {
-    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)` and
-    /// `fmi2GetBooleanStatus(fmi2Terminated)` after a Discard.
-    unsafe fn discarded(&mut self) -> f64 {
-        let (mut last, mut term) = (f64::NAN, 7);
-        // SAFETY: a live instance; writable outputs.
-        let codes = unsafe {
-            [
-                fmi2::fmi2GetRealStatus(self.0, 2, &mut last),
-                fmi2::fmi2GetBooleanStatus(self.0, 3, &mut term),
-            ]
-        };
-        assert_eq!(codes, [OK, OK], "status after Discard");
-        assert_eq!(term, 1, "fmi2Terminated after Discard");
-        last
     }
 }
 
@@ -655,8 +638,6 @@ impl Fmu for Fmi2 {
         let code = unsafe { fmi2::fmi2DoStep(self.0, current, h, 0) };
         match code {
             OK => (code, current + h, false),
-            // SAFETY: a live instance (the call above returned Discard).
-            DISCARD => (code, unsafe { self.discarded() }, true),
             _ => (code, f64::NAN, false),
         }
     }
@@ -669,7 +650,7 @@ impl Fmu for Fmi2 {
         let n = rng.below(3);
         let mut strs = [null::<c_char>(); 3];
         let kind = rng.below(6) as c_int - 1;
-        let queried = m.is(&[St::Step, St::Discarded, St::Terminated]);
+        let queried = m.is(&[St::Step, St::Terminated]);
         let (mut i, mut r, mut s) = (0 as c_int, 0.0, null::<c_char>());
         // SAFETY: arrays of three elements, `n` at most 2; writable outputs.
         unsafe {
@@ -923,7 +904,6 @@ impl<F: Fmu> Case<F> {
             (_, Some(St::Instantiated)) => *rng.pick(&[0, 1, 1, 2]),
             (_, Some(St::Init)) => *rng.pick(&[2, 3, 4, 4]),
             (_, Some(St::Step)) => *rng.pick(&[5, 5, 5, 5, 3, 7, 8, 9, 10]),
-            (_, Some(St::Discarded)) => *rng.pick(&[3, 7, 10, 11, 15]),
             _ => *rng.pick(&[11, 16, 16]),
         };
         // SAFETY (the unsafe calls below): the instance is live, every
@@ -1282,7 +1262,14 @@ impl<F: Fmu> Case<F> {
             false,
             logged,
         );
-        if code == OK || code == DISCARD {
+        // The scene's end completes the step: never Discard, never a
+        // request to stop (issue 65).
+        assert!(
+            code != DISCARD && !terminate,
+            "a step answered {code} (terminate {terminate}): {:?}",
+            self.calls
+        );
+        if code == OK {
             assert!(
                 last.is_finite(),
                 "lastSuccessfulTime {last} with {code}: {:?}",
@@ -1295,13 +1282,6 @@ impl<F: Fmu> Case<F> {
                 );
             }
             self.m.time = last;
-            if code == DISCARD {
-                assert!(
-                    F::FMI2 && terminate,
-                    "Discard from FMI 3 or without fmi2Terminated"
-                );
-                self.m.st = self.m.st.map(|_| St::Discarded);
-            }
         }
     }
 
