@@ -299,8 +299,9 @@ fn the_fmu_state_is_compact() {
 /// --nocapture`; about a minute on two cores, 4 GB. `MI_BOUNDARY_RADIAL`,
 /// `MI_BOUNDARY_LENGTH` and `MI_BOUNDARY_TIME` choose another rod and the
 /// time of the first communication step (one solver step by default).
-/// Asserted: every output read and field read allocates at most
-/// `READ_BYTES` whatever the size, and the state round-trips; the times
+/// Asserted: every output read allocates at most 16 bytes and 8 a value
+/// read, whatever the size, a C field read no more than the field asked
+/// for, and the state round-trips; the times
 /// are printed for BENCHMARKS.md (a benchmark, not a timed test).
 #[test]
 #[ignore = "heavy: about a minute and 4 GB; scripts/validate.sh"]
@@ -333,11 +334,13 @@ fn figures_at_a_million_particles() {
         (bytes, r)
     }
     /// The boundary's claim (BENCHMARKS.md, "Boundaries at 10^6
-    /// particles"): a read allocates a few bytes whatever the number of
-    /// particles (measured 16 for an output read, none for a field read
-    /// into the caller's buffer), where a copy of the particles would take
-    /// megabytes.
-    const READ_BYTES: usize = 64;
+    /// particles"): a read allocates a few bytes a value read whatever the
+    /// number of particles (measured 8 bytes a value for an output read,
+    /// 96 for all 12 outputs), where a copy of the particles would take
+    /// megabytes; a C field read makes the field asked for once (8 MB for
+    /// `density` at 10^6 particles) and no more.
+    const READ_BYTES: usize = 16;
+    const READ_BYTES_A_VALUE: usize = 8;
     println!("particles_radial = {pr}, initial_length = {length} m, first step to {time} s");
     println!("| operation | wall time | bytes allocated (this thread) | extra peak live bytes |");
     println!("|---|---|---|---|");
@@ -364,7 +367,10 @@ fn figures_at_a_million_particles() {
         });
         assert_eq!(status, 0);
         assert!(out.iter().all(|x| x.is_finite()), "{what}: {out:?}");
-        assert!(bytes <= READ_BYTES, "{what}: {bytes} bytes allocated");
+        assert!(
+            bytes <= READ_BYTES + READ_BYTES_A_VALUE * refs.len(),
+            "{what}: {bytes} bytes allocated"
+        );
     }
     let mut state = null_mut();
     let mut size = 0;
@@ -411,7 +417,12 @@ fn figures_at_a_million_particles() {
             },
         );
         assert_eq!(r, mi_result::MI_OK);
-        assert!(bytes <= READ_BYTES, "mi_sim_field {name}: {bytes} bytes");
+        // The field asked for is made once (8 bytes a value), never a
+        // snapshot of every field (13 doubles a particle).
+        assert!(
+            bytes <= READ_BYTES + 8 * len,
+            "mi_sim_field {name}: {bytes} bytes for {len} values"
+        );
     }
     let mut needed = 0;
     // SAFETY: a live handle, freed once.
