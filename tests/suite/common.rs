@@ -95,6 +95,21 @@ pub fn run_cli_with_outputs(args: &[&str], dir: &std::path::Path, vtk_times: &st
     o
 }
 
+/// Runs the program with `args`, asserts that it succeeded (printing its
+/// stderr if not) and returns its stdout.
+pub fn cli_stdout<S: AsRef<std::ffi::OsStr>>(args: impl IntoIterator<Item = S>) -> String {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
 /// Asserts that `run` gives the same result on one thread and on two.
 pub fn same_on_one_thread_and_two<T: PartialEq + Send>(run: impl Fn() -> T + Sync) {
     let on = |threads: usize| {

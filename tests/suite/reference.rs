@@ -77,14 +77,6 @@ fn every_scene_has_a_page_listed_in_the_index() {
 #[test]
 fn the_cli_prints_the_page() {
     let page = meshless_impact::reference::builtin_page("penetration").unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
-        .args(["params", "penetration", "--markdown"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(String::from_utf8(out.stdout).unwrap(), page);
+    let out = crate::common::cli_stdout(["params", "penetration", "--markdown"]);
+    assert_eq!(out, page);
 }

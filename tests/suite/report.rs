@@ -6,7 +6,6 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
 
 type Rows = Vec<BTreeMap<String, String>>;
 
@@ -146,16 +145,12 @@ const EXPECTED: &[(&str, &str)] = &[
 fn quick_report_regenerates_and_meets_its_claims() {
     let dir = std::env::temp_dir().join(format!("mi-report-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let out = Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
-        .args(["report", "--quick", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    crate::common::cli_stdout([
+        std::ffi::OsStr::new("report"),
+        "--quick".as_ref(),
+        "--out".as_ref(),
+        dir.as_os_str(),
+    ]);
 
     // Every linked table and figure exists; figures are SVG.
     let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
@@ -348,16 +343,8 @@ fn the_committed_report_was_made_by_this_code() {
         .unwrap_or_else(|| panic!("no physics digest in {index}"))
         + label.len();
     let recorded = &text[at..at + text[at..].find('`').unwrap()];
-    let out = Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
-        .args(["report", "--digest"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let now = String::from_utf8_lossy(&out.stdout).trim().to_string();
+    let now = crate::common::cli_stdout(["report", "--digest"]);
+    let now = now.trim();
     assert_eq!(
         recorded, now,
         "docs/report was made by other physics: generate it again \
