@@ -91,6 +91,11 @@ pub enum Error {
     /// A scene file that could not be read or parsed.
     #[error("scene file: {0}")]
     SceneFile(String),
+    /// An experiments file of a calibration that could not be read or
+    /// does not fit the scene: the message names the file, the line and the
+    /// column.
+    #[error("experiments file {0}")]
+    ShotsFile(String),
     /// The moment matrix of a particle or node is singular or too
     /// ill-conditioned: MSPH's (axisymmetric solver) or MLS's (3-D MLPG).
     #[error(
@@ -233,6 +238,7 @@ impl Error {
             Error::ParseValue { .. } => "ParseValue",
             Error::Inconsistent(_) => "Inconsistent",
             Error::SceneFile(_) => "SceneFile",
+            Error::ShotsFile(_) => "ShotsFile",
             Error::SingularMomentMatrix { .. } => "SingularMomentMatrix",
             Error::NonFinite { .. } => "NonFinite",
             Error::ThroughBoundary { .. } => "ThroughBoundary",

@@ -69,6 +69,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod budget;
+pub mod calibrate;
 // Unsafe code is allowed in these places only: the C ABI, the FMI glue and
 // the pointer and panic helpers they share (here), the dispatch to the
 // compiled copies of the hot loops (`hot!` in src/isa.rs), the team of

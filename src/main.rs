@@ -38,6 +38,7 @@ fn try_main() -> Result<(), Stop> {
         })?,
         Some(Command::Run(a)) => cli::run::run(a)?,
         Some(Command::Sweep(a)) => cli::sweep::sweep(a)?,
+        Some(Command::Calibrate(a)) => cli::calibrate::calibrate(a)?,
         Some(Command::Report { out, quick, digest }) => cli::report::report(out, quick, digest)?,
         Some(Command::Params {
             scene,

@@ -12,6 +12,8 @@ the command line, the C ABI and the FMUs, in SI units.
   interpreter lock is released while the solver steps).
 - Many runs: :func:`sweep` (a thread pool, or a Dask cluster) and
   :func:`ballistic_limit` (the penetration sweep and the Lambert-Jonas fit).
+- Calibration: :func:`calibrate` fits a material's constants to impact
+  tests, with their uncertainty.
 - Errors: :mod:`meshless_impact.errors`, one class per named error.
 """
 
@@ -19,6 +21,7 @@ from __future__ import annotations
 
 from . import errors
 from ._native import VERSION as __version__
+from ._calibrate import calibrate
 from ._native import Simulation, fields, observables, params, presets, scenes
 from ._sweep import BallisticLimit, ballistic_limit, shot_status, sweep
 from .errors import InputError, MeshlessImpactError, SolverStop
@@ -30,6 +33,7 @@ __all__ = [
     "Simulation",
     "SolverStop",
     "ballistic_limit",
+    "calibrate",
     "errors",
     "fields",
     "observables",

@@ -15,11 +15,12 @@ class Simulation:
     """One run of one scene.
 
     ``Simulation(scene_or_toml_path, *, preset=None, strength=None, eos=None,
-    scheme=None, threads=None, **params)``: a built-in scene by name
+    scheme=None, threads=None, preset_file=None, **params)``: a built-in scene by name
     (:func:`scenes`) or a TOML scene file (a path ending in ``.toml``, or
     any ``os.PathLike``), with the material choice, the numerical scheme and
     parameters by their names (SI units), applied as the command line's
-    ``--scheme``, ``--strength``, ``--eos``, ``--preset`` and ``--set``. A
+    ``--scheme``, ``--strength``, ``--eos``, ``--preset``, ``--preset-file``
+    (a material file, as ``calibrate`` writes) and ``--set``. A
     bad name or value raises a ``ValueError``
     (:class:`meshless_impact.errors.InputError`) with the command line's
     message. `threads`: solver threads of this run's own pool (default:
@@ -41,6 +42,7 @@ class Simulation:
         eos: Optional[str] = None,
         scheme: Optional[str] = None,
         threads: Optional[int] = None,
+        preset_file: Union[str, "PathLike[str]", None] = None,
         **params: Union[float, str],
     ) -> None: ...
     def run(self, progress: Union[bool, Progress, None] = False) -> None:
@@ -121,3 +123,24 @@ def presets() -> Dict[str, Dict[str, Any]]:
 
 def _error_samples() -> List[Tuple[str, str, Exception]]: ...
 def _debug_panic() -> None: ...
+
+def calibrate(
+    scene: Union[str, "PathLike[str]"],
+    shots: Union[str, "PathLike[str]"],
+    free: List[Tuple[str, float, float]],
+    *,
+    preset: Optional[str] = None,
+    strength: Optional[str] = None,
+    eos: Optional[str] = None,
+    scheme: Optional[str] = None,
+    preset_file: Union[str, "PathLike[str]", None] = None,
+    max_runs: int = 400,
+    max_wall: float = 3600.0,
+    coarse: Optional[Tuple[str, float]] = None,
+    fd_step: float = 0.01,
+    xtol: float = 1e-3,
+    leave_one_out: bool = False,
+    params: Optional[Dict[str, Union[float, str]]] = None,
+) -> Tuple[str, str]:
+    """The calibration (``meshless_impact.calibrate`` wraps it): returns
+    (``calibration.json``'s text, the material file's text)."""

@@ -50,6 +50,10 @@ class SceneFile(InputError):
     """A scene file that could not be read or parsed."""
 
 
+class ShotsFile(InputError):
+    """An experiments file of a calibration that cannot be read or does not fit the scene (the message names the file, line and column)."""
+
+
 class InvalidState(InputError):
     """Bytes that are not a saved state of this kind of scene."""
 

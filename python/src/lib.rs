@@ -17,6 +17,8 @@
 //!
 //! It holds no global state: separate `Simulation`s run in parallel.
 
+mod calibrate;
+
 use meshless_impact::{Error, Scene, SceneKind, Simulation as Core};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -49,7 +51,7 @@ fn exception(py: Python<'_>, name: &str, message: String) -> PyErr {
 
 /// A core error as the exception of its name: `ValueError` subclasses for
 /// bad input, a `SolverStop` subclass for a run that left its domain.
-fn raise(py: Python<'_>, e: &Error) -> PyErr {
+pub(crate) fn raise(py: Python<'_>, e: &Error) -> PyErr {
     exception(py, e.name(), e.to_string())
 }
 
@@ -68,7 +70,7 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// Runs `f`, turning a panic into `meshless_impact.errors.InternalError`:
 /// nothing unwinds into Python (pyo3 would raise its `PanicException`, a
 /// `BaseException` that `except Exception` does not catch).
-fn guard<T>(py: Python<'_>, f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+pub(crate) fn guard<T>(py: Python<'_>, f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     match catch_unwind(AssertUnwindSafe(f)) {
         Ok(r) => r,
         Err(payload) => Err(exception(
@@ -81,7 +83,7 @@ fn guard<T>(py: Python<'_>, f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 
 /// A parameter value from Python: a number, or text (a level's name for a
 /// scheme, or a number as the command line takes it).
-enum Value {
+pub(crate) enum Value {
     Number(f64),
     Text(String),
 }
@@ -108,7 +110,7 @@ impl Value {
 /// `--strength`, `--eos`, `--preset` and `--set`s: the scheme, then the
 /// material, then the parameters (schemes first), then the whole scene is
 /// checked. Errors carry the command line's messages.
-fn build_scene(
+pub(crate) fn build_scene(
     scene: &Bound<'_, PyAny>,
     choices: &Choices,
     params: &[(String, Value)],
@@ -131,11 +133,14 @@ fn build_scene(
 
 /// The choices of the material models, the preset and the scheme.
 #[derive(Default)]
-struct Choices {
-    preset: Option<String>,
-    strength: Option<String>,
-    eos: Option<String>,
-    scheme: Option<String>,
+pub(crate) struct Choices {
+    pub(crate) preset: Option<String>,
+    pub(crate) strength: Option<String>,
+    pub(crate) eos: Option<String>,
+    pub(crate) scheme: Option<String>,
+    /// A material file (the CLI's `--preset-file`), applied after the
+    /// preset.
+    pub(crate) preset_file: Option<std::path::PathBuf>,
 }
 
 /// [`build_scene`]'s steps after the scene is read.
@@ -155,6 +160,9 @@ fn apply(
             choices.preset.as_deref(),
         )?;
     }
+    if let Some(path) = &choices.preset_file {
+        scene.apply_material_file(path)?;
+    }
     let pairs = scene.schemes_first(params.iter().map(|(n, v)| (n.as_str(), v)));
     for (name, value) in pairs {
         match value {
@@ -167,7 +175,7 @@ fn apply(
 }
 
 /// The parameters of `**kwargs`, in their order.
-fn kwargs(params: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, Value)>> {
+pub(crate) fn kwargs(params: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, Value)>> {
     let mut out = Vec::new();
     if let Some(d) = params {
         for (k, v) in d.iter() {
@@ -361,7 +369,7 @@ fn drive_loop(sim: &mut Core, until: Option<f64>, progress: Option<&Py<PyAny>>) 
 impl Simulation {
     /// See `meshless_impact.Simulation`.
     #[new]
-    #[pyo3(signature = (scene, *, preset=None, strength=None, eos=None, scheme=None, threads=None, **params))]
+    #[pyo3(signature = (scene, *, preset=None, strength=None, eos=None, scheme=None, threads=None, preset_file=None, **params))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -371,6 +379,7 @@ impl Simulation {
         eos: Option<String>,
         scheme: Option<String>,
         threads: Option<usize>,
+        preset_file: Option<std::path::PathBuf>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         guard(py, || {
@@ -379,6 +388,7 @@ impl Simulation {
                 strength,
                 eos,
                 scheme,
+                preset_file,
             };
             let params = kwargs(params)?;
             let scene = build_scene(scene, &choices, &params)?.map_err(|e| raise(py, &e))?;
@@ -668,6 +678,7 @@ fn params<'py>(
             strength,
             eos,
             scheme,
+            preset_file: None,
         };
         let s = apply(Scene::builtin(scene), &choices, &[]).map_err(|e| raise(py, &e))?;
         let d = PyDict::new(py);
@@ -765,6 +776,7 @@ fn sample_errors() -> Vec<Error> {
         },
         Error::Inconsistent("a and b".into()),
         Error::SceneFile("x.toml".into()),
+        Error::ShotsFile("shots.csv, line 2, column 3: `x` is not a number".into()),
         Error::SingularMomentMatrix {
             method: MomentMethod::Msph,
             particle: 1,
@@ -831,6 +843,7 @@ fn every_error_is_listed(e: &Error) {
         | Error::ParseValue { .. }
         | Error::Inconsistent(_)
         | Error::SceneFile(_)
+        | Error::ShotsFile(_)
         | Error::SingularMomentMatrix { .. }
         | Error::NonFinite { .. }
         | Error::ThroughBoundary { .. }
@@ -875,6 +888,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(observables, m)?)?;
     m.add_function(wrap_pyfunction!(fields, m)?)?;
     m.add_function(wrap_pyfunction!(presets, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(_error_samples, m)?)?;
     m.add_function(wrap_pyfunction!(_debug_panic, m)?)?;
     m.add("VERSION", meshless_impact::VERSION)?;

@@ -237,6 +237,9 @@ pub(crate) fn code_of(e: &Error) -> mi_result {
         Error::ParseValue { .. } => MI_PARSE_VALUE,
         Error::Inconsistent(_) => MI_INCONSISTENT,
         Error::SceneFile(_) => MI_SCENE_FILE,
+        // Never returned through the C ABI, which has no calibration: the
+        // input file that it names is the kind of MI_SCENE_FILE's.
+        Error::ShotsFile(_) => MI_SCENE_FILE,
         Error::SingularMomentMatrix { .. } => MI_SINGULAR_MOMENT_MATRIX,
         Error::NonFinite { .. } => MI_NON_FINITE,
         Error::ThroughBoundary { .. } => MI_THROUGH_BOUNDARY,

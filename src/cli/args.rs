@@ -22,6 +22,10 @@ pub(crate) enum Command {
     Run(RunArgs),
     /// Run a family of scenes in parallel: `table1` is the twelve tests of Table 1.
     Sweep(SweepArgs),
+    /// Fit named parameters of a scene (a material's constants) to the
+    /// measured observables of a set of experiments: writes
+    /// DIR/calibration.json, DIR/material.toml and DIR/fit.svg.
+    Calibrate(CalibrateArgs),
     /// Regenerate the verification report (error against run time,
     /// sensitivity, Table 1, figures, stability matrix) as DIR/index.md with
     /// CSV tables and SVG figures.
@@ -89,6 +93,11 @@ pub(crate) struct ChoiceArgs {
     /// models and constants; --set may override its constants.
     #[arg(long, value_name = "NAME")]
     pub(crate) preset: Option<String>,
+    /// A material file: a TOML `[material]` table as a scene file's (the
+    /// `material.toml` that `calibrate` writes), applied after --preset;
+    /// --set may override its constants.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) preset_file: Option<PathBuf>,
 }
 
 impl ChoiceArgs {
@@ -97,14 +106,17 @@ impl ChoiceArgs {
         if let Some(name) = &self.scheme {
             scene.set_str("scheme", name)?;
         }
-        if self.strength.is_none() && self.eos.is_none() && self.preset.is_none() {
-            return Ok(());
+        if self.strength.is_some() || self.eos.is_some() || self.preset.is_some() {
+            scene.choose_material(
+                self.strength.as_deref(),
+                self.eos.as_deref(),
+                self.preset.as_deref(),
+            )?;
         }
-        scene.choose_material(
-            self.strength.as_deref(),
-            self.eos.as_deref(),
-            self.preset.as_deref(),
-        )
+        if let Some(path) = &self.preset_file {
+            scene.apply_material_file(path)?;
+        }
+        Ok(())
     }
 }
 
@@ -166,6 +178,58 @@ pub(crate) struct SweepArgs {
     /// Override a parameter in every case, e.g. `--set particles_radial=10`.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub(crate) set: Vec<String>,
+}
+
+#[derive(Args)]
+pub(crate) struct CalibrateArgs {
+    /// Built-in scene (`meshless-impact scenes` lists them).
+    #[arg(default_value = "taylor", conflicts_with = "scene_file")]
+    pub(crate) scene: String,
+    /// Read the scene (the fixed part of the fit) from a TOML file instead.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) scene_file: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) material: ChoiceArgs,
+    /// Fix a parameter in every experiment, e.g. `--set particles_radial=20`
+    /// (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub(crate) set: Vec<String>,
+    /// The experiments: a CSV file, one row per experiment; each column a
+    /// parameter of the scene (a setting) or an observable (a measurement),
+    /// with optional `sigma_NAME`, `shot`, `outline` and `sigma_outline`
+    /// columns (docs/guide/calibration.md).
+    #[arg(long, value_name = "FILE.csv")]
+    pub(crate) shots: PathBuf,
+    /// A free parameter and its bounds, e.g. `--free jc_a=600e6:1200e6`
+    /// (repeatable); it starts from the scene's value.
+    #[arg(long = "free", value_name = "NAME=LO:HI", required = true)]
+    pub(crate) free: Vec<String>,
+    /// Output directory: calibration.json, material.toml, fit.svg.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) out: PathBuf,
+    /// Cap on forward runs (one experiment at one point is one run).
+    #[arg(long, value_name = "N", default_value_t = 400)]
+    pub(crate) max_runs: usize,
+    /// Cap on wall time, seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 3600.0)]
+    pub(crate) max_wall: f64,
+    /// Fit at a coarser resolution first, e.g. `--coarse particles_radial=10`;
+    /// the fine stage starts from its answer and its Jacobian.
+    #[arg(long, value_name = "NAME=VALUE")]
+    pub(crate) coarse: Option<String>,
+    /// Finite-difference step, relative to a parameter's value.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
+    pub(crate) fd_step: f64,
+    /// Converged when a step moves no parameter by more than this fraction.
+    #[arg(long, value_name = "FRACTION", default_value_t = 1e-3)]
+    pub(crate) xtol: f64,
+    /// After the fit, predict each experiment from the constants fitted to
+    /// the others (cross-validation; its runs are counted apart).
+    #[arg(long)]
+    pub(crate) leave_one_out: bool,
+    /// No progress bar and no iteration lines (the summary is printed).
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 /// Applies `--set NAME=VALUE`s: a scheme first (`--set scheme=paper`),

@@ -4,6 +4,7 @@
 //! `report`).
 
 pub(crate) mod args;
+pub(crate) mod calibrate;
 pub(crate) mod listing;
 pub(crate) mod output;
 pub(crate) mod report;

@@ -121,6 +121,25 @@ fn usable(p: &(f64, f64), ax: &Axes) -> bool {
 
 /// Draws `series` on the given axes into an SVG file.
 pub fn lines(path: &Path, ax: Axes, series: &[Series]) -> Result<()> {
+    panels(path, &[(ax, series)])
+}
+
+/// Draws charts side by side into one SVG file: each its axes and series.
+pub fn panels(path: &Path, charts: &[(Axes, &[Series])]) -> Result<()> {
+    let n = charts.len().max(1);
+    let root = SVGBackend::new(path, (SIZE.0 * n as u32, SIZE.1)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    for (area, (ax, series)) in root.split_evenly((1, n)).iter().zip(charts) {
+        chart(path, area, *ax, series)?;
+    }
+    root.present().map_err(|e| plot_err(path, e))
+}
+
+/// The drawing area of one chart.
+type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
+
+/// Draws one chart into `area` (of the file `path`, for the messages).
+fn chart(path: &Path, area: &Area, ax: Axes, series: &[Series]) -> Result<()> {
     let pts = || {
         series
             .iter()
@@ -133,23 +152,28 @@ pub fn lines(path: &Path, ax: Axes, series: &[Series]) -> Result<()> {
         (x0, x1, y0, y1) = (lo, hi, lo, hi);
     }
     match (ax.log_x, ax.log_y) {
-        (false, false) => draw(path, ax, series, x0..x1, y0..y1),
-        (true, false) => draw(path, ax, series, (x0..x1).log_scale(), y0..y1),
-        (false, true) => draw(path, ax, series, x0..x1, (y0..y1).log_scale()),
-        (true, true) => draw(path, ax, series, (x0..x1).log_scale(), (y0..y1).log_scale()),
+        (false, false) => draw(path, area, ax, series, x0..x1, y0..y1),
+        (true, false) => draw(path, area, ax, series, (x0..x1).log_scale(), y0..y1),
+        (false, true) => draw(path, area, ax, series, x0..x1, (y0..y1).log_scale()),
+        (true, true) => draw(
+            path,
+            area,
+            ax,
+            series,
+            (x0..x1).log_scale(),
+            (y0..y1).log_scale(),
+        ),
     }
 }
 
-fn draw<X, Y>(path: &Path, ax: Axes, series: &[Series], xs: X, ys: Y) -> Result<()>
+fn draw<X, Y>(path: &Path, area: &Area, ax: Axes, series: &[Series], xs: X, ys: Y) -> Result<()>
 where
     X: AsRangedCoord<Value = f64>,
     Y: AsRangedCoord<Value = f64>,
     X::CoordDescType: ValueFormatter<f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let root = SVGBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(area)
         .caption(ax.title, ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(40)
@@ -208,8 +232,7 @@ where
             SeriesLabelPosition::UpperRight
         })
         .draw()
-        .map_err(|e| plot_err(path, e))?;
-    root.present().map_err(|e| plot_err(path, e))
+        .map_err(|e| plot_err(path, e))
 }
 
 /// Particles in the R-Z plane (the first two coordinates of axisymmetric

@@ -267,9 +267,10 @@ struct SceneFile {
     reference: BTreeMap<String, f64>,
 }
 
-/// The `[material]` table of a scene file.
+/// The `[material]` table of a scene file (and of a material file,
+/// `--preset-file`): the models or a preset, then constants by parameter
+/// name, which override the preset's.
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 struct MaterialTable {
     #[serde(default)]
     strength: Option<String>,
@@ -277,6 +278,16 @@ struct MaterialTable {
     eos: Option<String>,
     #[serde(default)]
     preset: Option<String>,
+    /// Constants of the material by parameter name (`jc_a = 8.1e8`).
+    #[serde(flatten)]
+    constants: BTreeMap<String, toml::Value>,
+}
+
+/// The shape of a material file: a `[material]` table alone.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialFile {
+    material: MaterialTable,
 }
 
 impl Scene {
@@ -322,25 +333,108 @@ impl Scene {
             scene.title = t;
         }
         if let Some(m) = &file.material {
-            scene.choose_material(m.strength.as_deref(), m.eos.as_deref(), m.preset.as_deref())?;
+            scene.apply_material_table(m)?;
         }
         let pairs = file.parameters.iter().map(|(n, v)| (n.as_str(), v));
         for (name, value) in scene.schemes_first(pairs) {
-            let v = match value {
-                toml::Value::Float(f) => *f,
-                toml::Value::Integer(i) => *i as f64,
-                toml::Value::String(text) => scene.spec(name)?.parse(text)?,
-                other => {
-                    return Err(Error::ParseValue {
-                        name: name.to_string(),
-                        text: other.to_string(),
-                    });
-                }
-            };
+            let v = scene.toml_value(name, value)?;
             scene.set(name, v)?;
         }
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// The number a TOML value gives the parameter `name`: a float, an
+    /// integer, or a text that the parameter parses (a level's name).
+    fn toml_value(&self, name: &str, value: &toml::Value) -> Result<f64> {
+        match value {
+            toml::Value::Float(f) => Ok(*f),
+            toml::Value::Integer(i) => Ok(*i as f64),
+            toml::Value::String(text) => self.spec(name)?.parse(text),
+            other => Err(Error::ParseValue {
+                name: name.to_string(),
+                text: other.to_string(),
+            }),
+        }
+    }
+
+    /// Applies a `[material]` table: its models or preset, then its
+    /// constants, each of which must be a constant of the scene's material
+    /// ([`Scene::material_names`]).
+    fn apply_material_table(&mut self, m: &MaterialTable) -> Result<()> {
+        if m.strength.is_some() || m.eos.is_some() || m.preset.is_some() {
+            self.choose_material(m.strength.as_deref(), m.eos.as_deref(), m.preset.as_deref())?;
+        }
+        let allowed = self.material_names();
+        for (name, value) in &m.constants {
+            if !allowed.contains(&name.as_str()) {
+                return Err(Error::SceneFile(format!(
+                    "[material] `{name}` is not a constant of the material of scene `{}`; allowed: strength, eos, preset, {}",
+                    self.kind.name(),
+                    allowed.join(", ")
+                )));
+            }
+            let v = self.toml_value(name, value)?;
+            self.set(name, v)?;
+        }
+        Ok(())
+    }
+
+    /// Applies a material file (`--preset-file`): a TOML file with a
+    /// `[material]` table alone, as a scene file's (`calibrate` writes
+    /// one as `material.toml`). Nothing changes on an error.
+    pub fn apply_material_file(&mut self, path: impl AsRef<std::path::Path>) -> Result<()> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let file: MaterialFile = toml::from_str(&text)
+            .map_err(|e| Error::SceneFile(format!("{}: {e}", path.display())))?;
+        let mut next = self.clone();
+        next.apply_material_table(&file.material)
+            .map_err(|e| match e {
+                Error::SceneFile(m) => Error::SceneFile(format!("{}: {m}", path.display())),
+                other => other,
+            })?;
+        *self = next;
+        Ok(())
+    }
+
+    /// The names of the scene's parameters that are constants of its
+    /// materials (the material blocks' and the ceramic plate's), in table
+    /// order.
+    pub fn material_names(&self) -> Vec<&'static str> {
+        use crate::material::ceramic_block::PLATE_CERAMIC;
+        let in_a_block = |name: &str| {
+            Prefix::ALL
+                .iter()
+                .any(|p| p.block().iter().any(|b| b.spec.name == name))
+                || PLATE_CERAMIC.iter().any(|s| s.name == name)
+        };
+        self.param_specs()
+            .iter()
+            .map(|s| s.name)
+            .filter(|n| in_a_block(n))
+            .collect()
+    }
+
+    /// The scene's material as a material file (`--preset-file`): a
+    /// `[material]` table with the models (where the scene has a choice of
+    /// them) and every constant of [`Scene::material_names`], each written
+    /// so that it reads back bit for bit.
+    pub fn material_toml(&self) -> String {
+        let mut out = String::from("[material]\n");
+        if let Some(c) = self.kind.material {
+            out.push_str(&format!(
+                "strength = \"{}\"\neos = \"{}\"\n",
+                c.strength.name(),
+                c.eos.name()
+            ));
+        }
+        for name in self.material_names() {
+            let spec = self.spec(name).expect("own name");
+            let v = self.get(name).expect("own name");
+            out.push_str(&format!("{name} = {v:?}  # {}\n", spec.unit));
+        }
+        out
     }
 
     /// Reads a TOML scene file.

@@ -8,6 +8,7 @@
 //! `tests/mlpg_alloc.rs` a counting global allocator, `tests/fuzz.rs` a panic
 //! hook that counts every panic.
 
+mod calibrate;
 mod capi;
 mod cli;
 mod common;
