@@ -32,6 +32,7 @@ def calibrate(
     fd_step: float = 0.01,
     xtol: float = 1e-3,
     leave_one_out: bool = False,
+    method: str = "broyden",
     out: Optional[PathLike] = None,
 ) -> Dict[str, Any]:
     """Fits the ``free`` parameters of ``scene`` to the experiments in the
@@ -44,8 +45,9 @@ def calibrate(
     ``preset_file`` and ``set`` (a dict of fixed parameters) are the command
     line's ``--preset``, ``--strength``, ``--eos``, ``--scheme``,
     ``--preset-file`` and ``--set``; ``max_runs``, ``max_wall`` (s),
-    ``coarse`` (``(name, value)``), ``fd_step``, ``xtol`` and
-    ``leave_one_out`` its options of the same names.
+    ``coarse`` (``(name, value)``), ``fd_step``, ``xtol``, ``method``
+    (``"broyden"`` or ``"plain"``) and ``leave_one_out`` its options of the
+    same names.
 
     Returns the fields of ``calibration.json`` as a dict: ``parameters``,
     ``std`` (``None`` where the data do not constrain a parameter),
@@ -79,6 +81,7 @@ def calibrate(
         fd_step=fd_step,
         xtol=xtol,
         leave_one_out=leave_one_out,
+        method=method,
         params=dict(set or {}),
     )
     result: Dict[str, Any] = json.loads(text)

@@ -140,6 +140,7 @@ def calibrate(
     fd_step: float = 0.01,
     xtol: float = 1e-3,
     leave_one_out: bool = False,
+    method: str = "broyden",
     params: Optional[Dict[str, Union[float, str]]] = None,
 ) -> Tuple[str, str]:
     """The calibration (``meshless_impact.calibrate`` wraps it): returns

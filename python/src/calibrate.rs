@@ -14,7 +14,7 @@ use pyo3::types::PyDict;
 #[pyfunction]
 #[pyo3(signature = (scene, shots, free, *, preset=None, strength=None, eos=None, scheme=None,
     preset_file=None, max_runs=400, max_wall=3600.0, coarse=None, fd_step=0.01, xtol=1e-3,
-    leave_one_out=false, params=None))]
+    leave_one_out=false, method="broyden".to_string(), params=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn calibrate(
     py: Python<'_>,
@@ -32,6 +32,7 @@ pub(crate) fn calibrate(
     fd_step: f64,
     xtol: f64,
     leave_one_out: bool,
+    method: String,
     params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(String, String)> {
     guard(py, || {
@@ -56,6 +57,17 @@ pub(crate) fn calibrate(
                 coarse,
                 fd_step,
                 xtol,
+                broyden: match method.as_str() {
+                    "broyden" => true,
+                    "plain" => false,
+                    other => {
+                        return Err(meshless_impact::Error::UnknownModel {
+                            key: "method".into(),
+                            name: other.into(),
+                            allowed: "broyden, plain".into(),
+                        });
+                    }
+                },
                 leave_one_out,
             };
             Calibration::new(scene, free, shots, options)

@@ -55,6 +55,11 @@ pub struct Options {
     /// without it a small step with a carried Jacobian ends the search (a
     /// coarse stage).
     pub fresh_at_end: bool,
+    /// Carry the Jacobian from point to point by Broyden's updates (the
+    /// default); otherwise take it afresh at every accepted point (plain
+    /// Levenberg-Marquardt on finite differences, the alternative measured
+    /// in docs/guide/calibration.md).
+    pub carry: bool,
 }
 
 impl Default for Options {
@@ -64,6 +69,7 @@ impl Default for Options {
             xtol: 1e-3,
             max_iterations: 40,
             fresh_at_end: true,
+            carry: true,
         }
     }
 }
@@ -156,7 +162,7 @@ pub fn minimise(
     for _ in 0..opts.max_iterations {
         let mut took_jacobian = false;
         let step = lm_step(&s.j, &s.r, lambda, &s.x, bounds);
-        if is_small(&step, &s.x, bounds, opts.xtol) {
+        if is_small(&step, &s, bounds, opts.xtol) {
             if s.fresh || !opts.fresh_at_end {
                 return finish(s, Stop::Converged, iterations);
             }
@@ -168,7 +174,7 @@ pub fn minimise(
             }
             took_jacobian = true;
             let step = lm_step(&s.j, &s.r, lambda, &s.x, bounds);
-            if is_small(&step, &s.x, bounds, opts.xtol) {
+            if is_small(&step, &s, bounds, opts.xtol) {
                 let it = Iteration {
                     objective: objective(&s.r),
                     lambda,
@@ -208,6 +214,13 @@ pub fn minimise(
                 lambda = (lambda / 3.0).max(1e-9);
             } else if ratio < 0.25 {
                 lambda *= 2.0;
+            }
+            // The plain method takes the Jacobian afresh at every new point.
+            if !opts.carry {
+                if let Err(cap) = refresh(&mut s, bounds, opts, eval) {
+                    return finish(s, Stop::Capped(cap), iterations);
+                }
+                took_jacobian = true;
             }
         } else {
             lambda *= 4.0;
@@ -258,11 +271,7 @@ fn add(a: &[f64], b: &[f64]) -> Vec<f64> {
 /// The finite-difference step of parameter `k` at `x`: `fd_step` of the
 /// value (of the bound's width at 0), forward unless that leaves the box.
 fn fd_delta(x: f64, (lo, hi): (f64, f64), fd_step: f64) -> f64 {
-    let h = if x != 0.0 {
-        fd_step * x.abs()
-    } else {
-        fd_step * (hi - lo)
-    };
+    let h = fd_step * scale(x, (lo, hi));
     if x + h <= hi { h } else { -h }
 }
 
@@ -333,13 +342,28 @@ fn broyden(j: &mut Mat, d: &[f64], rt: &[f64], r: &[f64]) {
     }
 }
 
+/// The scale of a parameter: its value's magnitude (its bound's width at
+/// 0). Steps and tolerances are relative to it, and the step is solved for
+/// in parameters divided by it, so that constants of different units (a
+/// stress in Pa and an exponent) weigh alike.
+fn scale(x: f64, (lo, hi): (f64, f64)) -> f64 {
+    if x != 0.0 { x.abs() } else { hi - lo }
+}
+
 /// The Levenberg-Marquardt step at `x`, with Marquardt's scaling (the
-/// damping proportional to the normal matrix's diagonal), cut back into the
-/// box.
+/// damping proportional to the normal matrix's diagonal), solved for in
+/// scaled parameters ([`scale`]) and cut back into the box.
 fn lm_step(j: &Mat, r: &[f64], lambda: f64, x: &[f64], bounds: &[(f64, f64)]) -> Vec<f64> {
     let p = x.len();
-    let mut a = j.gram();
-    let g = j.transpose_times(r);
+    let s: Vec<f64> = x.iter().zip(bounds).map(|(x, b)| scale(*x, *b)).collect();
+    let mut js = j.clone();
+    for i in 0..js.rows {
+        for k in 0..p {
+            js[(i, k)] *= s[k];
+        }
+    }
+    let mut a = js.gram();
+    let g = js.transpose_times(r);
     let dmax = (0..p).map(|k| a[(k, k)]).fold(0.0, f64::max);
     for k in 0..p {
         let d = a[(k, k)].max(1e-12 * dmax).max(f64::MIN_POSITIVE);
@@ -348,19 +372,31 @@ fn lm_step(j: &Mat, r: &[f64], lambda: f64, x: &[f64], bounds: &[(f64, f64)]) ->
     let neg_g: Vec<f64> = g.iter().map(|v| -v).collect();
     let step = solve_spd(&a, &neg_g).unwrap_or_else(|| vec![0.0; p]);
     step.iter()
+        .zip(&s)
         .zip(x)
         .zip(bounds)
-        .map(|((d, x), (lo, hi))| (x + d).clamp(*lo, *hi) - x)
+        .map(|(((d, s), x), (lo, hi))| (x + d * s).clamp(*lo, *hi) - x)
         .collect()
 }
 
-/// Whether every component of `step` is below `xtol` of its parameter's
-/// value (of its bound's width at 0).
-fn is_small(step: &[f64], x: &[f64], bounds: &[(f64, f64)], xtol: f64) -> bool {
-    step.iter().zip(x).zip(bounds).all(|((d, x), (lo, hi))| {
-        let scale = if *x != 0.0 { x.abs() } else { hi - lo };
-        d.abs() <= xtol * scale
-    })
+/// The fraction of a parameter's standard error below which a step is
+/// small: further steps would move the answer far less than the data
+/// determine it.
+pub const STD_FRACTION: f64 = 0.1;
+
+/// Whether every component of `step` is small: below `xtol` of its
+/// parameter's [`scale`], or below [`STD_FRACTION`] of its standard error
+/// as the current Jacobian and residuals give it.
+fn is_small(step: &[f64], s: &State, bounds: &[(f64, f64)], xtol: f64) -> bool {
+    let names: Vec<String> = (0..s.x.len()).map(|k| k.to_string()).collect();
+    let std = super::stats::uncertainty(&names, &s.x, &s.j, &s.r).std;
+    step.iter()
+        .zip(&s.x)
+        .zip(bounds)
+        .zip(&std)
+        .all(|(((d, x), b), sd)| {
+            d.abs() <= xtol * scale(*x, *b) || sd.is_some_and(|sd| d.abs() <= STD_FRACTION * sd)
+        })
 }
 
 #[cfg(test)]

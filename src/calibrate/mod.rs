@@ -24,6 +24,7 @@ mod lsq;
 mod shots;
 mod stats;
 
+pub use lsq::STD_FRACTION;
 pub use shots::{Measured, Outline, Shot, parse as parse_shots, read as read_shots};
 pub use stats::{MAX_CORRELATION, MAX_RELATIVE_STD};
 
@@ -121,8 +122,14 @@ pub struct Options {
     pub coarse: Option<(String, f64)>,
     /// Finite-difference step, relative to a parameter's value.
     pub fd_step: f64,
-    /// Converged when a step is below this fraction of every parameter.
+    /// Converged when a step moves each parameter by less than this
+    /// fraction of its value, or by less than a tenth of its standard error
+    /// (`STD_FRACTION`).
     pub xtol: f64,
+    /// The method: Levenberg-Marquardt with the Jacobian carried by
+    /// Broyden's updates (`true`, the default) or taken afresh by finite
+    /// differences at every accepted point (`false`).
+    pub broyden: bool,
     /// After the fit, predict each experiment from the constants fitted to
     /// the others (each such fit starts from the whole fit's answer and
     /// Jacobian; its runs are counted apart, under the same caps).
@@ -137,6 +144,7 @@ impl Default for Options {
             coarse: None,
             fd_step: 0.01,
             xtol: 1e-3,
+            broyden: true,
             leave_one_out: false,
         }
     }
@@ -266,6 +274,10 @@ pub struct CalibrationResult {
     /// finite differences (otherwise it is Broyden's update, the cap having
     /// come first).
     pub jacobian_at_optimum: bool,
+    /// The Jacobian of the weighted residuals at the end (one row per
+    /// measurement, in the experiments' order; one column per free
+    /// parameter, per unit of it): the sensitivities behind `std`.
+    pub jacobian: Vec<Vec<f64>>,
     /// The settings.
     pub options: Options,
     /// The calibrated material as a `[material]` table (`material.toml`).
@@ -438,6 +450,7 @@ impl Calibration {
             xtol: self.options.xtol,
             max_iterations: 40,
             fresh_at_end: true,
+            carry: self.options.broyden,
         };
         let iterations_cell = Mutex::new(Vec::new());
         let mut failed_points = 0;
@@ -572,6 +585,9 @@ impl Calibration {
             wall_time_s: clock.elapsed().as_secs_f64(),
             outcome,
             jacobian_at_optimum: out.j_fresh,
+            jacobian: (0..out.j.rows)
+                .map(|i| (0..out.j.cols).map(|k| out.j[(i, k)]).collect())
+                .collect(),
             options: self.options.clone(),
             material_toml: at_fit.material_toml(),
             leave_one_out: if self.options.leave_one_out {
@@ -812,6 +828,10 @@ pub const METHOD: &str = "Levenberg-Marquardt (Marquardt scaling, box bounds by 
 Jacobian carried between trial points by Broyden's rank-one updates, refreshed by finite differences when a step fails \
 and at the optimum";
 
+/// The plain method (`broyden: false`), as the result records it.
+pub const METHOD_PLAIN: &str = "Levenberg-Marquardt (Marquardt scaling, box bounds by projection) on a forward-difference \
+Jacobian taken afresh at every accepted point";
+
 /// How the uncertainty is computed, as the result records it.
 pub const UNCERTAINTY: &str = "covariance s^2 (J^T J)^-1 from the Jacobian J of the weighted residuals at the optimum, \
 scaled by the residual s^2 = (sum of squared weighted residuals) / (measurements - free parameters)";
@@ -967,8 +987,9 @@ impl CalibrationResult {
             "max_wall_s": self.options.max_wall_s,
             "coarse": self.options.coarse.as_ref().map(|(n, v)| json!({ n.clone(): v })),
             "outcome": self.outcome.name(),
-            "method": METHOD,
+            "method": if self.options.broyden { METHOD } else { METHOD_PLAIN },
             "uncertainty": UNCERTAINTY,
+            "jacobian_matrix": self.jacobian,
             "jacobian": if self.jacobian_at_optimum {
                 "finite differences at the optimum"
             } else {

@@ -187,7 +187,8 @@ mod tests {
         assert!(u.std[0].is_none());
         // Nearly so: correlated beyond the bound.
         j[(3, 1)] = 4.05;
-        let u = uncertainty(&names(3), &[1.0, 1.0, 1.0], &j, &[0.01, -0.01, 0.02, 0.0]);
+        let small = [1e-5, -1e-5, 2e-5, 0.0];
+        let u = uncertainty(&names(3), &[1.0, 1.0, 1.0], &j, &small);
         let e = u.identifiable[0].clone().unwrap_err();
         assert!(e.contains("correlation") && e.contains("p1"), "{e}");
     }

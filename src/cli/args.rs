@@ -220,9 +220,15 @@ pub(crate) struct CalibrateArgs {
     /// Finite-difference step, relative to a parameter's value.
     #[arg(long, value_name = "FRACTION", default_value_t = 0.01)]
     pub(crate) fd_step: f64,
-    /// Converged when a step moves no parameter by more than this fraction.
+    /// Converged when a step moves each parameter by less than this
+    /// fraction of its value, or by less than a tenth of its standard error.
     #[arg(long, value_name = "FRACTION", default_value_t = 1e-3)]
     pub(crate) xtol: f64,
+    /// The method: `broyden` (the default: the finite-difference Jacobian
+    /// carried from point to point by Broyden's updates) or `plain` (taken
+    /// afresh at every accepted point).
+    #[arg(long, value_name = "METHOD", default_value = "broyden", value_parser = ["broyden", "plain"])]
+    pub(crate) method: String,
     /// After the fit, predict each experiment from the constants fitted to
     /// the others (cross-validation; its runs are counted apart).
     #[arg(long)]

@@ -54,6 +54,7 @@ pub(crate) fn calibrate(a: CalibrateArgs) -> Result<(), Stop> {
         coarse,
         fd_step: a.fd_step,
         xtol: a.xtol,
+        broyden: a.method == "broyden",
         leave_one_out: a.leave_one_out,
     };
     let problem = Calibration::new(scene, free, shots, options)?;

@@ -323,3 +323,29 @@ fn a_fit_at_its_cap_keeps_the_best_point() {
     assert!(dir.join("out/material.toml").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The shipped experiments file of Table 1 holds the table's settings and
+/// measurements (data/house1995_4340_table1.csv), in SI units.
+#[test]
+fn the_table_1_experiments_file_is_the_table() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/calibration/house1995_4340_shots.csv");
+    let shots =
+        meshless_impact::calibrate::read_shots(&path, &Scene::builtin("taylor").unwrap()).unwrap();
+    let rows = meshless_impact::Table1Row::all();
+    assert_eq!(shots.len(), rows.len());
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+    for (s, r) in shots.iter().zip(&rows) {
+        assert_eq!(s.label, format!("test{}", r.test));
+        let setting = |n: &str| s.settings.iter().find(|(k, _)| k == n).unwrap().1;
+        let measured = |n: &str| s.observed.iter().find(|m| m.name == n).unwrap().value;
+        assert!(close(setting("impact_speed"), r.v) && close(setting("initial_length"), r.l0));
+        assert!(close(setting("initial_diameter"), r.d0));
+        assert!(close(measured("rod_length"), r.lf_test));
+        assert!(
+            close(measured("mushroom_radius"), 0.5 * r.df_test),
+            "{}",
+            s.label
+        );
+    }
+}
