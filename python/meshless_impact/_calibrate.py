@@ -31,7 +31,7 @@ def calibrate(
     coarse: Optional[Tuple[str, float]] = None,
     fd_step: float = 0.01,
     xtol: float = 1e-3,
-    leave_one_out: bool = False,
+    leave_one_out: Optional[str] = None,
     method: str = "broyden",
     out: Optional[PathLike] = None,
 ) -> Dict[str, Any]:
@@ -46,8 +46,8 @@ def calibrate(
     line's ``--preset``, ``--strength``, ``--eos``, ``--scheme``,
     ``--preset-file`` and ``--set``; ``max_runs``, ``max_wall`` (s),
     ``coarse`` (``(name, value)``), ``fd_step``, ``xtol``, ``method``
-    (``"broyden"`` or ``"plain"``) and ``leave_one_out`` its options of the
-    same names.
+    (``"broyden"`` or ``"plain"``) and ``leave_one_out`` (``None``,
+    ``"linearised"`` or ``"refit"``) its options of the same names.
 
     Returns the fields of ``calibration.json`` as a dict: ``parameters``,
     ``std`` (``None`` where the data do not constrain a parameter),

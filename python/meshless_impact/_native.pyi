@@ -139,7 +139,7 @@ def calibrate(
     coarse: Optional[Tuple[str, float]] = None,
     fd_step: float = 0.01,
     xtol: float = 1e-3,
-    leave_one_out: bool = False,
+    leave_one_out: Optional[str] = None,
     method: str = "broyden",
     params: Optional[Dict[str, Union[float, str]]] = None,
 ) -> Tuple[str, str]:

@@ -5,7 +5,7 @@
 //! the package's `_calibrate.py` makes them a dict with numpy arrays.
 
 use super::{Choices, build_scene, guard, kwargs, raise};
-use meshless_impact::calibrate::{Calibration, Free, Options, read_shots};
+use meshless_impact::calibrate::{Calibration, Free, LeaveOneOutMethod, Options, read_shots};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -14,7 +14,7 @@ use pyo3::types::PyDict;
 #[pyfunction]
 #[pyo3(signature = (scene, shots, free, *, preset=None, strength=None, eos=None, scheme=None,
     preset_file=None, max_runs=400, max_wall=3600.0, coarse=None, fd_step=0.01, xtol=1e-3,
-    leave_one_out=false, method="broyden".to_string(), params=None))]
+    leave_one_out=None, method="broyden".to_string(), params=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn calibrate(
     py: Python<'_>,
@@ -31,7 +31,7 @@ pub(crate) fn calibrate(
     coarse: Option<(String, f64)>,
     fd_step: f64,
     xtol: f64,
-    leave_one_out: bool,
+    leave_one_out: Option<String>,
     method: String,
     params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(String, String)> {
@@ -68,7 +68,10 @@ pub(crate) fn calibrate(
                         });
                     }
                 },
-                leave_one_out,
+                leave_one_out: leave_one_out
+                    .as_deref()
+                    .map(LeaveOneOutMethod::named)
+                    .transpose()?,
             };
             Calibration::new(scene, free, shots, options)
         })()

@@ -23,7 +23,7 @@ def shots(tmp_path_factory):
     for k, (v, length) in enumerate(SHOTS):
         sim = mi.Simulation("taylor", impact_speed=v, initial_length=length, **COARSE, **TRUTH)
         sim.run()
-        o = sim.observables
+        o = sim.observables()
         lines.append(f"s{k},{v!r},{length!r},{o['rod_length']!r},{o['mushroom_radius']!r}")
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -55,7 +55,7 @@ def test_the_material_runs_as_it_was_fitted(shots, tmp_path):
     sim = mi.Simulation("taylor", preset_file=tmp_path / "material.toml", **COARSE, **e["settings"])
     sim.run()
     for name, value in e["fitted"].items():
-        assert sim.observables[name] == value
+        assert sim.observables()[name] == value
 
 
 def test_bad_input_raises_by_name(shots, tmp_path):

@@ -342,6 +342,12 @@ fn broyden(j: &mut Mat, d: &[f64], rt: &[f64], r: &[f64]) {
     }
 }
 
+/// The Gauss-Newton step at `x` (the Levenberg-Marquardt step with a
+/// vanishing damping), cut back into the box.
+pub fn gauss_newton_step(j: &Mat, r: &[f64], x: &[f64], bounds: &[(f64, f64)]) -> Vec<f64> {
+    lm_step(j, r, 1e-9, x, bounds)
+}
+
 /// The scale of a parameter: its value's magnitude (its bound's width at
 /// 0). Steps and tolerances are relative to it, and the step is solved for
 /// in parameters divided by it, so that constants of different units (a

@@ -131,9 +131,8 @@ pub struct Options {
     /// differences at every accepted point (`false`).
     pub broyden: bool,
     /// After the fit, predict each experiment from the constants fitted to
-    /// the others (each such fit starts from the whole fit's answer and
-    /// Jacobian; its runs are counted apart, under the same caps).
-    pub leave_one_out: bool,
+    /// the others, by the method given (its runs are counted apart).
+    pub leave_one_out: Option<LeaveOneOutMethod>,
 }
 
 impl Default for Options {
@@ -145,7 +144,7 @@ impl Default for Options {
             fd_step: 0.01,
             xtol: 1e-3,
             broyden: true,
-            leave_one_out: false,
+            leave_one_out: None,
         }
     }
 }
@@ -287,9 +286,44 @@ pub struct CalibrationResult {
     pub leave_one_out: Option<LeaveOneOut>,
 }
 
+/// How the constants fitted to all experiments but one are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LeaveOneOutMethod {
+    /// One Gauss-Newton step from the whole fit's answer with its Jacobian
+    /// less the experiment's rows: the linearised refit, no runs.
+    Linearised,
+    /// The search from the whole fit's answer, to its first small step.
+    Refit,
+}
+
+impl LeaveOneOutMethod {
+    /// Its name (`linearised`, `refit`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LeaveOneOutMethod::Linearised => "linearised",
+            LeaveOneOutMethod::Refit => "refit",
+        }
+    }
+
+    /// The method called `name`.
+    pub fn named(name: &str) -> Result<Self> {
+        match name {
+            "linearised" => Ok(LeaveOneOutMethod::Linearised),
+            "refit" => Ok(LeaveOneOutMethod::Refit),
+            other => Err(Error::UnknownModel {
+                key: "leave_one_out".into(),
+                name: other.into(),
+                allowed: "linearised, refit".into(),
+            }),
+        }
+    }
+}
+
 /// Each experiment predicted from the constants fitted to the others.
 #[derive(Debug, Clone)]
 pub struct LeaveOneOut {
+    /// How the constants were found.
+    pub method: LeaveOneOutMethod,
     /// Per experiment: the constants fitted without it, and its predicted
     /// values (`Err` with the error's message where a run failed).
     pub predictions: Vec<std::result::Result<(Vec<f64>, ShotValues), String>>,
@@ -590,20 +624,23 @@ impl Calibration {
                 .collect(),
             options: self.options.clone(),
             material_toml: at_fit.material_toml(),
-            leave_one_out: if self.options.leave_one_out {
-                Some(self.leave_one_out(&out.x, &out.j, &out.r, &bounds, &opts))
-            } else {
-                None
-            },
+            leave_one_out: self
+                .options
+                .leave_one_out
+                .map(|m| self.leave_one_out(m, &out.x, &out.j, &out.r, &bounds, &opts)),
         })
     }
 
-    /// Each experiment predicted from the constants fitted to the others:
-    /// each fit starts at the whole fit's answer `x` with its Jacobian `j`
-    /// and residuals `r` less the experiment's rows, and ends at the first
-    /// small step (no fresh Jacobian: only the constants are wanted).
+    /// Each experiment predicted from the constants fitted to the others.
+    /// Each such fit starts at the whole fit's answer `x` with its Jacobian
+    /// `j` and residuals `r` less the experiment's rows: linearised, it is
+    /// one Gauss-Newton step from there (no runs); refitted, the search
+    /// goes on to its first small step (no fresh Jacobian: only the
+    /// constants are wanted). The experiments are then run at their
+    /// constants in one parallel batch.
     fn leave_one_out(
         &self,
+        method: LeaveOneOutMethod,
         x: &[f64],
         j: &linalg::Mat,
         r: &[f64],
@@ -612,7 +649,7 @@ impl Calibration {
     ) -> LeaveOneOut {
         let clock = Instant::now();
         let mut runs = 0;
-        let mut predictions = Vec::new();
+        let mut constants = Vec::new();
         let mut first_row = 0;
         for (k, left) in self.shots.iter().enumerate() {
             let rows = left.measurements();
@@ -620,9 +657,6 @@ impl Calibration {
                 .filter(|i| !(first_row..first_row + rows).contains(i))
                 .collect();
             first_row += rows;
-            let mut sub = self.clone();
-            sub.shots.remove(k);
-            sub.options.leave_one_out = false;
             let mut jk = linalg::Mat::zeros(keep.len(), x.len());
             for (a, &i) in keep.iter().enumerate() {
                 for b in 0..x.len() {
@@ -630,23 +664,44 @@ impl Calibration {
                 }
             }
             let rk: Vec<f64> = keep.iter().map(|&i| r[i]).collect();
-            let book = Book::new();
-            let mut eval = |pts: &[Vec<f64>]| sub.residuals(pts, Level::Fine, &book, &|_| {});
-            let sub_opts = lsq::Options {
-                fresh_at_end: false,
-                ..*opts
-            };
-            let out = lsq::minimise(x, rk, Some(jk), bounds, &sub_opts, &mut eval, &mut |_| {});
-            runs += book.runs.load(Ordering::SeqCst) + 1;
-            predictions.push(
-                self.run_shot(left, &out.x, Level::Fine, &book)
-                    .map(|v| (out.x.clone(), v))
-                    .map_err(|e| e.to_string()),
-            );
+            constants.push(match method {
+                LeaveOneOutMethod::Linearised => {
+                    let step = lsq::gauss_newton_step(&jk, &rk, x, bounds);
+                    x.iter().zip(&step).map(|(x, d)| x + d).collect::<Vec<f64>>()
+                }
+                LeaveOneOutMethod::Refit => {
+                    let mut sub = self.clone();
+                    sub.shots.remove(k);
+                    sub.options.leave_one_out = None;
+                    let book = Book::new();
+                    let mut eval =
+                        |pts: &[Vec<f64>]| sub.residuals(pts, Level::Fine, &book, &|_| {});
+                    let sub_opts = lsq::Options {
+                        fresh_at_end: false,
+                        ..*opts
+                    };
+                    let out =
+                        lsq::minimise(x, rk, Some(jk), bounds, &sub_opts, &mut eval, &mut |_| {});
+                    runs += book.runs.load(Ordering::SeqCst);
+                    out.x
+                }
+            });
         }
+        let book = Book::new();
+        let predictions: Vec<_> = self
+            .shots
+            .par_iter()
+            .zip(constants)
+            .map(|(shot, xk)| {
+                self.run_shot(shot, &xk, Level::Fine, &book)
+                    .map(|v| (xk, v))
+                    .map_err(|e| e.to_string())
+            })
+            .collect();
         LeaveOneOut {
+            method,
             predictions,
-            runs,
+            runs: runs + self.shots.len(),
             wall_time_s: clock.elapsed().as_secs_f64(),
         }
     }
@@ -1027,6 +1082,11 @@ impl CalibrationResult {
                 Err(e) => json!({ "shot": shot.label, "error": e }),
             })
             .collect();
-        json!({ "experiments": experiments, "runs": l.runs, "wall_time_s": l.wall_time_s })
+        json!({
+            "method": l.method.name(),
+            "experiments": experiments,
+            "runs": l.runs,
+            "wall_time_s": l.wall_time_s,
+        })
     }
 }

@@ -230,9 +230,13 @@ pub(crate) struct CalibrateArgs {
     #[arg(long, value_name = "METHOD", default_value = "broyden", value_parser = ["broyden", "plain"])]
     pub(crate) method: String,
     /// After the fit, predict each experiment from the constants fitted to
-    /// the others (cross-validation; its runs are counted apart).
-    #[arg(long)]
-    pub(crate) leave_one_out: bool,
+    /// the others (cross-validation; its runs are counted apart):
+    /// `linearised` (the default: one Gauss-Newton step from the whole
+    /// fit's answer, then one run per experiment) or `refit` (the search
+    /// from there for each experiment left out).
+    #[arg(long, value_name = "METHOD", num_args = 0..=1, default_missing_value = "linearised",
+          value_parser = ["linearised", "refit"])]
+    pub(crate) leave_one_out: Option<String>,
     /// No progress bar and no iteration lines (the summary is printed).
     #[arg(long, short)]
     pub(crate) quiet: bool,

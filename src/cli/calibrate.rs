@@ -8,7 +8,7 @@ use super::output::{check_output_dir, check_output_file, write_json};
 use super::stop::{Stop, outcome, outln};
 use indicatif::{ProgressBar, ProgressStyle};
 use meshless_impact::calibrate::{
-    Calibration, CalibrationResult, Event, Free, Options, Outcome, read_shots,
+    Calibration, CalibrationResult, Event, Free, LeaveOneOutMethod, Options, Outcome, read_shots,
 };
 use meshless_impact::{Error, Scene};
 use std::io::{IsTerminal, Write};
@@ -55,7 +55,11 @@ pub(crate) fn calibrate(a: CalibrateArgs) -> Result<(), Stop> {
         fd_step: a.fd_step,
         xtol: a.xtol,
         broyden: a.method == "broyden",
-        leave_one_out: a.leave_one_out,
+        leave_one_out: a
+            .leave_one_out
+            .as_deref()
+            .map(LeaveOneOutMethod::named)
+            .transpose()?,
     };
     let problem = Calibration::new(scene, free, shots, options)?;
     for file in ["calibration.json", "material.toml", "fit.svg"] {
@@ -291,7 +295,8 @@ fn summary(r: &CalibrationResult, out: &Path) -> Result<(), Stop> {
     }
     if let Some(l) = &r.leave_one_out {
         outln!(
-            "leave-one-out: {} forward runs, {:.1} s{}",
+            "leave-one-out ({}): {} forward runs, {:.1} s{}",
+            l.method.name(),
             l.runs,
             l.wall_time_s,
             match l.predictions.iter().filter(|p| p.is_err()).count() {
