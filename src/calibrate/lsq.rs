@@ -19,6 +19,39 @@ pub enum Cap {
     Wall,
 }
 
+/// What a batch of runs is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Purpose {
+    /// The experiments at a starting point.
+    Start,
+    /// A finite-difference Jacobian's directions.
+    Jacobian,
+    /// A trial point of the search.
+    Trial,
+    /// The leave-one-out predictions.
+    LeaveOneOut,
+}
+
+impl Purpose {
+    /// Every purpose, in the order the result lists them.
+    pub const ALL: [Purpose; 4] = [
+        Purpose::Start,
+        Purpose::Jacobian,
+        Purpose::Trial,
+        Purpose::LeaveOneOut,
+    ];
+
+    /// Its name in `calibration.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Purpose::Start => "start",
+            Purpose::Jacobian => "jacobian",
+            Purpose::Trial => "trial",
+            Purpose::LeaveOneOut => "leave_one_out",
+        }
+    }
+}
+
 /// The answer of an evaluator for one batch: a residual vector per point,
 /// `None` where the point's runs failed (a named error of the solver), or
 /// the cap that stopped the batch.
@@ -131,7 +164,7 @@ pub fn minimise(
     j0: Option<Mat>,
     bounds: &[(f64, f64)],
     opts: &Options,
-    eval: &mut dyn FnMut(&[Vec<f64>]) -> Batch,
+    eval: &mut dyn FnMut(&[Vec<f64>], Purpose) -> Batch,
     hook: &mut dyn FnMut(&Iteration),
 ) -> Outcome {
     let mut s = State {
@@ -189,7 +222,7 @@ pub fn minimise(
         }
         let step = lm_step(&s.j, &s.r, lambda, &s.x, bounds);
         let trial: Vec<f64> = s.x.iter().zip(&step).map(|(x, d)| x + d).collect();
-        let result = match eval(std::slice::from_ref(&trial)) {
+        let result = match eval(std::slice::from_ref(&trial), Purpose::Trial) {
             Ok(mut v) => v.pop().flatten(),
             Err(cap) => return finish(s, Stop::Capped(cap), iterations),
         };
@@ -283,7 +316,7 @@ fn refresh(
     s: &mut State,
     bounds: &[(f64, f64)],
     opts: &Options,
-    eval: &mut dyn FnMut(&[Vec<f64>]) -> Batch,
+    eval: &mut dyn FnMut(&[Vec<f64>], Purpose) -> Batch,
 ) -> std::result::Result<(), Cap> {
     let p = s.x.len();
     let deltas: Vec<f64> = (0..p)
@@ -295,7 +328,7 @@ fn refresh(
         x
     };
     let points: Vec<Vec<f64>> = (0..p).map(|k| shifted(k, deltas[k])).collect();
-    let results = eval(&points)?;
+    let results = eval(&points, Purpose::Jacobian)?;
     let mut j = Mat::zeros(s.r.len(), p);
     for (k, res) in results.into_iter().enumerate() {
         let (res, d) = match res {
@@ -305,7 +338,9 @@ fn refresh(
                 let back = -deltas[k];
                 let inside = (bounds[k].0..=bounds[k].1).contains(&(s.x[k] + back));
                 let again = if inside {
-                    eval(&[shifted(k, back)])?.pop().flatten()
+                    eval(&[shifted(k, back)], Purpose::Jacobian)?
+                        .pop()
+                        .flatten()
                 } else {
                     None
                 };
@@ -428,7 +463,7 @@ mod tests {
         cap: usize,
     ) -> (Outcome, usize) {
         let mut calls = 0;
-        let mut eval = |pts: &[Vec<f64>]| -> Batch {
+        let mut eval = |pts: &[Vec<f64>], _: Purpose| -> Batch {
             calls += pts.len();
             if calls > cap {
                 return Err(Cap::Runs);

@@ -267,6 +267,11 @@ pub struct CalibrationResult {
     pub iterations: Vec<IterationRecord>,
     /// Wall time (s).
     pub wall_time_s: f64,
+    /// Where the runs and the wall time went: per purpose (`start`,
+    /// `jacobian`, `trial`), its forward runs and the wall time (s) of their
+    /// batches; the rest of `wall_time_s` is the fit's own arithmetic and
+    /// bookkeeping.
+    pub spent: Vec<(&'static str, usize, f64)>,
     /// How it ended.
     pub outcome: Outcome,
     /// Whether the uncertainty's Jacobian was taken at the optimum by
@@ -453,7 +458,13 @@ impl Calibration {
         let book = Book::new();
         let x0 = self.start();
         on_event(&Event::Stage("fine".into()));
-        let before = match self.evaluate(std::slice::from_ref(&x0), Level::Fine, &book, on_event) {
+        let before = match self.evaluate(
+            std::slice::from_ref(&x0),
+            Level::Fine,
+            lsq::Purpose::Start,
+            &book,
+            on_event,
+        ) {
             Ok(mut v) => v.pop().expect("one point"),
             Err(cap) => {
                 return Err(Error::Inconsistent(
@@ -514,7 +525,13 @@ impl Calibration {
         let mut capped = None;
         if let Some((name, v)) = &self.options.coarse {
             on_event(&Event::Stage(format!("coarse ({name} = {v})")));
-            let r0 = self.evaluate(std::slice::from_ref(&x0), Level::Coarse, &book, on_event);
+            let r0 = self.evaluate(
+                std::slice::from_ref(&x0),
+                Level::Coarse,
+                lsq::Purpose::Start,
+                &book,
+                on_event,
+            );
             match r0.map(|mut v| v.pop().expect("one point")) {
                 Ok(Ok((r0, _))) => {
                     let coarse_opts = lsq::Options {
@@ -522,8 +539,9 @@ impl Calibration {
                         fresh_at_end: false,
                         ..opts
                     };
-                    let mut eval =
-                        |pts: &[Vec<f64>]| self.residuals(pts, Level::Coarse, &book, on_event);
+                    let mut eval = |pts: &[Vec<f64>], why| {
+                        self.residuals(pts, Level::Coarse, why, &book, on_event)
+                    };
                     let mut hook = hook_for("coarse");
                     let out =
                         lsq::minimise(&x0, r0, None, &bounds, &coarse_opts, &mut eval, &mut hook);
@@ -536,6 +554,7 @@ impl Calibration {
                         match self.evaluate(
                             std::slice::from_ref(&out.x),
                             Level::Fine,
+                            lsq::Purpose::Start,
                             &book,
                             on_event,
                         ) {
@@ -567,7 +586,8 @@ impl Calibration {
                 failed_points: 0,
             },
             None => {
-                let mut eval = |pts: &[Vec<f64>]| self.residuals(pts, Level::Fine, &book, on_event);
+                let mut eval =
+                    |pts: &[Vec<f64>], why| self.residuals(pts, Level::Fine, why, &book, on_event);
                 let mut hook = hook_for("fine");
                 lsq::minimise(&xs, rs, js, &bounds, &opts, &mut eval, &mut hook)
             }
@@ -594,6 +614,7 @@ impl Calibration {
         for (f, v) in self.free.iter().zip(&out.x) {
             at_fit.set(&f.name, *v)?;
         }
+        let spent = book.spent();
         let failures = book.failures.into_inner().expect("no panics hold it");
         let failed_runs = failures.iter().map(|(_, n)| n).sum();
         let iterations = iterations_cell.into_inner().expect("no panics hold it");
@@ -617,6 +638,7 @@ impl Calibration {
             failures,
             iterations,
             wall_time_s: clock.elapsed().as_secs_f64(),
+            spent,
             outcome,
             jacobian_at_optimum: out.j_fresh,
             jacobian: (0..out.j.rows)
@@ -667,15 +689,19 @@ impl Calibration {
             constants.push(match method {
                 LeaveOneOutMethod::Linearised => {
                     let step = lsq::gauss_newton_step(&jk, &rk, x, bounds);
-                    x.iter().zip(&step).map(|(x, d)| x + d).collect::<Vec<f64>>()
+                    x.iter()
+                        .zip(&step)
+                        .map(|(x, d)| x + d)
+                        .collect::<Vec<f64>>()
                 }
                 LeaveOneOutMethod::Refit => {
                     let mut sub = self.clone();
                     sub.shots.remove(k);
                     sub.options.leave_one_out = None;
                     let book = Book::new();
-                    let mut eval =
-                        |pts: &[Vec<f64>]| sub.residuals(pts, Level::Fine, &book, &|_| {});
+                    let mut eval = |pts: &[Vec<f64>], why| {
+                        sub.residuals(pts, Level::Fine, why, &book, &|_| {})
+                    };
                     let sub_opts = lsq::Options {
                         fresh_at_end: false,
                         ..*opts
@@ -711,11 +737,12 @@ impl Calibration {
         &self,
         points: &[Vec<f64>],
         level: Level,
+        purpose: lsq::Purpose,
         book: &Book,
         on_event: &(dyn Fn(&Event) + Sync),
     ) -> lsq::Batch {
         Ok(self
-            .evaluate(points, level, book, on_event)?
+            .evaluate(points, level, purpose, book, on_event)?
             .into_iter()
             .map(|r| r.ok().map(|(r, _)| r))
             .collect())
@@ -729,6 +756,7 @@ impl Calibration {
         &self,
         points: &[Vec<f64>],
         level: Level,
+        purpose: lsq::Purpose,
         book: &Book,
         on_event: &(dyn Fn(&Event) + Sync),
     ) -> std::result::Result<
@@ -747,6 +775,7 @@ impl Calibration {
             book.runs_coarse.fetch_add(n, Ordering::SeqCst);
         }
         on_event(&Event::Batch { runs: n });
+        let batch_clock = Instant::now();
         let ns = self.shots.len();
         let results: Vec<Result<ShotValues>> = (0..n)
             .into_par_iter()
@@ -757,6 +786,7 @@ impl Calibration {
                 r
             })
             .collect();
+        book.tally(purpose, n, batch_clock.elapsed().as_secs_f64());
         if results
             .iter()
             .any(|r| matches!(r, Err(Error::Cancelled { .. })))
@@ -864,6 +894,8 @@ struct Book {
     #[allow(clippy::type_complexity)]
     fine: Mutex<Vec<(Vec<f64>, Vec<ShotValues>)>>,
     clock: Instant,
+    /// Runs and wall time (s) of the batches, by purpose.
+    spent: Mutex<Vec<(lsq::Purpose, usize, f64)>>,
 }
 
 impl Book {
@@ -874,7 +906,30 @@ impl Book {
             failures: Mutex::new(Vec::new()),
             fine: Mutex::new(Vec::new()),
             clock: Instant::now(),
+            spent: Mutex::new(Vec::new()),
         }
+    }
+
+    /// Books a batch of `runs` that took `wall` seconds, for `purpose`.
+    fn tally(&self, purpose: lsq::Purpose, runs: usize, wall: f64) {
+        let mut spent = self.spent.lock().expect("no panics hold it");
+        match spent.iter_mut().find(|(p, _, _)| *p == purpose) {
+            Some((_, n, w)) => {
+                *n += runs;
+                *w += wall;
+            }
+            None => spent.push((purpose, runs, wall)),
+        }
+    }
+
+    /// What was booked, in [`lsq::Purpose::ALL`]'s order.
+    fn spent(&self) -> Vec<(&'static str, usize, f64)> {
+        let spent = self.spent.lock().expect("no panics hold it");
+        lsq::Purpose::ALL
+            .iter()
+            .filter_map(|p| spent.iter().find(|(q, _, _)| q == p))
+            .map(|(p, n, w)| (p.name(), *n, *w))
+            .collect()
     }
 }
 
@@ -1038,6 +1093,12 @@ impl CalibrationResult {
             "failures": Value::Object(self.failures.iter().map(|(n, k)| (n.clone(), json!(k))).collect()),
             "iterations": iterations,
             "wall_time_s": self.wall_time_s,
+            "spent": Value::Object(
+                self.spent
+                    .iter()
+                    .map(|(p, n, w)| (p.to_string(), json!({ "runs": n, "wall_time_s": w })))
+                    .collect()
+            ),
             "max_runs": self.options.max_runs,
             "max_wall_s": self.options.max_wall_s,
             "coarse": self.options.coarse.as_ref().map(|(n, v)| json!({ n.clone(): v })),
