@@ -176,7 +176,25 @@ fn printing_commands(dir: &Path) -> Vec<Vec<String>> {
     let mut sweep = strings(&SMALL_SWEEP);
     sweep.push("--out".into());
     sweep.push(dir.join("sweep.csv").display().to_string());
+    // A one-constant fit on one coarse shot (test 7's final length).
+    std::fs::create_dir_all(dir).unwrap();
+    let shots = dir.join("shots.csv");
+    std::fs::write(&shots, "impact_speed,rod_length\n181,0.0346\n").unwrap();
+    let shots = shots.display().to_string();
+    let fit = dir.join("fit").display().to_string();
     vec![
+        strings(&[
+            "calibrate",
+            "taylor",
+            "--shots",
+            &shots,
+            "--free",
+            "jc_a=600e6:1200e6",
+            "--set",
+            "particles_radial=6",
+            "--out",
+            &fit,
+        ]),
         strings(&["params", "taylor"]),
         strings(&["observables", "taylor"]),
         strings(&["scene", "taylor"]),
