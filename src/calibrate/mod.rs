@@ -9,7 +9,7 @@
 //!   `(simulated - measured) / measured`, each weighted by its relative
 //!   uncertainty (`sigma / |measured|`; [`DEFAULT_RELATIVE_SIGMA`] where the
 //!   file gives none), by Levenberg-Marquardt on a finite-difference
-//!   Jacobian that Broyden's updates carry between trial points ([`lsq`];
+//!   Jacobian that Broyden's updates carry between trial points (`lsq.rs`;
 //!   docs/guide/calibration.md compares it with the plain method).
 //! - Forward runs go in parallel over the experiments and over the
 //!   directions of a finite-difference step; a coarser resolution may go
@@ -17,7 +17,7 @@
 //! - A trial point whose run stops with a named error is a step that
 //!   failed; the fit is bounded by a cap on forward runs and on wall time.
 //! - The uncertainty comes from the Jacobian at the optimum scaled by the
-//!   residual ([`stats`]).
+//!   residual (`stats.rs`).
 
 mod linalg;
 mod lsq;
