@@ -62,7 +62,10 @@ pub(crate) fn calibrate(a: CalibrateArgs) -> Result<(), Stop> {
             .transpose()?,
     };
     let problem = Calibration::new(scene, free, shots, options)?;
-    for file in ["calibration.json", "material.toml", "fit.svg"] {
+    for file in ["calibration.json", "material.toml"]
+        .into_iter()
+        .chain(cfg!(feature = "report").then_some("fit.svg"))
+    {
         check_output_dir("--out", &a.out, file)?;
         check_output_file("--out", &a.out.join(file))?;
     }
@@ -315,10 +318,18 @@ fn summary(r: &CalibrationResult, out: &Path) -> Result<(), Stop> {
         r.failed_points,
         r.wall_time_s
     )?;
-    outln!(
-        "written: {0}/calibration.json, {0}/material.toml, {0}/fit.svg",
-        out.display()
-    )
+    if cfg!(feature = "report") {
+        outln!(
+            "written: {0}/calibration.json, {0}/material.toml, {0}/fit.svg",
+            out.display()
+        )
+    } else {
+        outln!(
+            "written: {0}/calibration.json, {0}/material.toml (no fit.svg: this program was built \
+             without the `report` feature, which plots)",
+            out.display()
+        )
+    }
 }
 
 /// `fit.svg`: measured against simulated (before and fitted) for each
@@ -397,11 +408,8 @@ fn figure(path: &Path, r: &CalibrationResult) -> Result<(), Error> {
 }
 
 /// Without the `report` feature there is no plotting: `fit.svg` is not
-/// written, and the program says so.
+/// written, and the summary says so (the fit's own outputs are whole).
 #[cfg(not(feature = "report"))]
-fn figure(path: &Path, _r: &CalibrationResult) -> Result<(), Error> {
-    Err(Error::io(
-        path,
-        "not written: this program was built without the `report` feature (plotting)",
-    ))
+fn figure(_path: &Path, _r: &CalibrationResult) -> Result<(), Error> {
+    Ok(())
 }
