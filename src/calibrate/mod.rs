@@ -128,8 +128,9 @@ pub struct Options {
     /// Finite-difference step, relative to a parameter's value.
     pub fd_step: f64,
     /// Converged when a step moves each parameter by less than this
-    /// fraction of its value, or when the whole Gauss-Newton step is
-    /// shorter than a tenth of a standard error (`STD_FRACTION`).
+    /// fraction of its value, or by less than a tenth of its standard error
+    /// (`STD_FRACTION`) while it would lower the objective by less than the
+    /// residual's scale.
     pub xtol: f64,
     /// The method: Levenberg-Marquardt with the Jacobian carried by
     /// Broyden's updates (`true`, the default) or taken afresh by finite

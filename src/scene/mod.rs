@@ -1007,7 +1007,14 @@ mod tests {
                 "[material]\npreset = \"tungsten_seed\"\nstrength = \"johnson_cook\"\n",
                 "contradicts",
             ),
-            ("[material]\nmodel = \"bilinear\"\n", "unknown field"),
+            (
+                "[material]\nmodel = \"bilinear\"\n",
+                "`model` is not a constant of the material of scene `taylor`; allowed: strength, eos, preset, density",
+            ),
+            (
+                "[material]\njc_a = \"hard\"\n",
+                "`jc_a`: cannot parse `hard`",
+            ),
         ] {
             let e = Scene::from_toml_str(&format!("scene = \"taylor\"\n{text}"))
                 .unwrap_err()
