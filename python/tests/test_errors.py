@@ -13,7 +13,7 @@ from meshless_impact import errors
 from conftest import PLAIN, cli_error, cli_run
 
 INPUT = {"OutOfRange", "UnknownParameter", "UnknownScene", "UnknownModel", "ParseValue", "Inconsistent",
-         "SceneFile", "InvalidState"}
+         "SceneFile", "ShotsFile", "InvalidState"}
 STOPS = {"SingularMomentMatrix", "NonFinite", "ThroughBoundary", "TimeStepCollapse", "EnergyDrift",
          "SpacingCollapse", "CompressionLimit"}
 
