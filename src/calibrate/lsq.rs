@@ -424,17 +424,24 @@ fn lm_step(j: &Mat, r: &[f64], lambda: f64, x: &[f64], bounds: &[(f64, f64)]) ->
 /// small.
 pub const STD_FRACTION: f64 = 0.1;
 
+/// The fraction of the residual's scale `s^2` below which a step's
+/// predicted gain counts as small: a quarter, a step half a standard error
+/// long in the metric of the covariance.
+pub const GAIN_FRACTION: f64 = 0.25;
+
 /// Whether the search has converged at the current point: every component
 /// of `step` is below `xtol` of its parameter's [`scale`]; or every
 /// component is below [`STD_FRACTION`] of its parameter's standard error
 /// (as the current Jacobian and residuals give it) *and* the step would
-/// lower the objective by less than the residual's scale `s^2` (the
-/// objective over the degrees of freedom: what one measurement's noise
-/// weighs). Further steps would then move the answer far less than the
+/// lower the objective by less than [`GAIN_FRACTION`] of the residual's
+/// scale `s^2` (the objective over the degrees of freedom: what one
+/// measurement's noise weighs). Further steps would then move the answer far less than the
 /// data determine it, and improve the fit by less than their noise. The
 /// second condition keeps a fit from stopping far from its optimum, where
 /// the misfit inflates the standard errors (a one-speed fit stopped at its
-/// start without it, 2026-11-29); the bound on the undamped Gauss-Newton
+/// start without it, 2026-11-29; with the whole of `s^2` as the bound, a
+/// fit with one degree of freedom stopped at its second step, since then
+/// no step can gain more than `s^2`); the bound on the undamped Gauss-Newton
 /// step's reduction alone was tried and is not enough (on Table 1 it
 /// stopped at an objective of 61.2 that damped steps took on to 50.7: the
 /// linear model is poor there).
@@ -454,7 +461,7 @@ fn is_small(step: &[f64], s: &State, bounds: &[(f64, f64)], xtol: f64) -> bool {
         let dof = s.r.len().saturating_sub(s.x.len());
         let f = objective(&s.r);
         let predicted = f - objective(&add(&s.r, &s.j.times(step)));
-        by_std && dof > 0 && predicted <= f / dof as f64
+        by_std && dof > 0 && predicted <= GAIN_FRACTION * f / dof as f64
     }
 }
 

@@ -25,7 +25,7 @@ mod result;
 mod shots;
 mod stats;
 
-pub use lsq::STD_FRACTION;
+pub use lsq::{GAIN_FRACTION, STD_FRACTION};
 pub use result::{
     CalibrationResult, IterationRecord, LeaveOneOut, LeaveOneOutMethod, METHOD, METHOD_PLAIN,
     Outcome, ShotValues, UNCERTAINTY,
@@ -129,8 +129,8 @@ pub struct Options {
     pub fd_step: f64,
     /// Converged when a step moves each parameter by less than this
     /// fraction of its value, or by less than a tenth of its standard error
-    /// (`STD_FRACTION`) while it would lower the objective by less than the
-    /// residual's scale.
+    /// (`STD_FRACTION`) while it would lower the objective by less than a
+    /// quarter of the residual's scale (`GAIN_FRACTION`).
     pub xtol: f64,
     /// The method: Levenberg-Marquardt with the Jacobian carried by
     /// Broyden's updates (`true`, the default) or taken afresh by finite

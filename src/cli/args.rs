@@ -222,7 +222,8 @@ pub(crate) struct CalibrateArgs {
     pub(crate) fd_step: f64,
     /// Converged when a step moves each parameter by less than this
     /// fraction of its value, or by less than a tenth of its standard error
-    /// while it would lower the objective by less than the residual's scale.
+    /// while it would lower the objective by less than a quarter of the
+    /// residual's scale.
     #[arg(long, value_name = "FRACTION", default_value_t = 1e-3)]
     pub(crate) xtol: f64,
     /// The method: `broyden` (the default: the finite-difference Jacobian
