@@ -413,3 +413,22 @@ fn an_outline_is_fitted_as_well() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A fit gives the same bits on one thread and on two: its runs are
+/// batches on the thread pool, collected in order.
+#[test]
+fn a_fit_is_the_same_on_one_thread_and_two() {
+    let scene = base();
+    let csv = twin_csv(&TRUTH, &SHOTS);
+    let shots = parse_shots(&csv, Path::new("twin.csv"), &scene).unwrap();
+    let fit = Calibration::new(scene.clone(), free(&scene), shots, Options::default()).unwrap();
+    crate::common::same_on_one_thread_and_two(|| {
+        let r = fit.run(&|_| {}).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        (
+            bits(&r.parameters),
+            r.fitted.iter().map(|v| bits(&v.values)).collect::<Vec<_>>(),
+            r.runs,
+        )
+    });
+}
