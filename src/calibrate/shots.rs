@@ -181,6 +181,18 @@ pub fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Vec<Shot>> {
             }
             Ok(v)
         };
+        // An uncertainty: a finite positive number.
+        let sigma = |c: usize, cell: &str, column: &str| -> Result<f64> {
+            let s = number(c, cell)?;
+            if s <= 0.0 {
+                return Err(fail(
+                    line,
+                    Some(c),
+                    format!("{column} = {cell}: an uncertainty must be positive"),
+                ));
+            }
+            Ok(s)
+        };
         let mut shot = Shot {
             label: format!("line {line}"),
             line,
@@ -227,14 +239,7 @@ pub fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Vec<Shot>> {
                 }
                 Column::Sigma(name) => {
                     if !cell.is_empty() {
-                        let s = number(c, cell)?;
-                        if s <= 0.0 {
-                            return Err(fail(
-                                line,
-                                Some(c),
-                                format!("sigma_{name} = {cell}: an uncertainty must be positive"),
-                            ));
-                        }
+                        let s = sigma(c, cell, &format!("sigma_{name}"))?;
                         sigmas.push((c, name.clone(), s));
                     }
                 }
@@ -251,15 +256,7 @@ pub fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Vec<Shot>> {
                 }
                 Column::OutlineSigma => {
                     if !cell.is_empty() {
-                        let s = number(c, cell)?;
-                        if s <= 0.0 {
-                            return Err(fail(
-                                line,
-                                Some(c),
-                                format!("sigma_outline = {cell}: an uncertainty must be positive"),
-                            ));
-                        }
-                        outline_sigma = Some(s);
+                        outline_sigma = Some(sigma(c, cell, "sigma_outline")?);
                     }
                 }
             }
