@@ -136,3 +136,16 @@ pub fn mean_stress_residual(sim: &Simulation, components: usize) -> (f64, f64) {
     }
     worst
 }
+
+/// The bits of everything a run shows: its clock, every observable, every
+/// particle field and the recorded histories.
+pub fn bits(s: &Simulation) -> Vec<u64> {
+    let mut v = vec![s.time(), s.steps() as f64];
+    v.extend(s.observables());
+    for f in s.field_specs() {
+        v.extend(s.field(f.name).unwrap());
+    }
+    v.extend(&s.history().times);
+    v.extend(&s.history().values);
+    v.iter().map(|x| x.to_bits()).collect()
+}

@@ -24,6 +24,7 @@ mod reference;
 #[cfg(feature = "report")]
 mod report;
 mod state;
+mod state_files;
 mod taylor;
 mod taylor3d;
 mod vtu;

@@ -2,7 +2,7 @@
 //! way a new scene with the same values would be refused; an unedited state
 //! is accepted and resumes (issue: forged saved states are accepted).
 
-use crate::common;
+use crate::common::{self, bits};
 
 use meshless_impact::{Scene, Simulation};
 use serde_json::{Value, json};
@@ -215,19 +215,6 @@ fn a_preset_run_round_trips_and_a_forged_material_is_refused() {
     s["scene"]["material"]["strength"] = json!("plastic");
     let msg = refused(&s);
     assert!(msg.contains("plastic"), "{msg}");
-}
-
-/// The bits of everything a run shows: its clock, every observable, every
-/// particle field and the recorded histories.
-fn bits(s: &Simulation) -> Vec<u64> {
-    let mut v = vec![s.time(), s.steps() as f64];
-    v.extend(s.observables());
-    for f in s.field_specs() {
-        v.extend(s.field(f.name).unwrap());
-    }
-    v.extend(&s.history().times);
-    v.extend(&s.history().values);
-    v.iter().map(|x| x.to_bits()).collect()
 }
 
 /// A `taylor3d` run (3 nodes across the radius) saved mid-way, as JSON

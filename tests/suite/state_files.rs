@@ -1,0 +1,122 @@
+//! Saved states written by earlier builds, committed under
+//! `tests/data/states/` (its README says which build wrote each folder),
+//! load into this build and go on to the bits of a run that was never
+//! interrupted: clock, every observable, every field and the histories.
+//!
+//! `v1/` is the layout of the states saved up to 2026-11-29 (no `format`
+//! key; each solver's fields flat under its kind's key), written at commit
+//! 1e8cb70 by `record_states` below.
+
+use crate::common::bits;
+use meshless_impact::{Scene, Simulation};
+use std::path::{Path, PathBuf};
+
+/// One committed state: the scene it is a run of, the time it was saved
+/// at, and the time the test runs both copies to.
+struct Case {
+    file: &'static str,
+    scene: &'static str,
+    sets: &'static [(&'static str, f64)],
+    saved_at: f64,
+    until: f64,
+}
+
+/// One small run of each solver: axisymmetric MSPH (`taylor`), the Noh
+/// solver, the 3-D MLPG solver (`taylor3d`, and `penetration`: two bodies,
+/// quarter model, the ceramic's damage state) and the plate-impact solver.
+const CASES: &[Case] = &[
+    Case {
+        file: "taylor.json",
+        scene: "taylor",
+        sets: &[("particles_radial", 5.0)],
+        saved_at: 5e-6,
+        until: 12e-6,
+    },
+    Case {
+        file: "noh.json",
+        scene: "noh",
+        sets: &[("particles_radial", 100.0)],
+        saved_at: 0.1,
+        until: 0.2,
+    },
+    Case {
+        file: "taylor3d.json",
+        scene: "taylor3d",
+        sets: &[("particles_radial", 3.0)],
+        saved_at: 10e-6,
+        until: 20e-6,
+    },
+    Case {
+        file: "penetration.json",
+        scene: "penetration",
+        sets: &[
+            ("particles_radial", 3.0),
+            ("symmetry", 1.0),
+            ("plate_diameter", 0.03),
+            ("end_time", 6e-6),
+        ],
+        saved_at: 3e-6,
+        until: 6e-6,
+    },
+    Case {
+        file: "plate_impact.json",
+        scene: "plate_impact",
+        sets: &[],
+        saved_at: 0.5e-6,
+        until: 1.2e-6,
+    },
+];
+
+/// The folder of the states of one layout.
+fn folder(layout: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/states")
+        .join(layout)
+}
+
+/// The scene of a case.
+fn scene(case: &Case) -> Scene {
+    let mut scene = Scene::builtin(case.scene).unwrap();
+    for (k, v) in case.sets {
+        scene.set(k, *v).unwrap();
+    }
+    scene
+}
+
+/// Each state of layout `v1` loads, is the run at its time bit for bit, and
+/// goes on to the bits of the uninterrupted run.
+#[test]
+fn states_of_the_first_layout_load_and_continue_to_the_same_bits() {
+    for case in CASES {
+        let path = folder("v1").join(case.file);
+        let bytes = std::fs::read(&path).unwrap();
+        let mut back = Simulation::deserialize_state(&bytes)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mut whole = Simulation::new(scene(case)).unwrap();
+        whole.advance_to(case.saved_at).unwrap();
+        assert_eq!(bits(&back), bits(&whole), "{}: as saved", case.file);
+        back.advance_to(case.until).unwrap();
+        whole.advance_to(case.until).unwrap();
+        assert!(
+            whole.steps() > 0 && back.time() >= case.until,
+            "{}",
+            case.file
+        );
+        assert_eq!(bits(&back), bits(&whole), "{}: continued", case.file);
+    }
+}
+
+/// Writes the states of [`CASES`] into the folder `MI_RECORD_STATES` (run
+/// once per layout, by hand: `MI_RECORD_STATES=tests/data/states/vN cargo
+/// test --test suite record_states -- --ignored`).
+#[test]
+#[ignore = "writes the committed state files; run by hand for a new layout"]
+fn record_states() {
+    let dir = PathBuf::from(std::env::var("MI_RECORD_STATES").expect("MI_RECORD_STATES"));
+    std::fs::create_dir_all(&dir).unwrap();
+    for case in CASES {
+        let mut sim = Simulation::new(scene(case)).unwrap();
+        sim.advance_to(case.saved_at).unwrap();
+        std::fs::write(dir.join(case.file), sim.serialize_state()).unwrap();
+    }
+}
