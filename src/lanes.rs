@@ -428,7 +428,7 @@ mod tests {
             for l in 0..W {
                 let one: [[f64; 6]; 6] =
                     std::array::from_fn(|r| std::array::from_fn(|c| a[r][c][l]));
-                let want = crate::msph::invert(one).unwrap();
+                let want = crate::approx::msph::invert(one).unwrap();
                 let scale = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
                 for r in 0..6 {
                     for c in 0..6 {
@@ -462,7 +462,7 @@ mod tests {
         let flagged: Vec<usize> = (0..W).filter(|&l| singular[l]).collect();
         assert_eq!(flagged, vec![3, 5]);
         let m = [[2.0, 0.5, 0.5], [0.5, 2.0, 0.5], [0.5, 0.5, 2.0]];
-        let want = crate::msph::invert(m).unwrap();
+        let want = crate::approx::msph::invert(m).unwrap();
         for l in [0, 1, 2, 4, 6, 7] {
             for r in 0..3 {
                 for c in 0..3 {

@@ -68,15 +68,16 @@
 // Index loops over fixed-size arrays read more clearly in numerical kernels.
 #![allow(clippy::needless_range_loop)]
 
+mod approx;
 mod budget;
 pub mod calibrate;
 // Unsafe code is allowed in these places only: the C ABI, the FMI glue and
 // the pointer and panic helpers they share (here), the dispatch to the
 // compiled copies of the hot loops (`hot!` in src/isa.rs), the team of
 // threads sharing disjoint chunks of the axisymmetric step's arrays
-// (src/solver/team.rs, and the chunk sets `named_parts!` declares), the
-// AVX-512 kernels of its pair pass (src/solver/pairs/avx512.rs) and the
-// read of the stepping thread's processor time (src/mlpg/profile.rs).
+// (src/solver/axisymmetric/team.rs, and the chunk sets `named_parts!` declares), the
+// AVX-512 kernels of its pair pass (src/solver/axisymmetric/pairs/avx512.rs) and the
+// read of the stepping thread's processor time (src/solver/mlpg3d/profile.rs).
 #[allow(unsafe_code)]
 mod capi;
 mod error;
@@ -88,9 +89,7 @@ mod isa;
 mod kernel;
 mod lanes;
 mod material;
-mod mlpg;
 mod model;
-mod msph;
 mod neighbours;
 mod observe;
 mod params;
@@ -101,7 +100,6 @@ mod sim;
 mod solver;
 #[cfg(test)]
 mod test_rng;
-mod uniaxial;
 
 pub use budget::{DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_VAR, MemoryPerNode, memory_budget};
 pub use error::{Error, MomentMethod, Result};
@@ -121,7 +119,7 @@ pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
 pub use scene::{Scene, SceneKind, builtin_names};
 pub use sim::{Progress, Simulation};
-pub use uniaxial::{FreeSurfaceReading, Layer, PLATE_IMPACT_FIELDS, PlateImpact};
+pub use solver::uniaxial::{FreeSurfaceReading, Layer, PLATE_IMPACT_FIELDS, PlateImpact};
 
 /// Material models and their composition into a [`Material`](materials::Material):
 /// an equation of state ([`Eos`](materials::Eos)), a strength model
@@ -160,25 +158,26 @@ pub mod internals {
     }
     /// The 3-D MLPG method's parts.
     pub mod mlpg {
-        pub use crate::mlpg::mls::distance;
-        pub use crate::mlpg::nodal::NodalOperator;
-        pub use crate::mlpg::penetration::{Penetration, PenetrationSetup};
-        pub use crate::mlpg::scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
-        pub use crate::mlpg::solver::{SMOOTHING, WeakForm};
-        pub use crate::mlpg::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
-        pub use crate::mlpg::step::{
+        pub use crate::approx::lattice::{Cylinder, NodeLattice, Surfaces};
+        pub use crate::approx::mls::distance;
+        pub use crate::approx::mls::{NodalShapes, SupportParams, Supports};
+        pub use crate::approx::nodal::NodalOperator;
+        pub use crate::approx::sphere::{ALPHA, BOUNDARY_RULE, DEFAULT_RULE, test_radii};
+        pub use crate::approx::sphere::{SphereRule, TestSphere};
+        pub use crate::approx::step::{
             OMEGA_FACTOR, OMEGA_FACTOR_NODAL, largest_eigenvalue, stable_step, stable_step_with,
         };
-        pub use crate::mlpg::weak::VOIGT;
-        pub use crate::mlpg::{
-            Body, Cylinder, Mlpg3d, NodalShapes, NodeLattice, RodSetup, SphereRule, SupportParams,
-            Supports, Surfaces, TestSphere, TractionOperator,
-        };
+        pub use crate::approx::weak::TractionOperator;
+        pub use crate::approx::weak::VOIGT;
         pub use crate::scene::penetration::penetration;
+        pub use crate::solver::mlpg3d::penetration::{Penetration, PenetrationSetup};
+        pub use crate::solver::mlpg3d::scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
+        pub use crate::solver::mlpg3d::{Body, Mlpg3d, RodSetup};
+        pub use crate::solver::mlpg3d::{SMOOTHING, WeakForm};
     }
+    pub use crate::approx::msph::{Neighbourhood, Row2};
     pub use crate::kernel::kernel2;
     pub use crate::lanes::W;
-    pub use crate::msph::{Neighbourhood, Row2};
     pub use crate::neighbours::{cell_list, naive, padded_rows};
     pub use crate::run::SPACING_COLLAPSE_BOUND;
     pub use crate::solver::axisymmetric::TaylorSolver;

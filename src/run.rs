@@ -1,6 +1,6 @@
 //! The run's guards and bounds, shared by every solver (the axisymmetric
 //! and radial MSPH solvers in [`crate::solver`], the 3-D MLPG solver in
-//! [`crate::mlpg`]): the named stops (energy drift, spacing collapse, time
+//! [`crate::solver::mlpg3d`]): the named stops (energy drift, spacing collapse, time
 //! step collapse, NaN), the quiet end and its detector ([`QuietEnd`]), the
 //! shifting bounds, and the checks of a restored run's clock and bounds. No
 //! solver imports these from another solver's file.

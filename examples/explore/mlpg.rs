@@ -97,7 +97,7 @@ pub fn unstable_modes_of_the_bar() {
     }
 }
 
-/// The measurement behind the solver's damping (`mlpg::solver::DAMPING`):
+/// The measurement behind the solver's damping (`solver::mlpg3d::DAMPING`):
 /// stiffness-proportional (Rayleigh) damping `σ_v = c C : D` with
 /// `c = 2 ζ / ω_max`, ζ the damping ratio at the solver's `ω_max`. Each
 /// eigenvalue `λ` of the undamped operator `K` gives the modes

@@ -1,5 +1,5 @@
 //! The `penetration` scene: a projectile perforating a plate in 3-D by the
-//! MLPG mixed method (seed 004, section 5.2; [`crate::mlpg::penetration`]).
+//! MLPG mixed method (seed 004, section 5.2; [`crate::solver::mlpg3d::penetration`]).
 //! Its defaults are the seed's case: a tungsten cylinder 10 mm long and
 //! 10 mm in diameter at 1500 m/s, normal to an AD85 plate 5 mm thick and
 //! 80 mm in diameter (free rim), run to 20 µs. The projectile is bilinear
@@ -11,15 +11,15 @@ use super::Scene;
 use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
 use super::registry::{SceneRow, no_variants, restore};
 use super::taylor3d::{RingLattice, mlpg_memory};
+use crate::approx::lattice::Cylinder;
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
 use crate::material::choice::{MaterialChoice, Prefix};
-use crate::mlpg::Cylinder;
-use crate::mlpg::penetration::{Penetration, PenetrationSetup};
-use crate::mlpg::scheme::MlpgScheme;
-use crate::mlpg::solver::{DAMPING, REBUILD_STRAIN, RodSetup};
 use crate::observe::PENETRATION_OBSERVABLES;
+use crate::solver::mlpg3d::penetration::{Penetration, PenetrationSetup};
+use crate::solver::mlpg3d::scheme::MlpgScheme;
+use crate::solver::mlpg3d::{DAMPING, REBUILD_STRAIN, RodSetup};
 use std::collections::BTreeMap;
 
 /// The registry row of the `penetration` scene.
@@ -29,7 +29,7 @@ pub static ROW: SceneRow = SceneRow {
     params: PENETRATION_PARAMS,
     material: None,
     observables: PENETRATION_OBSERVABLES,
-    fields: crate::mlpg::penetration::PENETRATION_FIELDS,
+    fields: crate::solver::mlpg3d::penetration::PENETRATION_FIELDS,
     reference: || BTreeMap::from([("projectile_velocity".to_string(), RESIDUAL_VELOCITY)]),
     variants: no_variants,
     check: |s| setup(s).map(|_| ()),
@@ -346,7 +346,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
 mod tests {
     use super::*;
     use crate::material::presets::Preset;
-    use crate::mlpg::solver::WeakForm;
+    use crate::solver::mlpg3d::WeakForm;
 
     /// The projectile's defaults are the preset `tungsten_seed`, by value.
     #[test]

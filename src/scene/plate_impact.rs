@@ -1,5 +1,5 @@
 //! The `plate_impact` scene: a flyer plate strikes a target plate in
-//! uniaxial strain ([`crate::PlateImpact`], `src/uniaxial.rs`), the
+//! uniaxial strain ([`crate::PlateImpact`], `src/solver/uniaxial/mod.rs`), the
 //! experiment that ceramic models are calibrated with. Either plate is the
 //! Rajendran-Grove ceramic (the `plate_` block, defaults AD85 as in
 //! `penetration`) or one of the metal presets ([`crate::Preset`]). The
@@ -22,7 +22,7 @@ use crate::material::Damage;
 use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
 use crate::material::presets::Preset;
 use crate::observe::PLATE_IMPACT_OBSERVABLES;
-use crate::uniaxial::{Layer, PlateImpact};
+use crate::solver::uniaxial::{Layer, PlateImpact};
 use std::collections::BTreeMap;
 
 /// The registry row of the `plate_impact` scene.
@@ -32,7 +32,7 @@ pub static ROW: SceneRow = SceneRow {
     params: PLATE_IMPACT_PARAMS,
     material: None,
     observables: PLATE_IMPACT_OBSERVABLES,
-    fields: crate::uniaxial::PLATE_IMPACT_FIELDS,
+    fields: crate::solver::uniaxial::PLATE_IMPACT_FIELDS,
     reference: BTreeMap::new,
     variants: no_variants,
     check: |s| setup(s).map(|_| ()),

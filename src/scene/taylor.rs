@@ -170,7 +170,7 @@ const AFTER: &[ParamSpec] = &[
 ];
 
 /// The schemes of the axisymmetric MSPH solver, by name (the `scheme` row;
-/// [`crate::solver::scheme::MsphScheme`] decodes the knobs they set). The
+/// [`crate::solver::axisymmetric::scheme::MsphScheme`] decodes the knobs they set). The
 /// first is the default.
 pub const SCHEMES: &[Level] = &[
     Level {

@@ -1,5 +1,5 @@
 //! The `taylor3d` scene: House et al. test 7 in 3-D by the MLPG mixed
-//! method (seed 004, [`crate::mlpg`]): a rod of 4340 steel on the ring
+//! method (seed 004, [`crate::solver::mlpg3d`]): a rod of 4340 steel on the ring
 //! lattice striking a rigid smooth anvil, with the `taylor` scene's
 //! parameter and observable names, the same choice of material models
 //! ([`crate::material::choice`]; no FMU of its own for the other choices
@@ -12,13 +12,13 @@ use super::Scene;
 use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec, param_struct};
 use super::registry::{MaterialSlot, SceneRow, restore};
 use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
+use crate::approx::lattice::Cylinder;
 use crate::budget::MemoryPerNode;
 use crate::material::Material;
 use crate::material::choice::{MaterialChoice, Prefix};
-use crate::mlpg::Cylinder;
-use crate::mlpg::scheme::MlpgScheme;
-use crate::mlpg::solver::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
 use crate::observe::TAYLOR3D_OBSERVABLES;
+use crate::solver::mlpg3d::scheme::MlpgScheme;
+use crate::solver::mlpg3d::{DAMPING, Mlpg3d, REBUILD_STRAIN, RodSetup, SMOOTHING};
 
 /// The registry row of the `taylor3d` scene.
 pub static ROW: SceneRow = SceneRow {
@@ -31,7 +31,7 @@ pub static ROW: SceneRow = SceneRow {
         fmus: &[],
     }),
     observables: TAYLOR3D_OBSERVABLES,
-    fields: crate::mlpg::solver::MLPG_FIELDS,
+    fields: crate::solver::mlpg3d::MLPG_FIELDS,
     reference: || super::table1::Table1Row::all()[6].reference(),
     variants,
     check: |s| {
@@ -111,7 +111,7 @@ impl RingLattice {
         }
     }
 
-    /// Nodes of the ring lattice of a cylinder ([`crate::mlpg::lattice`])
+    /// Nodes of the ring lattice of a cylinder ([`crate::approx::lattice`])
     /// of `radius` and `length` at the radial `spacing`, one layer a
     /// spacing: `1 + 3 k (k + 1)` a layer for `k` rings; in the quarter,
     /// the axis and, of ring `j`'s `6 j` nodes, those at angles in
@@ -152,7 +152,7 @@ pub(crate) const SMOOTHING_ORDER_SPEC: ParamSpec = spec(
 );
 
 /// The `symmetry` row of the 3-D scenes of a normal impact: 0 the whole
-/// body, 1 the quarter model (`src/mlpg/mirror.rs`).
+/// body, 1 the quarter model (`src/approx/mirror.rs`).
 pub(crate) const SYMMETRY: ParamSpec = spec(
     "symmetry",
     "1",
@@ -164,8 +164,8 @@ pub(crate) const SYMMETRY: ParamSpec = spec(
 
 /// The `weak_form` row of the 3-D scenes: 0 the seed's local weak form
 /// over test spheres (eq. 10), 1 the nodal Galerkin form
-/// (`src/mlpg/nodal.rs`), 2 the nodal form with gradients that conform to
-/// the nodal quadrature at the surfaces (`src/mlpg/conform.rs`).
+/// (`src/approx/nodal.rs`), 2 the nodal form with gradients that conform to
+/// the nodal quadrature at the surfaces (`src/approx/conform.rs`).
 pub(crate) const WEAK_FORM: ParamSpec = spec(
     "weak_form",
     "1",

@@ -5,15 +5,9 @@
 //! bookkeeping), but nothing else runs per step.
 
 pub mod axisymmetric;
-pub mod boundary;
-mod pairs;
+pub mod mlpg3d;
 pub mod radial;
-pub mod scheme;
-mod shift;
-// Shares disjoint chunks of the step's arrays between the threads of a
-// team: the only unsafe code of the solver besides the AVX-512 kernels.
-#[allow(unsafe_code)]
-mod team;
+pub mod uniaxial;
 
 /// Courant number of eq. (3.22).
 pub const COURANT: f64 = 0.2;
@@ -94,7 +88,7 @@ pub(crate) fn rows_mut<'a, T>(mut buf: &'a mut [T], offsets: &[usize]) -> Vec<&'
 
 /// The first degenerate moment matrix, in particle order, as the named error.
 pub(crate) fn first_degenerate(
-    status: Vec<std::result::Result<(), crate::msph::Degenerate>>,
+    status: Vec<std::result::Result<(), crate::approx::msph::Degenerate>>,
     time: f64,
 ) -> crate::Result<()> {
     match status.into_iter().find_map(|s| s.err()) {

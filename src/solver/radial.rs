@@ -37,10 +37,10 @@
 //! its volume.
 
 use super::{COURANT, first_degenerate, rows_mut};
+use crate::approx::msph::{Msph1Rows, Row1};
 use crate::error::{Error, Result};
 use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
-use crate::msph::{Msph1Rows, Row1};
 use crate::neighbours::{NeighbourList, cell_list};
 use crate::observe::{FieldSpec, NOH_OBSERVABLES};
 use crate::run::{check_derived, check_time_step, first_non_finite};
@@ -266,7 +266,7 @@ impl NohSolver {
         let mut w = vec![0.0; nl.indices.len()];
         let rows = rows_mut(&mut w, &nl.offsets);
         let h = self.h;
-        let status: Vec<std::result::Result<(), crate::msph::Degenerate>> = rows
+        let status: Vec<std::result::Result<(), crate::approx::msph::Degenerate>> = rows
             .into_par_iter()
             .take(n)
             .enumerate()

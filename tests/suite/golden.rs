@@ -22,7 +22,7 @@
 //! cases were re-recorded again the same day when the 3-D solver's sums
 //! over the nodes (kinetic energy, the step's tallies, the anvil's
 //! dissipation, the conjugate gradients' dot products) began to run on the
-//! pool in fixed blocks of 1024 nodes (src/mlpg/sums.rs): the paper's case
+//! pool in fixed blocks of 1024 nodes (src/approx/sums.rs): the paper's case
 //! moved only in its kinetic energy, smoothing dissipation and energy
 //! error (the motion kept its bits); the default case moved through the
 //! dot products of its conforming correction. The penetration case (under

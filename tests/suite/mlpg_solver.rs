@@ -1,4 +1,4 @@
-//! The 3-D MLPG solver's time loop (`src/mlpg/solver/`): elastic waves
+//! The 3-D MLPG solver's time loop (`src/solver/mlpg3d/`): elastic waves
 //! in a rod on the rigid anvil against the wave speeds of elasticity, the
 //! elastic rebound of a Taylor rod, and the determinism of the loop.
 
@@ -383,7 +383,7 @@ fn axisymmetric_wilkins(particles_radial: f64) -> (f64, f64) {
 }
 
 /// The Wilkins bar in 3-D with conforming gradients (`weak_form = 2`,
-/// `src/mlpg/conform.rs`), the order-1 smoothing and the aligned lattice,
+/// `src/approx/conform.rs`), the order-1 smoothing and the aligned lattice,
 /// at 6 nodes across the radius comes to rest with
 /// no named stop, and its final length and impact-face radius are those of
 /// the axisymmetric solver at the same spacing (6 across,

@@ -1,4 +1,4 @@
-//! Plate impact in uniaxial strain (`src/uniaxial.rs`): an elastic impact
+//! Plate impact in uniaxial strain (`src/solver/uniaxial/mod.rs`): an elastic impact
 //! against the exact solution, and the AD85 ceramic's elastic precursor
 //! against the Hugoniot elastic limit of its constants.
 

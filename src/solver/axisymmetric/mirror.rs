@@ -3,7 +3,7 @@
 //! the velocity component and the shear stress odd across the plane, the
 //! rest even.
 
-use crate::solver::boundary::Stress;
+use crate::solver::axisymmetric::boundary::Stress;
 
 /// The plane or planes a mirror image is reflected across: the axis R = 0,
 /// the anvil Z = 0, or both (an image of a particle near the axis and the

@@ -12,7 +12,7 @@
 //!
 //! One step, from positions `x^n`, velocities `v^{n-1/2}` and stresses
 //! `sigma^n` (with boundary conditions applied):
-//! 0. with `shifting > 0`, particle shifting (src/solver/shift.rs): pairs
+//! 0. with `shifting > 0`, particle shifting (src/solver/axisymmetric/shift.rs): pairs
 //!    closer than half the initial spacing push apart, and the moved
 //!    particles take the fields of their new place;
 //! 1. neighbours and MSPH first-derivative weights at `x^n`;
@@ -40,15 +40,23 @@
 //! restored run (`restore.rs`) and the observables and fields
 //! (`fields.rs`).
 
+pub mod boundary;
 mod fields;
 mod mirror;
 mod neighbours;
+mod pairs;
 mod passes;
 mod restore;
+pub mod scheme;
 mod setup;
+mod shift;
 mod shifting;
 mod step;
 mod surfaces;
+// Shares disjoint chunks of the step's arrays between the threads of a
+// team: the only unsafe code of the solver besides the AVX-512 kernels.
+#[allow(unsafe_code)]
+mod team;
 mod workspace;
 
 pub use fields::TAYLOR_FIELDS;
@@ -59,11 +67,11 @@ use crate::material::{Material, MaterialState};
 use crate::observe::FieldSpec;
 use crate::run::QuietEnd;
 use crate::solver::COURANT;
-use crate::solver::boundary::{Stress, Surface};
+use crate::solver::axisymmetric::boundary::{Stress, Surface};
 use workspace::Workspace;
 
 /// Gap along the axis, relative to the initial spacing, below which an
-/// axis particle may leave the axis (src/solver/shift.rs, `leaving`).
+/// axis particle may leave the axis (src/solver/axisymmetric/shift.rs, `leaving`).
 pub const AXIS_CROWD: f64 = 0.3;
 
 /// Distance from a surface particle, relative to the initial spacing,

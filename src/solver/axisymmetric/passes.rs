@@ -10,12 +10,12 @@ use super::{MIN_LEN, kinetic1, wave_and_flow_speed};
 use crate::isa::Isa;
 use crate::lanes::W;
 use crate::material::{Loading, Material, Point, PointState};
-use crate::solver::boundary::Stress;
-use crate::solver::pairs::{
+use crate::solver::axisymmetric::boundary::Stress;
+use crate::solver::axisymmetric::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
     smooth, smooth2, velocity_gradients,
 };
-use crate::solver::team::{Chunks, Team, named_parts};
+use crate::solver::axisymmetric::team::{Chunks, Team, named_parts};
 
 /// What the passes after the pair pass read: the team, the copy of the hot
 /// loops, the rows of the pair pass, the mirror images, the smoothing, and
@@ -58,7 +58,7 @@ named_parts! {
 /// Steps 1-2, per particle: the MSPH moment matrix over the neighbours in the
 /// support, the derivative and Shepard weights of each pair, and the
 /// momentum equation `v^{n+1/2} = v^{n-1/2} + dt div(sigma) / rho`, [`W`]
-/// particles at a time (src/solver/pairs.rs); then `U_Z = 0` on the
+/// particles at a time (src/solver/axisymmetric/pairs.rs); then `U_Z = 0` on the
 /// particles touching the anvil (`contact`), the kinetic energy that takes
 /// booked per batch.
 #[allow(clippy::too_many_arguments)]

@@ -10,7 +10,7 @@ use crate::isa::Isa;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Material, MaterialState};
 use crate::run::{QuietEnd, check_derived};
-use crate::solver::boundary::Surface;
+use crate::solver::axisymmetric::boundary::Surface;
 use crate::solver::setup_struct;
 
 setup_struct! {

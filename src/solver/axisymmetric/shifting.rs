@@ -1,4 +1,4 @@
-//! Particle shifting in the axisymmetric solver (src/solver/shift.rs):
+//! Particle shifting in the axisymmetric solver (src/solver/axisymmetric/shift.rs):
 //! which way each particle may move, the shifts, the fields carried along,
 //! and the crowded particles that leave the axis.
 
@@ -8,8 +8,10 @@ use super::workspace::Workspace;
 use super::{AXIS_CROWD, AXIS_LEAVE, SURFACE_BAND, TaylorSolver, kinetic1};
 use crate::error::{Error, Result};
 use crate::run::{SHIFT_CAP, SHIFT_RANGE};
-use crate::solver::boundary::Surface;
-use crate::solver::shift::{Candidates, Freedom, carry, leaving, shifts, surface_band};
+use crate::solver::axisymmetric::boundary::Surface;
+use crate::solver::axisymmetric::shift::{
+    Candidates, Freedom, carry, leaving, shifts, surface_band,
+};
 
 impl TaylorSolver {
     /// The directions each particle may shift in: along the surface on the
@@ -70,7 +72,7 @@ impl TaylorSolver {
         out
     }
 
-    /// Particle shifting (src/solver/shift.rs): pushes apart the pairs closer
+    /// Particle shifting (src/solver/axisymmetric/shift.rs): pushes apart the pairs closer
     /// than [`SHIFT_RANGE`] and carries the fields of the moved particles
     /// along. The kinetic energy the carrying changes is booked with the
     /// smoothing. With a `margin` ([`Workspace::shift_margin`]) only the

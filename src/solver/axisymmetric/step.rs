@@ -16,9 +16,9 @@ use crate::error::{Error, Result};
 use crate::lanes::W;
 use crate::run::{ENERGY_ERROR_BOUND, SPACING_COLLAPSE_BOUND, above, below, check_time_step};
 use crate::solver::COURANT;
-use crate::solver::pairs::{PairInputs, Rows};
-use crate::solver::scheme::{MsphScheme, SmoothingOrder};
-use crate::solver::team::{Chunks, Team};
+use crate::solver::axisymmetric::pairs::{PairInputs, Rows};
+use crate::solver::axisymmetric::scheme::{MsphScheme, SmoothingOrder};
+use crate::solver::axisymmetric::team::{Chunks, Team};
 
 impl TaylorSolver {
     /// Advances one step.
@@ -26,7 +26,7 @@ impl TaylorSolver {
         let mut ws = std::mem::take(&mut self.ws);
         // The whole step runs on one worker of the thread pool, which leads
         // a team of the others through its parallel passes
-        // (src/solver/team.rs). The neighbour rebuild comes first, with its
+        // (src/solver/axisymmetric/team.rs). The neighbour rebuild comes first, with its
         // own parallel loops, so that no follower waits through it. Particle
         // shifting, if on, follows it, on lists that hold every pair in the
         // support (so that it does not depend on when they were built, and a

@@ -3,7 +3,7 @@
 //! shear on the anvil.
 
 use super::TaylorSolver;
-use crate::solver::boundary::{Surface, corner_free, traction_free};
+use crate::solver::axisymmetric::boundary::{Surface, corner_free, traction_free};
 
 /// The outward normal of the top at the axis.
 pub(super) const TOP_ON_AXIS: [f64; 2] = [0.0, 1.0];

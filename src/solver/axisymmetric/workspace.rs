@@ -3,8 +3,8 @@
 //! rebuilt), and the per-chunk sums the passes write into them.
 
 use super::mirror::Image;
-use crate::solver::boundary::Stress;
-use crate::solver::pairs::{PairPass, ScratchPool};
+use crate::solver::axisymmetric::boundary::Stress;
+use crate::solver::axisymmetric::pairs::{PairPass, ScratchPool};
 
 /// Buffers reused from step to step. Not part of the state: rebuilt from
 /// the positions after a restore, and after a copy (see its `Clone`).

@@ -1,0 +1,319 @@
+//! What follows from the positions at the last build ([`Geometry`]): the
+//! supports (with the quarter model's mirror images), the shapes at the
+//! nodes, the traction operator, and the pass over the named pairs that
+//! decides when they are rebuilt.
+
+use super::*;
+
+/// What follows from the positions at the last build: supports, nodal
+/// shapes, test spheres and the traction operator. Rebuilt, never saved.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Geometry {
+    pub(super) supports: Option<Supports>,
+    pub(super) shapes: NodalShapes,
+    pub(super) spheres: Vec<TestSphere>,
+    pub(super) op: TractionOperator,
+    /// The transposed shapes: the nodal form's operator, and the order-2
+    /// smoothing's `Hᵀ` (empty otherwise).
+    pub(super) nodal: NodalOperator,
+    /// The mirror images of the quarter model (none for the whole body),
+    /// chosen with the supports.
+    pub(super) mirror: Mirror,
+    /// The conforming correction's multipliers at this build (empty
+    /// without it): the next build starts from them.
+    pub(super) multipliers: Vec<[f64; 3]>,
+}
+
+/// What [`Mlpg3d::named_pairs`] finds.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct NamedPairs {
+    /// The smallest distance between named nodes (its square while the
+    /// pairs are visited).
+    pub(super) nearest: f64,
+    /// A pair has left the range of the supports.
+    pub(super) recompute: bool,
+    /// A pair has moved by more than [`RodSetup::rebuild_strain`] of its
+    /// length at the last build.
+    pub(super) strained: bool,
+}
+
+impl NamedPairs {
+    const NONE: NamedPairs = NamedPairs {
+        nearest: f64::INFINITY,
+        recompute: false,
+        strained: false,
+    };
+
+    pub(super) fn join(a: Self, b: Self) -> Self {
+        NamedPairs {
+            nearest: a.nearest.min(b.nearest),
+            recompute: a.recompute || b.recompute,
+            strained: a.strained || b.strained,
+        }
+    }
+}
+
+/// The margin of the squared pre-tests of [`Mlpg3d::named_pairs`]: far
+/// above the round-off of the exact tests, so a pair the pre-test passes
+/// passes them.
+const PRE_TEST_MARGIN: f64 = 1e-9;
+
+impl Mlpg3d {
+    /// The smallest current distance between a node and one it names.
+    pub(super) fn nearest_distance(&self) -> f64 {
+        let sup = self.supports();
+        let mut buf = Vec::new();
+        let pos = extended(self.mirror(), &self.pos, &mut buf, mirror::vector);
+        (0..self.pos.len())
+            .into_par_iter()
+            .map(|i| {
+                sup.named
+                    .of(i)
+                    .iter()
+                    .map(|&j| distance(&pos[i], &pos[j]))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect::<Vec<f64>>()
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The mirror images of the last computation of the supports (none
+    /// for the whole body).
+    pub(super) fn mirror(&self) -> &Mirror {
+        &self
+            .geometry
+            .as_ref()
+            .expect("the geometry is built before use")
+            .mirror
+    }
+
+    pub(super) fn supports(&self) -> &Supports {
+        self.geometry
+            .as_ref()
+            .and_then(|g| g.supports.as_ref())
+            .expect("the geometry is built before use")
+    }
+
+    /// Rebuilds the geometry at `built_at` (and the supports at
+    /// `supports_at` when `supports` is true or none exist).
+    pub(super) fn build_geometry(&mut self, supports: bool) -> Result<()> {
+        let time = self.time;
+        let stamp = |e: Error| at_time(e, time);
+        let mut clock = self.profile.clock();
+        let mut g = self.geometry.take().unwrap_or_default();
+        // The old traction operator goes before the new is built; the
+        // shapes and the nodal operator are rebuilt in their own buffers.
+        // They are most of the heap (BENCHMARKS.md, memory).
+        g.op = TractionOperator::default();
+        let n = self.pos.len();
+        if supports || g.supports.is_none() {
+            let (sup, mirror) = self.supports_with_images().map_err(stamp)?;
+            g.supports = Some(sup);
+            g.mirror = mirror;
+            self.profile.supports += 1;
+        }
+        self.profile.lap(Phase::Supports, &mut clock);
+        let sup = g.supports.as_ref().expect("computed above");
+        let mut buf = Vec::new();
+        let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
+        g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
+        self.profile.lap(Phase::Shapes, &mut clock);
+        if self.setup.conforming {
+            let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
+            let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
+            // The start: the last build's multipliers in this process, or
+            // the saved start of a restored run's last build.
+            if !g.multipliers.is_empty() {
+                self.built_multipliers.clone_from(&g.multipliers);
+            }
+            g.multipliers.clone_from(&self.built_multipliers);
+            let c = conform(
+                self.isa,
+                &mut g.shapes,
+                pts,
+                &volume,
+                &inner,
+                CONFORM_TOLERANCE,
+                &mut g.multipliers,
+            );
+            self.profile.conform_iterations += c.iterations as u64;
+        }
+        self.profile.lap(Phase::Conform, &mut clock);
+        match self.setup.weak_form {
+            WeakForm::Sphere => {
+                g.spheres = self.spheres(pts, &g.mirror, sup, &g.shapes);
+                self.profile.lap(Phase::Spheres, &mut clock);
+                g.op = TractionOperator::build(
+                    self.isa,
+                    pts,
+                    sup,
+                    &g.spheres,
+                    &SphereRule::of(DEFAULT_RULE),
+                    &SphereRule::of(BOUNDARY_RULE),
+                )
+                .map_err(stamp)?;
+            }
+            WeakForm::Nodal => {
+                g.spheres.clear();
+            }
+        }
+        if self.setup.weak_form == WeakForm::Nodal || self.setup.smoothing_order >= 2 {
+            g.nodal.rebuild(&g.shapes, pts.len());
+        } else {
+            g.nodal = NodalOperator::default();
+        }
+        self.profile.lap(Phase::Operator, &mut clock);
+        self.profile.operators += 1;
+        self.geometry = Some(g);
+        self.rebuilds += 1;
+        Ok(())
+    }
+
+    /// The supports at `supports_at` and, in the quarter model, the mirror
+    /// images they take (`src/approx/mirror.rs`). An image can matter to a real
+    /// row only if it is among the `k` nearest of a real node (within the
+    /// largest `k`-th distance `d_k` of the plane) or covers a point of a
+    /// real node's test sphere (within `r_J + d_k` of the quarter, the test
+    /// radius being below the nearest distance); so the supports are
+    /// computed with the images within a layer of the planes at least as
+    /// wide as the largest `r_J + d_k` (from six spacings, widened until
+    /// it is), and the images farther than their `r_J + d_k` are then
+    /// dropped: the rows are the same.
+    pub(super) fn supports_with_images(&self) -> Result<(Supports, Mirror)> {
+        let n = self.pos.len();
+        let at = &self.supports_at;
+        if self.plane.is_empty() {
+            let sup = Supports::compute_grouped(at, &self.group, SupportParams::default())?;
+            return Ok((sup, Mirror::default()));
+        }
+        let mut layer = 6.0 * self.reach;
+        let (mut sup, m, dk) = loop {
+            let m = Mirror::choose(at, &self.plane, layer);
+            let (mut pts, mut group) = (Vec::new(), Vec::new());
+            m.extend(at, &mut pts, mirror::vector);
+            if !self.group.is_empty() {
+                m.extend(&self.group, &mut group, mirror::same);
+            }
+            let mut sup = Supports::compute_rows(&pts, &group, n, SupportParams::default())?;
+            // A node's radius covers what its images' do (their namers are
+            // the images of its own), and its images have its radius.
+            for (k, &j) in m.source.iter().enumerate() {
+                sup.radius[j] = sup.radius[j].max(sup.radius[n + k]);
+            }
+            for (k, &j) in m.source.iter().enumerate() {
+                sup.radius[n + k] = sup.radius[j];
+            }
+            let widest = sup.radius[..n].iter().copied().fold(0.0, f64::max);
+            let dk = sup.named_distance.iter().copied().fold(0.0, f64::max);
+            if !(widest + dk).is_finite() {
+                // Only positions that overflow get here: never grow for ever.
+                return Err(Error::NonFinite {
+                    field: "support radius",
+                    particle: sup.radius.iter().position(|r| !r.is_finite()).unwrap_or(0),
+                    time: self.time,
+                });
+            }
+            if widest + dk < layer {
+                break (sup, m, dk);
+            }
+            layer = 1.25 * (widest + dk);
+        };
+        // Drop the images that no real row can see.
+        let at_ext = |k: usize| mirror::vector(&at[m.source[k]], m.flip[k]);
+        let keep: Vec<bool> = (0..m.len())
+            .map(|k| {
+                let x = at_ext(k);
+                // Distance to the quarter x ≥ 0, y ≥ 0.
+                let d = (x[0].min(0.0).powi(2) + x[1].min(0.0).powi(2)).sqrt();
+                d < sup.radius[n + k] + dk
+            })
+            .collect();
+        let mut index: Vec<usize> = (0..n).collect();
+        let mut kept = Mirror::default();
+        for (k, &keep) in keep.iter().enumerate() {
+            if keep {
+                index.push(n + kept.len());
+                kept.source.push(m.source[k]);
+                kept.flip.push(m.flip[k]);
+            } else {
+                index.push(usize::MAX);
+            }
+        }
+        for j in &mut sup.named.indices {
+            *j = index[*j];
+            debug_assert!(*j != usize::MAX, "a named image is kept");
+        }
+        /// The entries of the kept nodes.
+        fn compact<T: Copy>(v: &[T], index: &[usize]) -> Vec<T> {
+            v.iter()
+                .zip(index)
+                .filter(|(_, i)| **i != usize::MAX)
+                .map(|(x, _)| *x)
+                .collect()
+        }
+        sup.radius = compact(&sup.radius, &index);
+        if !sup.group.is_empty() {
+            sup.group = compact(&sup.group, &index);
+        }
+        Ok((sup, kept))
+    }
+
+    /// One pass over the named pairs at the current positions `x` (the
+    /// positions at the last build `b`; both the real nodes', then their
+    /// images'): the smallest distance (the spacing check), whether a pair
+    /// has left the range of [`Supports::recompute_reason`] (the supports
+    /// are recomputed), and whether a pair has moved since the last build
+    /// by more than [`RodSetup::rebuild_strain`] of its length then
+    /// ([`REBUILD_STRAIN`]). Minima and "any"s: the same for any number of
+    /// threads.
+    ///
+    /// The two tests compare squares first, with a margin
+    /// ([`PRE_TEST_MARGIN`]): only a pair near a bound (or one with a
+    /// non-finite position) takes the exact test's square root and
+    /// division, so the answers are the exact tests' (the smallest
+    /// distance is the root of the smallest square: the root is monotone
+    /// and correctly rounded).
+    pub(super) fn named_pairs(&self, x: &[[f64; 3]], b: &[[f64; 3]]) -> NamedPairs {
+        let sup = self.supports();
+        let limit = 0.5 * (1.0 + sup.params.factor);
+        let rebuild = self.setup.rebuild_strain;
+        let (within, beyond) = (
+            limit * limit * (1.0 - PRE_TEST_MARGIN),
+            (1.0 + PRE_TEST_MARGIN) / (limit * limit),
+        );
+        let still = rebuild * rebuild * (1.0 - PRE_TEST_MARGIN);
+        let dot = |a: [f64; 3]| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        let pairs = (0..self.pos.len())
+            .into_par_iter()
+            .map(|i| {
+                let lo = sup.named.offsets[i];
+                let mut out = NamedPairs::NONE;
+                for (q, &j) in sup.named.of(i).iter().enumerate() {
+                    let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
+                    let d2 = dot(now);
+                    out.nearest = out.nearest.min(d2);
+                    let named = sup.named_distance[lo + q];
+                    let n2 = named * named;
+                    // Inside the squared bounds (false for a NaN).
+                    let inside = d2 <= within * n2 && d2 >= beyond * n2;
+                    if !out.recompute && !inside {
+                        let ratio = distance(&x[i], &x[j]) / named;
+                        out.recompute = ratio > limit || ratio < 1.0 / limit;
+                    }
+                    let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
+                    let moved: [f64; 3] = std::array::from_fn(|d| now[d] - then[d]);
+                    let small = dot(moved) <= still * dot(then);
+                    if !out.strained && !small {
+                        out.strained = norm(moved) / norm(then) > rebuild;
+                    }
+                }
+                out
+            })
+            .reduce(|| NamedPairs::NONE, NamedPairs::join);
+        NamedPairs {
+            nearest: pairs.nearest.sqrt(),
+            ..pairs
+        }
+    }
+}

@@ -1,0 +1,379 @@
+//! What a run reports: its clock and fields, the energies, the rod's
+//! observables, the node fields, the memory by part, and the [`crate::model::Model`]
+//! seam.
+
+use super::*;
+
+impl Mlpg3d {
+    /// Number of nodes.
+    pub fn particles(&self) -> usize {
+        self.pos.len()
+    }
+
+    crate::run::clock_getters!(dt);
+
+    /// Builds of the operator so far (the first included).
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+
+    /// The reference lattice.
+    pub fn lattice(&self) -> &NodeLattice {
+        &self.lattice
+    }
+
+    /// Node positions (m).
+    pub fn positions(&self) -> &[[f64; 3]] {
+        &self.pos
+    }
+
+    /// Node velocities (m/s).
+    pub fn velocities(&self) -> &[[f64; 3]] {
+        &self.vel
+    }
+
+    /// Node masses (kg).
+    pub fn masses(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Whether each node is pressed on the anvil.
+    pub fn in_contact(&self) -> &[bool] {
+        &self.contact
+    }
+
+    /// Time of the last release of a node from the anvil (s): where the
+    /// node's net axial force, linear between the last step it was held
+    /// (pushed by the anvil) and the step it lets go (pulled away), crosses
+    /// zero; the node leaves the anvil in that step.
+    pub fn last_release(&self) -> f64 {
+        self.last_release
+    }
+
+    /// Whether the end condition holds: the rod is at rest or has left the
+    /// anvil, or `end_time` has been reached.
+    pub fn finished(&self) -> bool {
+        self.at_rest || self.time >= self.setup.end_time
+    }
+
+    /// Smallest distance between named neighbours relative to the initial
+    /// smallest, over the run so far.
+    pub fn min_spacing_ratio(&self) -> f64 {
+        self.min_spacing
+    }
+
+    /// The energies: kinetic, internal (stress work), plastic work, damping
+    /// and contact dissipation, and the relative energy error; the whole
+    /// body's in the quarter model (four times the quarter's).
+    pub fn energies(&self) -> Energies {
+        let kinetic = kinetic(&self.vel, &self.mass);
+        let k = self.multiplicity();
+        Energies {
+            initial: k * self.initial_energy,
+            kinetic: k * kinetic,
+            internal: k * self.internal_energy,
+            plastic_work: k * self.plastic_work,
+            damping: k * self.damping_dissipation,
+            contact: k * self.contact_dissipation,
+            smoothing: k * self.smoothing_dissipation,
+            error: self.energy_error_with(kinetic),
+        }
+    }
+
+    /// The part of the smoothing dissipation ([`Energies::smoothing`]) that
+    /// node shifting booked over the run so far (J; the whole body's in the
+    /// quarter model): the kinetic energy that carrying the moved nodes'
+    /// velocities changed.
+    pub fn shift_dissipation(&self) -> f64 {
+        self.multiplicity() * self.shift_dissipation
+    }
+
+    /// How many copies of the modelled part make the body: 4 in the quarter
+    /// model, else 1.
+    pub fn multiplicity(&self) -> f64 {
+        if self.plane.is_empty() { 1.0 } else { 4.0 }
+    }
+
+    /// The symmetry planes each node lies on in the quarter model (bits
+    /// `X`, `Y` of `src/approx/mirror.rs`); empty for the whole body.
+    pub fn planes(&self) -> &[u8] {
+        &self.plane
+    }
+
+    /// Runs the hot loops in the compiled copy `isa` from now on (by
+    /// default the best this processor runs); every copy gives the same
+    /// bits.
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = isa;
+    }
+
+    /// The heap bytes the run holds, by part (capacities, not lengths):
+    /// node fields (with the reference lattice and the material state),
+    /// the step's buffers, the supports, the shapes at the nodes, the test
+    /// spheres and the traction operator. BENCHMARKS.md, "3-D MLPG speed".
+    pub fn memory(&self) -> [(&'static str, usize); 6] {
+        fn b<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
+        let l = &self.lattice;
+        let fields = b(&self.pos)
+            + b(&self.vel)
+            + b(&self.mass)
+            + b(&self.rho)
+            + b(&self.dev)
+            + b(&self.pressure)
+            + b(&self.eps_p)
+            + b(&self.temp)
+            + b(&self.visc)
+            + b(&self.contact)
+            + b(&self.supports_at)
+            + b(&self.built_at)
+            + b(&self.reference)
+            + b(&self.built_reference)
+            + b(&self.built_contact)
+            + b(&self.built_rho)
+            + b(&self.built_multipliers)
+            + b(&self.reaction)
+            + b(&l.position)
+            + b(&l.volume)
+            + b(&l.surfaces)
+            + b(&l.sets.face)
+            + b(&l.sets.mantle)
+            + self.particles() * std::mem::size_of::<crate::material::PointState>();
+        let scratch = self.scratch.bytes();
+        let (mut supports, mut shapes, mut spheres, mut op) = (0, 0, 0, 0);
+        if let Some(g) = &self.geometry {
+            if let Some(s) = &g.supports {
+                supports =
+                    b(&s.radius) + b(&s.named.offsets) + b(&s.named.indices) + b(&s.named_distance);
+            }
+            let h = &g.shapes;
+            shapes = b(&h.offsets) + b(&h.nodes) + b(&h.phi) + b(&h.grad) + b(&g.multipliers);
+            spheres = b(&g.spheres);
+            let o = &g.op;
+            op = b(&o.offsets) + b(&o.nodes) + b(&o.b) + b(&o.volume) + g.nodal.bytes();
+        }
+        [
+            ("node fields", fields),
+            ("step buffers", scratch),
+            ("supports", supports),
+            ("shapes at the nodes", shapes),
+            ("test spheres", spheres),
+            ("traction operator (or the nodal one)", op),
+        ]
+    }
+
+    /// Wall time per phase of the steps taken in this process (a restored
+    /// run starts from zero), and the counts of the builds.
+    pub fn profile(&self) -> &PhaseTimes {
+        &self.profile
+    }
+
+    /// Turns on or off the counting of each phase's serial time in
+    /// [`Mlpg3d::profile`] ([`PhaseTimes::count_serial`]).
+    pub fn count_serial(&mut self, on: bool) {
+        self.profile.count_serial(on);
+    }
+
+    /// The rod observables of the current state.
+    pub fn rod(&self) -> RodObservables {
+        RodObservables::of::<3>(
+            &self.lattice.sets,
+            &self.pos,
+            &self.vel,
+            self.setup.cylinder.radius,
+        )
+    }
+
+    /// The distances from the axis of the face's outer ring (the nodes on
+    /// both the face and the mantle), in node order.
+    fn ring_radii(&self) -> impl Iterator<Item = f64> + '_ {
+        self.lattice
+            .sets
+            .face
+            .iter()
+            .filter(|&&i| self.lattice.surfaces[i].has(Surfaces::MANTLE))
+            .map(|&i| radius(&self.pos[i]))
+    }
+
+    /// `(max − min) / mean` of the distance from the axis of the face's
+    /// outer ring (the nodes on both the face and the mantle).
+    pub fn mushroom_radius_spread(&self) -> f64 {
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for r in self.ring_radii() {
+            lo = lo.min(r);
+            hi = hi.max(r);
+        }
+        (hi - lo) / self.ring_radius()
+    }
+
+    /// The mean distance from the axis of the face's outer ring (m): the
+    /// face radius that an axisymmetric solver measures (its ring is one
+    /// particle), where `mushroom_radius`, the largest over the face, adds
+    /// the ring's scatter by azimuth (the Wilkins bar at 11 across: 7.296
+    /// mm against 7.353 mm, VALIDATION.md).
+    pub fn ring_radius(&self) -> f64 {
+        let (sum, k) = self
+            .ring_radii()
+            .fold((0.0, 0usize), |(s, k), r| (s + r, k + 1));
+        sum / k as f64
+    }
+
+    /// Height of the centre of the impact face above the anvil (m).
+    pub fn face_lift(&self) -> f64 {
+        self.pos[0][2]
+    }
+
+    /// Largest effective plastic strain.
+    pub fn max_plastic_strain(&self) -> f64 {
+        self.eps_p.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// Highest temperature (K).
+    pub fn max_temperature(&self) -> f64 {
+        self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Whether the rod has stopped or left the anvil.
+    pub fn at_rest(&self) -> bool {
+        self.at_rest
+    }
+
+    /// The node stresses `σ = S − p I` (Pa), `[xx, yy, zz, xy, yz, zx]`.
+    pub fn stress(&self) -> Vec<Full> {
+        self.dev
+            .iter()
+            .zip(&self.pressure)
+            .map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3], d[4], d[5]])
+            .collect()
+    }
+
+    /// Density (kg/m³), pressure (Pa), plastic strain and temperature (K)
+    /// of every node.
+    pub fn scalars(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
+        (&self.rho, &self.pressure, &self.eps_p, &self.temp)
+    }
+
+    /// The setup of this run.
+    pub fn setup(&self) -> &RodSetup {
+        &self.setup
+    }
+
+    /// The material of the rod.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// The bodies after the rod (none for a Taylor run).
+    pub fn others(&self) -> &[Body] {
+        &self.others
+    }
+
+    /// The body of each node (0: the rod); empty for a run of one body.
+    pub fn group(&self) -> &[u8] {
+        &self.group
+    }
+
+    /// The material state of each node (its damage variables; empty before
+    /// the first step).
+    pub fn material_points(&self) -> &[crate::material::PointState] {
+        self.material_state.points()
+    }
+
+    /// The contact reach between the bodies (m; [`contact`]).
+    pub fn contact_reach(&self) -> f64 {
+        self.reach
+    }
+}
+
+/// The energies of a run (J) and its relative energy error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Energies {
+    /// Kinetic energy at impact.
+    pub initial: f64,
+    /// Kinetic energy now.
+    pub kinetic: f64,
+    /// Stress work of the material (elastic plus plastic).
+    pub internal: f64,
+    /// The plastic part of `internal` (flow stress times plastic strain).
+    pub plastic_work: f64,
+    /// Work of the damping's viscous stress.
+    pub damping: f64,
+    /// Kinetic energy removed by the anvil when it stops nodes.
+    pub contact: f64,
+    /// Kinetic energy removed by the velocity smoothing.
+    pub smoothing: f64,
+    /// `|kinetic + internal + damping + contact + smoothing − initial| / initial`.
+    pub error: f64,
+}
+
+/// The node fields of the 3-D solver.
+pub const MLPG_FIELDS: &[FieldSpec] =
+    &crate::observe::rod_fields(&["x", "y", "z"], &["xx", "yy", "zz", "xy", "yz", "zx"]);
+
+impl Mlpg3d {
+    /// Current values of [`TAYLOR3D_OBSERVABLES`], in that order.
+    pub fn observables(&self) -> Vec<f64> {
+        let rod = self.rod();
+        let e = self.energies();
+        let values = [
+            rod.rod_length,
+            rod.mushroom_radius,
+            rod.undeformed_length,
+            rod.tail_velocity,
+            self.face_lift(),
+            self.max_plastic_strain(),
+            self.max_temperature(),
+            e.kinetic,
+            e.internal,
+            e.smoothing,
+            e.contact,
+            e.error,
+            if self.at_rest { 1.0 } else { 0.0 },
+            self.mushroom_radius_spread(),
+            e.damping,
+            e.plastic_work,
+        ];
+        debug_assert_eq!(values.len(), TAYLOR3D_OBSERVABLES.len());
+        values.to_vec()
+    }
+
+    /// The values of the node field `name` (one of [`MLPG_FIELDS`]),
+    /// interleaved per node.
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        Some(match name {
+            "position" => self.pos.iter().flatten().copied().collect(),
+            "density" => self.rho.clone(),
+            "velocity" => self.vel.iter().flatten().copied().collect(),
+            "pressure" => self.pressure.clone(),
+            "stress" => self.stress().into_iter().flatten().collect(),
+            "plastic_strain" => self.eps_p.clone(),
+            "temperature" => self.temp.clone(),
+            "in_contact" => self.contact.iter().map(|&c| c as u8 as f64).collect(),
+            _ => return None,
+        })
+    }
+}
+
+impl crate::model::Model for Mlpg3d {
+    crate::model::inherent_basics!();
+    fn field_specs(&self) -> &'static [FieldSpec] {
+        MLPG_FIELDS
+    }
+    /// 64 records per elastic transit of the rod.
+    fn record_interval(&self) -> f64 {
+        self.setup.cylinder.length / self.wave_speed() / 64.0
+    }
+    fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
+        Some(crate::rod::profile(&self.lattice.sets.mantle, &self.pos))
+    }
+    fn min_spacing_ratio(&self) -> Option<f64> {
+        Some(self.min_spacing_ratio())
+    }
+    fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
+        self.check_restored(crate::model::same_solver(fresh)?)
+    }
+    fn set_isa(&mut self, isa: Isa) {
+        self.set_isa(isa);
+    }
+}

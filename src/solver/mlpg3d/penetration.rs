@@ -1,0 +1,449 @@
+//! Ballistic penetration by the 3-D MLPG mixed method (seed 004, section
+//! 5.2): a cylindrical projectile striking a circular plate normally, both
+//! on the ring lattice, in contact through [`crate::solver::mlpg3d::contact`], the plate
+//! free at its rim.
+//!
+//! # The bodies
+//!
+//! The projectile (body 0, the rod of [`RodSetup`]) has `rings` rings
+//! across its radius, spacing `Δ = R_p / rings`; the plate (body 1) has
+//! `round(R_plate / Δ)` rings, so that both have the spacing `Δ` when the
+//! radii are in a whole ratio (the seed's 5 and 40 mm are), and its rings
+//! lie under the projectile's. The plate occupies `−h ≤ z ≤ 0`; the
+//! projectile's face starts one contact reach above it (the nodes of the
+//! two surfaces then just touch, [`crate::solver::mlpg3d::contact`]), moving at
+//! `−impact_speed`. No anvil. The run ends at its end time.
+
+use crate::approx::lattice::Cylinder;
+use crate::error::Result;
+use crate::material::Damage;
+use crate::material::Material;
+use crate::material::rajendran_grove::RajendranGrove;
+use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
+use crate::solver::mlpg3d::{Body, Energies, MLPG_FIELDS, Mlpg3d, RodSetup};
+
+/// The geometry and resolution of a penetration run.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PenetrationSetup {
+    /// The projectile (m).
+    pub projectile: Cylinder,
+    /// The plate: its radius and thickness (m).
+    pub plate: Cylinder,
+    /// Speed of the projectile toward the plate (m/s).
+    pub impact_speed: f64,
+    /// Rings across the projectile's radius.
+    pub rings: usize,
+    /// Latest simulated time (s).
+    pub end_time: f64,
+    /// The run ends as soon as the shot's outcome is decided
+    /// ([`Penetration::outcome`]), with `end_time` as its cap; false (the
+    /// default): it runs to `end_time`.
+    #[serde(default)]
+    pub until_outcome: bool,
+    /// The plate's rim is clamped (its outer ring of nodes held still,
+    /// [`crate::solver::mlpg3d::Body::clamped_rim`]); false (the default,
+    /// the seed's case): free.
+    #[serde(default)]
+    pub clamped_rim: bool,
+}
+
+/// What a shot has come to ([`Penetration::outcome`]; the observable
+/// `shot_outcome` is its number).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// 0: neither of the others yet.
+    Undecided,
+    /// 1: the projectile is through the plate and leaving it.
+    Perforated,
+    /// 2: the projectile moves no faster than the plate.
+    Stopped,
+}
+
+/// A penetration run: the two-body MLPG run and what its observables need.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct Penetration {
+    setup: PenetrationSetup,
+    run: Mlpg3d,
+}
+
+impl Penetration {
+    /// The projectile of `projectile` material over the plate of `plate`
+    /// material at the instant of impact; `numerics` gives the solver's
+    /// choices (damping, smoothing, safety, rebuild strain, shifting).
+    pub fn new(
+        setup: PenetrationSetup,
+        projectile: Material,
+        plate: Material,
+        numerics: RodSetup,
+    ) -> Result<Self> {
+        let rings = setup.rings.max(1);
+        let spacing = setup.projectile.radius / rings as f64;
+        let plate_rings = ((setup.plate.radius / spacing).round() as usize).max(1);
+        let reach = spacing.min(setup.plate.radius / plate_rings as f64);
+        // Every choice of `numerics` (the weak form and the smoothing's
+        // order too), on the projectile of `setup`.
+        let rod = RodSetup {
+            cylinder: setup.projectile,
+            rings,
+            impact_speed: setup.impact_speed,
+            end_time: setup.end_time,
+            base: reach,
+            ..numerics
+        };
+        let plate_body = Body {
+            cylinder: setup.plate,
+            rings: plate_rings,
+            base: -setup.plate.length,
+            velocity: 0.0,
+            material: plate,
+            clamped_rim: setup.clamped_rim,
+        };
+        let run = Mlpg3d::bodies(rod, projectile, vec![plate_body])?;
+        Ok(Penetration { setup, run })
+    }
+
+    /// The two-body run.
+    pub fn run(&self) -> &Mlpg3d {
+        &self.run
+    }
+
+    /// Turns on or off the counting of each phase's serial time in the
+    /// run's profile ([`Mlpg3d::count_serial`]).
+    pub fn count_serial(&mut self, on: bool) {
+        self.run.count_serial(on);
+    }
+
+    /// The setup.
+    pub fn setup(&self) -> &PenetrationSetup {
+        &self.setup
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.run.time()
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.run.steps()
+    }
+
+    /// Nodes of both bodies.
+    pub fn particles(&self) -> usize {
+        self.run.particles()
+    }
+
+    /// Whether the end time is reached, or, with
+    /// [`PenetrationSetup::until_outcome`], the outcome is decided.
+    pub fn finished(&self) -> bool {
+        self.run.finished() || (self.setup.until_outcome && self.outcome() != Outcome::Undecided)
+    }
+
+    /// The shot's outcome, decided by the state, not by the clock:
+    ///
+    /// - **perforated**: the projectile's highest node is below the plate's
+    ///   original back face (`projectile_clearance > 0`) and its centre of
+    ///   mass moves faster along the flight than the intact plate material
+    ///   around the hole (the mass-weighted mean over the plate nodes not
+    ///   pulverized within two node spacings of `hole_radius`): it is
+    ///   leaving the plate;
+    /// - **stopped**: not perforated, and the projectile's centre of mass
+    ///   moves no faster along the flight than the plate's centre of mass
+    ///   (or than 0, where the plate moves back): it no longer gains on the
+    ///   plate. With a free rim and momentum conserved this is the capture
+    ///   speed `m_p V / (m_p + m_plate)`, at which projectile and plate
+    ///   move on together;
+    /// - otherwise **undecided**.
+    pub fn outcome(&self) -> Outcome {
+        let v_p = self.projectile_velocity();
+        let (x, v, m) = (
+            self.run.positions(),
+            self.run.velocities(),
+            self.run.masses(),
+        );
+        if self.projectile_clearance() > 0.0 {
+            let spacing = self.setup.projectile.radius / self.setup.rings.max(1) as f64;
+            let reach = self.hole_radius() + 2.0 * spacing;
+            let points = self.run.material_points();
+            let (mut p, mut total) = (0.0, 0.0);
+            for i in self.nodes(1) {
+                let intact = points
+                    .get(i)
+                    .and_then(|p| p.ceramic())
+                    .is_none_or(|c| c.pulverized.is_none());
+                if intact && (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt() <= reach {
+                    p -= m[i] * v[i][2];
+                    total += m[i];
+                }
+            }
+            let around = if total > 0.0 { p / total } else { 0.0 };
+            if v_p > around {
+                return Outcome::Perforated;
+            }
+        }
+        let (mut p, mut total) = (0.0, 0.0);
+        for i in self.nodes(1) {
+            p -= m[i] * v[i][2];
+            total += m[i];
+        }
+        if v_p <= (p / total).max(0.0) {
+            Outcome::Stopped
+        } else {
+            Outcome::Undecided
+        }
+    }
+
+    /// One step.
+    pub fn step(&mut self) -> Result<()> {
+        self.run.step()
+    }
+
+    /// The energies of both bodies.
+    pub fn energies(&self) -> Energies {
+        self.run.energies()
+    }
+
+    /// The nodes of body `b` (0: projectile, 1: plate).
+    fn nodes(&self, b: u8) -> impl Iterator<Item = usize> + '_ {
+        self.run
+            .group()
+            .iter()
+            .enumerate()
+            .filter(move |(_, g)| **g == b)
+            .map(|(i, _)| i)
+    }
+
+    /// Axial velocity of the projectile's centre of mass, positive in its
+    /// direction of flight (m/s).
+    pub fn projectile_velocity(&self) -> f64 {
+        let (m, v) = (self.run.masses(), self.run.velocities());
+        let (mut p, mut total) = (0.0, 0.0);
+        for i in self.nodes(0) {
+            p += m[i] * v[i][2];
+            total += m[i];
+        }
+        -p / total
+    }
+
+    /// Extent of the projectile along the axis (m).
+    pub fn projectile_extent(&self) -> f64 {
+        let x = self.run.positions();
+        let (lo, hi) = self
+            .nodes(0)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), i| {
+                (lo.min(x[i][2]), hi.max(x[i][2]))
+            });
+        hi - lo
+    }
+
+    /// Depth of the projectile's highest node below the plate's original
+    /// back face, `z = −plate_thickness` (m): positive once the whole
+    /// projectile has passed that plane, negative while any of it is above.
+    pub fn projectile_clearance(&self) -> f64 {
+        let x = self.run.positions();
+        let hi = self
+            .nodes(0)
+            .map(|i| x[i][2])
+            .fold(f64::NEG_INFINITY, f64::max);
+        -self.setup.plate.length - hi
+    }
+
+    /// The plate's ceramic, if it is one.
+    fn ceramic(&self) -> Option<&RajendranGrove> {
+        match &self.run.others()[0].material.damage {
+            Damage::RajendranGrove(c) => Some(c),
+            Damage::None => None,
+        }
+    }
+
+    /// Crack density and pulverization of each plate node, with its mass:
+    /// `(γ, pulverized, mass)`; γ = 0 for a plate without damage.
+    fn plate_damage(&self) -> Vec<(f64, bool, f64)> {
+        let points = self.run.material_points();
+        let m = self.run.masses();
+        let c = self.ceramic();
+        self.nodes(1)
+            .map(|i| {
+                let vars = points.get(i).and_then(|p| p.ceramic());
+                match (c, vars) {
+                    (Some(c), Some(v)) => {
+                        (c.crack_density(v.crack_size), v.pulverized.is_some(), m[i])
+                    }
+                    (Some(c), None) => (c.crack_density(c.initial_crack_size), false, m[i]),
+                    _ => (0.0, false, m[i]),
+                }
+            })
+            .collect()
+    }
+
+    /// Radius of the channel about the axis free of intact plate material
+    /// within the plate's original thickness (m): the smallest distance
+    /// from the axis of a plate node there that is not pulverized.
+    pub fn hole_radius(&self) -> f64 {
+        let x = self.run.positions();
+        let h = self.setup.plate.length;
+        let points = self.run.material_points();
+        self.nodes(1)
+            .filter(|&i| x[i][2] >= -h && x[i][2] <= 0.0)
+            .filter(|&i| {
+                points
+                    .get(i)
+                    .and_then(|p| p.ceramic())
+                    .is_none_or(|v| v.pulverized.is_none())
+            })
+            .map(|i| (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt())
+            .fold(f64::INFINITY, f64::min)
+            .min(self.setup.plate.radius)
+    }
+
+    /// `(damaged_fraction, pulverized_fraction, max_damage)` of the plate.
+    pub fn damage(&self) -> (f64, f64, f64) {
+        let threshold = self
+            .ceramic()
+            .map_or(f64::INFINITY, RajendranGrove::damaged_threshold);
+        let (mut damaged, mut pulverized, mut total, mut max) = (0.0, 0.0, 0.0, 0.0f64);
+        for (g, p, m) in self.plate_damage() {
+            total += m;
+            if g >= threshold {
+                damaged += m;
+            }
+            if p {
+                pulverized += m;
+            }
+            max = max.max(g);
+        }
+        (damaged / total, pulverized / total, max)
+    }
+
+    /// Current values of [`PENETRATION_OBSERVABLES`], in that order.
+    pub fn observables(&self) -> Vec<f64> {
+        let e = self.energies();
+        let (damaged, pulverized, max) = self.damage();
+        let values = vec![
+            self.projectile_velocity(),
+            self.projectile_extent(),
+            self.projectile_clearance(),
+            self.hole_radius(),
+            damaged,
+            pulverized,
+            max,
+            e.kinetic,
+            e.internal,
+            e.contact,
+            e.smoothing,
+            e.error,
+            self.outcome() as u8 as f64,
+        ];
+        debug_assert_eq!(values.len(), PENETRATION_OBSERVABLES.len());
+        values
+    }
+
+    /// The node field `name` (one of [`PENETRATION_FIELDS`]).
+    pub fn field(&self, name: &str) -> Option<Vec<f64>> {
+        let n = self.particles();
+        let damage = || {
+            let points = self.run.material_points();
+            let c = self.ceramic();
+            (0..n).map(move |i| {
+                let vars = points.get(i).and_then(|p| p.ceramic());
+                (c, vars, self.run.group()[i])
+            })
+        };
+        Some(match name {
+            "body" => self.run.group().iter().map(|&g| g as f64).collect(),
+            "mass" => self.run.masses().to_vec(),
+            "damage" => damage()
+                .map(|(c, v, g)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => c.crack_density(v.crack_size),
+                    _ => 0.0,
+                })
+                .collect(),
+            "log10_damage" => damage()
+                .map(|(c, v, g)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => c
+                        .crack_density(v.crack_size)
+                        .log10()
+                        .max(crate::observe::LOG10_NO_CRACKS),
+                    _ => crate::observe::LOG10_NO_CRACKS,
+                })
+                .collect(),
+            "crack_size" => damage()
+                .map(|(_, v, g)| match v {
+                    Some(v) if g == 1 => v.crack_size,
+                    _ => 0.0,
+                })
+                .collect(),
+            "pulverized" => damage()
+                .map(|(_, v, _)| v.is_some_and(|v| v.pulverized.is_some()) as u8 as f64)
+                .collect(),
+            "porosity" => damage()
+                .map(|(_, v, _)| v.map_or(0.0, |v| v.porosity))
+                .collect(),
+            _ => return self.run.field(name),
+        })
+    }
+}
+
+/// The node fields of a penetration run: those of the 3-D solver, then the
+/// body of each node (0 projectile, 1 plate), the crack density γ, the
+/// pulverized flag, the porosity, the node mass, and, so that partial
+/// damage shows, log10 γ (floored at [`crate::LOG10_NO_CRACKS`],
+/// its value at the projectile's nodes) and the crack radius a (m; 0 at
+/// the projectile's nodes).
+pub const PENETRATION_FIELDS: &[FieldSpec] = &{
+    const fn scalar(
+        name: &'static str,
+        unit: &'static str,
+        component: &'static [&'static str],
+    ) -> FieldSpec {
+        FieldSpec {
+            name,
+            unit,
+            components: component,
+        }
+    }
+    let own = [
+        scalar("body", "1", &["body"]),
+        scalar("damage", "1", &["gamma"]),
+        scalar("pulverized", "bool", &["pulverized"]),
+        scalar("porosity", "1", &["f"]),
+        scalar("mass", "kg", &["m"]),
+        scalar("log10_damage", "1", &["log10_gamma"]),
+        scalar("crack_size", "m", &["a"]),
+    ];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 7];
+    let mut i = 0;
+    while i < out.len() {
+        out[i] = if i < MLPG_FIELDS.len() {
+            MLPG_FIELDS[i]
+        } else {
+            own[i - MLPG_FIELDS.len()]
+        };
+        i += 1;
+    }
+    out
+};
+
+impl crate::model::Model for Penetration {
+    crate::model::inherent_basics!();
+    fn field_specs(&self) -> &'static [FieldSpec] {
+        PENETRATION_FIELDS
+    }
+    /// 40 records over the run.
+    fn record_interval(&self) -> f64 {
+        self.setup.end_time / 40.0
+    }
+    fn min_spacing_ratio(&self) -> Option<f64> {
+        Some(self.run.min_spacing_ratio())
+    }
+    fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
+        let fresh: &Penetration = crate::model::same_solver(fresh)?;
+        if self.setup != fresh.setup {
+            return Err("its setup does not follow from its parameters".into());
+        }
+        self.run.check_restored(&fresh.run)
+    }
+    fn set_isa(&mut self, isa: crate::isa::Isa) {
+        self.run.set_isa(isa);
+    }
+}

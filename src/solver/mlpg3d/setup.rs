@@ -1,0 +1,229 @@
+//! The setup of a 3-D MLPG run: the rod and the solver's numerical
+//! choices ([`RodSetup`], [`WeakForm`]), the further bodies of a run of
+//! several ([`Body`]), and the defaults with the measurements behind them.
+
+use super::*;
+
+/// Default damping ratio ζ at the highest frequency `ω_max` of the
+/// stiffness-proportional damping: none, as in the seed. Measured (README,
+/// "3-D MLPG mixed method: the instability"): on the free bar ζ = 0.1
+/// slows the growth of the unstable modes (2.0 → 0.44 e-folds per period
+/// at 2 rings, 1.6 → 0.64 at 3) without removing it, as the remaining
+/// growth is in low modes (λ ≈ 2 % of λ_max); in `taylor3d` at 6 nodes
+/// across it dissipates 7.6 % of the impact energy and does not prevent
+/// the spacing collapse, while without it the energy error stays at 2.2 %.
+pub const DAMPING: f64 = 0.0;
+
+/// Default safety factor on the stable step of eq. (15).
+pub const SAFETY: f64 = 0.9;
+
+/// Relative motion of a named pair since the last build of the operator
+/// (`|Δ(x_i − x_j)| / |x_i − x_j|`) past which the shapes, test spheres
+/// and traction operator are rebuilt.
+/// 0.05: at 0.01 the plastic zone of `taylor3d` (strain rates near 1e5/s)
+/// rebuilds every step (270 s for 447 steps at 6 nodes across, against
+/// 99 s for 465 steps at 0.05; both runs stop early, at 27.7 and 28.6 µs,
+/// with rod lengths 34.56 and 34.51 mm).
+pub const REBUILD_STRAIN: f64 = 0.05;
+
+/// Default α of the velocity smoothing toward the MLS approximation at the
+/// node. The MLS approximation does not interpolate: a node can move
+/// relative to its neighbours by a motion the collocated gradients (eq. 4)
+/// barely see. Without smoothing `taylor3d` (6 nodes across) stops at
+/// 28.6 µs with the spacing collapsed to 0.1 on the axis at the face (the
+/// second node from the face 74 µm above the face centre, which had left
+/// the anvil, while the largest plastic strain is 0.95); measured α (Lf,
+/// face radius, energy error, smoothing work of 220 J): 0.02: at rest,
+/// 34.56 mm, 5.27 mm, 4.7 %, 4.2 J; 0.05: 34.59 mm, 5.20 mm, 2.5 %,
+/// 5.8 J; 0.1: 34.62 mm, 5.11 mm, 1.4 %, 8.7 J. The smoothing reproduces
+/// linear velocity fields, so it leaves uniform straining alone; 0.1 is
+/// chosen for the smallest energy error (README, "3-D MLPG").
+pub const SMOOTHING: f64 = 0.1;
+
+/// Default order of the velocity smoothing ([`RodSetup::smoothing_order`]):
+/// 1, the relaxation toward the MLS approximation.
+pub const SMOOTHING_ORDER: u32 = 1;
+
+/// A rod on the ring lattice at the instant of impact, and the solver's
+/// numerical choices.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RodSetup {
+    /// The rod (axis along z, impact face at z = 0).
+    pub cylinder: Cylinder,
+    /// Rings across the radius (radial spacing `R0 / rings`).
+    pub rings: usize,
+    /// Speed toward the anvil (m/s).
+    pub impact_speed: f64,
+    /// Damping ratio ζ at `ω_max` of the stiffness-proportional damping.
+    pub damping: f64,
+    /// Safety factor on the stable step.
+    pub safety: f64,
+    /// Latest simulated time (s).
+    pub end_time: f64,
+    /// See `REBUILD_STRAIN`.
+    pub rebuild_strain: f64,
+    /// α of the velocity smoothing `v ← v − α (I − Φ)^k v` after each
+    /// velocity update, with `(Φ v)_i = Σ_J φ_J(x_i) v_J` the MLS
+    /// approximation at the node ([`SMOOTHING`]). α is per step of the
+    /// seed's form; a form with a shorter stable step applies it in
+    /// proportion to its step ([`WeakForm::step_scale`]), so that the
+    /// smoothing per unit time does not depend on the form's step.
+    pub smoothing: f64,
+    /// The order of the smoothing (default 1): 1,
+    /// `v ← v − α H v` with `H = I − Φ`, relaxes each node toward the MLS
+    /// approximation; 2, `v ← v − α M⁻¹ Hᵀ M H v` (M the nodal masses), is
+    /// its symmetric square: it conserves momentum, only removes kinetic
+    /// energy, and damps smooth fields far less than the modes the shapes
+    /// cannot represent.
+    #[serde(default = "one")]
+    pub smoothing_order: u32,
+    /// β of the node shifting (`src/solver/mlpg3d/shift.rs`; the `taylor` scene's
+    /// `shifting`): pairs closer than `SHIFT_RANGE` of the initial
+    /// spacing push apart by up to β times the spacing per step
+    /// (`SHIFT_CAP` at most; both per step of the seed's form, as the
+    /// smoothing's α); 0 (the default): Lagrangian nodes.
+    #[serde(default)]
+    pub shifting: f64,
+    /// Height of the rod's face at impact (m): 0, on the anvil, for a
+    /// Taylor run; above the plate for a penetration run.
+    #[serde(default)]
+    pub base: f64,
+    /// The weak form of the forces ([`WeakForm`]; the seed's by default).
+    #[serde(default)]
+    pub weak_form: WeakForm,
+    /// The quarter model: only the nodes with `x ≥ 0`, `y ≥ 0`, with the
+    /// symmetry planes `x = 0` and `y = 0` by mirror images
+    /// (`src/approx/mirror.rs`); false (the default): the whole body.
+    #[serde(default)]
+    pub quarter: bool,
+    /// With the nodal form: gradients corrected to meet the integration
+    /// constraint at the surfaces (`src/approx/conform.rs`), so that a
+    /// uniform stress leaves every node off the surfaces in equilibrium.
+    /// The whole body only.
+    #[serde(default)]
+    pub conforming: bool,
+    /// The rod's lattice with its odd layers turned by half a node's angle
+    /// ([`NodeLattice::cylinder_with`]); false (the default): the layers
+    /// stand on the same radial lines.
+    #[serde(default)]
+    pub staggered: bool,
+    /// The shifting carries the velocities conservatively
+    /// (`solver::mlpg3d::shift::exchange`): a moved node's momentum increment is
+    /// drawn from the nodes around it, so that a shift changes the total
+    /// momentum by round-off only; false (the default): a moved node takes
+    /// the velocity of its new place (`solver::mlpg3d::shift::carry`). Either way
+    /// the kinetic energy a shift changes is booked with the smoothing's.
+    #[serde(default)]
+    pub conservative_carry: bool,
+}
+
+/// The weak form of the nodal forces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum WeakForm {
+    /// The seed's local weak form with the Heaviside test function over
+    /// each node's test sphere (eq. 10, [`TractionOperator`]), the sphere's
+    /// inertia `ρ V_s`.
+    #[default]
+    Sphere,
+    /// The nodal Galerkin form, the adjoint of the collocated gradients
+    /// (eq. 4; `src/approx/nodal.rs`), the nodal mass as inertia: it conserves
+    /// momentum and creates no energy, and node shifting also moves the
+    /// nodes of the mantle in its tangent plane and the face nodes held on
+    /// the anvil in its plane (README, "3-D MLPG mixed method").
+    Nodal,
+}
+
+impl WeakForm {
+    /// The ratio of this form's stable step to the seed's form's,
+    /// `OMEGA_FACTOR / κ` (1 for the sphere form, 0.78 for the nodal form):
+    /// the factor on the per-step rates, the smoothing's α and the
+    /// shifting's β and cap, so that they act at the same rate per unit
+    /// time in both forms.
+    pub fn step_scale(self) -> f64 {
+        OMEGA_FACTOR / self.omega_factor()
+    }
+
+    /// `κ` of its highest frequency, `ω_max = κ c_p / d_min`
+    /// (`src/approx/step.rs`, measured by power iteration on each form's
+    /// elastic operator).
+    pub fn omega_factor(self) -> f64 {
+        match self {
+            WeakForm::Sphere => OMEGA_FACTOR,
+            WeakForm::Nodal => OMEGA_FACTOR_NODAL,
+        }
+    }
+}
+
+impl RodSetup {
+    /// `κ` of the highest frequency of the forces chosen, `ω_max = κ c_p /
+    /// d_min`: the weak form's ([`WeakForm::omega_factor`]), or
+    /// [`OMEGA_FACTOR_CONFORMING`] with conforming gradients.
+    pub fn omega_factor(&self) -> f64 {
+        if self.conforming {
+            OMEGA_FACTOR_CONFORMING
+        } else {
+            self.weak_form.omega_factor()
+        }
+    }
+
+    /// The ratio of this setup's stable step to the seed's form's,
+    /// `OMEGA_FACTOR / κ`: the factor on the per-step rates (the
+    /// smoothing's α, the shifting's β and cap), so that they act at the
+    /// same rate per unit time whatever the step.
+    pub fn step_scale(&self) -> f64 {
+        OMEGA_FACTOR / self.omega_factor()
+    }
+
+    /// A rod with the default numerical choices ([`DAMPING`], [`SAFETY`],
+    /// [`REBUILD_STRAIN`]).
+    pub fn new(cylinder: Cylinder, rings: usize, impact_speed: f64, end_time: f64) -> Self {
+        RodSetup {
+            cylinder,
+            rings,
+            impact_speed,
+            damping: DAMPING,
+            safety: SAFETY,
+            end_time,
+            rebuild_strain: REBUILD_STRAIN,
+            smoothing: SMOOTHING,
+            smoothing_order: SMOOTHING_ORDER,
+            shifting: 0.0,
+            base: 0.0,
+            weak_form: WeakForm::Sphere,
+            quarter: false,
+            conforming: false,
+            staggered: false,
+            conservative_carry: false,
+        }
+    }
+}
+
+/// A further body of a run of several bodies (the first is the rod of the
+/// [`RodSetup`]): a cylinder on the ring lattice with its face at
+/// `z = base`, moving along z at `velocity`, of its own material.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Body {
+    /// The cylinder (axis along z).
+    pub cylinder: Cylinder,
+    /// Rings across its radius.
+    pub rings: usize,
+    /// Height of its face, its lowest layer (m).
+    pub base: f64,
+    /// Velocity along z at the start (m/s).
+    pub velocity: f64,
+    /// Its material.
+    pub material: Material,
+    /// Whether its rim is clamped: the nodes of its outer ring are held
+    /// still (their velocities zero, never shifted); a held node's
+    /// reaction does no work. Default: free.
+    #[serde(default)]
+    pub clamped_rim: bool,
+}
+
+pub(super) fn one() -> u32 {
+    1
+}
+
+pub(super) fn anvil_default() -> bool {
+    true
+}

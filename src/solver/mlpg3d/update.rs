@@ -1,0 +1,188 @@
+//! The material pass of step 5 (module docs of [`super`]): from the
+//! collocated velocity gradients, the rate of deformation and spin, the
+//! density `ρ (1 − dt tr D)` and the shared [`Material::update`] in the
+//! 3-D ([`Full`]) form, with each node's share of the step's energies and
+//! its checks; then the sums over the nodes in node order.
+
+use super::*;
+use crate::material::PointState;
+
+/// What the material pass reads.
+pub(super) struct MaterialInputs<'a> {
+    /// The step (s).
+    pub(super) dt: f64,
+    /// The damping time `c` of the viscous stress (s).
+    pub(super) damping_time: f64,
+    /// The rod's material, the further bodies and each node's body.
+    pub(super) rod: &'a Material,
+    pub(super) others: &'a [Body],
+    pub(super) group: &'a [u8],
+    pub(super) mass: &'a [f64],
+    pub(super) vel: &'a [[f64; 3]],
+    /// The velocity gradient `L = ∂v/∂x` at each node.
+    pub(super) grad: &'a [[[f64; 3]; 3]],
+}
+
+/// The node fields the material pass updates.
+pub(super) struct MaterialFields<'a> {
+    pub(super) dev: &'a mut [Full],
+    pub(super) pressure: &'a mut [f64],
+    pub(super) eps_p: &'a mut [f64],
+    pub(super) temp: &'a mut [f64],
+    pub(super) rho: &'a mut [f64],
+    /// The viscous stress of the damping, from this step's rate.
+    pub(super) visc: &'a mut [Full],
+    pub(super) states: &'a mut [PointState],
+}
+
+/// Updates every node's material and writes its sums of the step (or the
+/// first error met at it: the compression limit, a non-finite field) to
+/// `results`.
+pub(super) fn update_material(
+    input: &MaterialInputs,
+    fields: MaterialFields,
+    results: &mut [std::result::Result<Tally, (usize, Error)>],
+) {
+    let MaterialInputs {
+        dt,
+        damping_time: c,
+        rod: rod_material,
+        others,
+        group,
+        mass,
+        vel,
+        grad,
+    } = *input;
+    fields
+        .dev
+        .par_iter_mut()
+        .zip(fields.pressure.par_iter_mut())
+        .zip(fields.eps_p.par_iter_mut())
+        .zip(fields.temp.par_iter_mut())
+        .zip(fields.rho.par_iter_mut())
+        .zip(fields.visc.par_iter_mut())
+        .zip(fields.states.par_iter_mut())
+        .zip(results.par_iter_mut())
+        .enumerate()
+        .for_each(
+            |(i, (((((((dev, p), eps), temp), rho), visc), state), out))| {
+                *out = (|| {
+                    let material = material_of(rod_material, others, group, i);
+                    let l = &grad[i];
+                    let d = |a: usize, b: usize| 0.5 * (l[a][b] + l[b][a]);
+                    let w = |a: usize, b: usize| 0.5 * (l[a][b] - l[b][a]);
+                    let rate: Full = [d(0, 0), d(1, 1), d(2, 2), d(0, 1), d(1, 2), d(2, 0)];
+                    let tr = rate[0] + rate[1] + rate[2];
+                    let rho_new = *rho * (1.0 - dt * tr);
+                    let load = Loading {
+                        dt,
+                        rate,
+                        spin: [w(0, 1), w(1, 2), w(2, 0)],
+                        density: rho_new,
+                    };
+                    let before = Point {
+                        deviator: *dev,
+                        pressure: *p,
+                        plastic_strain: *eps,
+                        temperature: *temp,
+                    };
+                    let new = material.update(&load, &before, state).map_err(|l| {
+                        (
+                            i,
+                            Error::CompressionLimit {
+                                particle: i,
+                                time: 0.0,
+                                compression: l.compression,
+                                limit: l.limit,
+                            },
+                        )
+                    })?;
+                    let stress = |s: &Full, p: f64| -> Full {
+                        [s[0] - p, s[1] - p, s[2] - p, s[3], s[4], s[5]]
+                    };
+                    let mid: Full = {
+                        let (a, b) = (stress(dev, *p), stress(&new.deviator, new.pressure));
+                        std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
+                    };
+                    let volume = mass[i] / rho_new;
+                    let bulk = material.eos.bulk_modulus(rho_new, new.pressure);
+                    let mu = material.shear_modulus;
+                    let v: Full = std::array::from_fn(|k| {
+                        let dev_rate = if k < 3 { rate[k] - tr / 3.0 } else { rate[k] };
+                        let vol = if k < 3 { bulk * tr } else { 0.0 };
+                        c * (vol + 2.0 * mu * dev_rate)
+                    });
+                    let t = Tally {
+                        internal: dt * volume * mid.double_dot(&rate),
+                        plastic: volume * new.deviator.von_mises() * (new.plastic_strain - *eps),
+                        damping: dt * volume * v.double_dot(&rate),
+                        kinetic: kinetic1(vel[i], mass[i]),
+                        momentum: mass[i] * vel[i][2],
+                        mass: mass[i],
+                        worst_speed: (material.wave_modulus(rho_new, new.pressure, state)
+                            / rho_new)
+                            .sqrt()
+                            + norm(vel[i]),
+                    };
+                    *dev = new.deviator;
+                    *p = new.pressure;
+                    *eps = new.plastic_strain;
+                    *temp = new.temperature;
+                    *rho = rho_new;
+                    *visc = v;
+                    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+                    let bad = if !finite(&vel[i]) {
+                        Some("velocity")
+                    } else if !rho_new.is_finite() {
+                        Some("density")
+                    } else if !finite(dev) || !p.is_finite() {
+                        Some("stress")
+                    } else if !temp.is_finite() {
+                        Some("temperature")
+                    } else {
+                        None
+                    };
+                    if let Some(field) = bad {
+                        return Err((
+                            i,
+                            Error::NonFinite {
+                                field,
+                                particle: i,
+                                time: 0.0,
+                            },
+                        ));
+                    }
+                    Ok(t)
+                })();
+            },
+        );
+}
+
+/// The sums of the step over the nodes, on the pool in the fixed order of
+/// [`crate::approx::sums`] (the same bits for any number of threads), or the
+/// first node's error at `time`.
+pub(super) fn sum(
+    results: &[std::result::Result<Tally, (usize, Error)>],
+    time: f64,
+) -> Result<Tally> {
+    let add = |t: Tally, s: &Tally| Tally {
+        internal: t.internal + s.internal,
+        plastic: t.plastic + s.plastic,
+        damping: t.damping + s.damping,
+        kinetic: t.kinetic + s.kinetic,
+        momentum: t.momentum + s.momentum,
+        mass: t.mass + s.mass,
+        worst_speed: t.worst_speed.max(s.worst_speed),
+    };
+    crate::approx::sums::ordered(
+        results.len(),
+        || Ok(Tally::default()),
+        |t, i| {
+            let s = results[i]
+                .as_ref()
+                .map_err(|(_, e)| at_time(e.clone(), time))?;
+            Ok(add(t?, s))
+        },
+        |a: Result<Tally>, b| Ok(add(a?, &b?)),
+    )
+}

@@ -1,0 +1,98 @@
+//! Small helpers of the 3-D solver's passes: the material of a node, the
+//! quarter model's extended fields, the symmetry planes' pin, kinetic
+//! energy.
+
+use super::*;
+
+/// The material of node `i`: the rod's, or that of its body in `others`.
+#[inline]
+pub(super) fn material_of<'a>(
+    rod: &'a Material,
+    others: &'a [Body],
+    group: &[u8],
+    i: usize,
+) -> &'a Material {
+    match group.get(i) {
+        Some(&g) if g > 0 => &others[g as usize - 1].material,
+        _ => rod,
+    }
+}
+
+/// `real` itself for the whole body; in the quarter model `real` and its
+/// images' values (`reflect`), written into `buf`.
+pub(super) fn extended<'a, T: Copy>(
+    m: &Mirror,
+    real: &'a [T],
+    buf: &'a mut Vec<T>,
+    reflect: impl Fn(&T, u8) -> T,
+) -> &'a [T] {
+    if m.is_empty() {
+        real
+    } else {
+        m.extend(real, buf, reflect);
+        buf
+    }
+}
+
+/// The velocity of a node on the symmetry planes `on` (bits
+/// [`mirror::X`], [`mirror::Y`]): no component across them.
+#[inline]
+pub(super) fn pin(v: &mut [f64; 3], on: u8) {
+    if on & mirror::X != 0 {
+        v[0] = 0.0;
+    }
+    if on & mirror::Y != 0 {
+        v[1] = 0.0;
+    }
+}
+
+pub(super) fn kinetic1(v: [f64; 3], m: f64) -> f64 {
+    0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+}
+
+/// The kinetic energy of the nodes, summed on the pool in the fixed order
+/// of [`crate::approx::sums`].
+pub(super) fn kinetic(v: &[[f64; 3]], m: &[f64]) -> f64 {
+    crate::approx::sums::sum(v.len().min(m.len()), |i| kinetic1(v[i], m[i]))
+}
+
+pub(super) fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// The error `e` met at a node, stamped with the run's `time` (the passes
+/// over the nodes and the builds of the geometry do not know the time).
+pub(super) fn at_time(e: Error, time: f64) -> Error {
+    match e {
+        Error::NonFinite {
+            field, particle, ..
+        } => Error::NonFinite {
+            field,
+            particle,
+            time,
+        },
+        Error::CompressionLimit {
+            particle,
+            compression,
+            limit,
+            ..
+        } => Error::CompressionLimit {
+            particle,
+            time,
+            compression,
+            limit,
+        },
+        Error::SingularMomentMatrix {
+            method,
+            particle,
+            condition,
+            ..
+        } => Error::SingularMomentMatrix {
+            method,
+            particle,
+            time,
+            condition,
+        },
+        e => e,
+    }
+}
