@@ -94,10 +94,10 @@ mod neighbours;
 mod observe;
 mod params;
 mod rod;
-mod run;
 mod scene;
 mod sim;
 mod solver;
+mod state_format;
 #[cfg(test)]
 mod test_rng;
 
@@ -111,7 +111,6 @@ pub use observe::{
 };
 pub use params::{Level, ParamSpec, Range};
 pub use rod::{profile_deviation, profile_radius};
-pub use run::ENERGY_ERROR_BOUND;
 pub use scene::noh::NohParams;
 pub use scene::reference;
 pub use scene::table1::Table1Row;
@@ -119,7 +118,9 @@ pub use scene::taylor::TaylorParams;
 pub use scene::taylor3d::{Taylor3dParams, axisymmetric_twin};
 pub use scene::{Scene, SceneKind, builtin_names};
 pub use sim::{Progress, Simulation};
+pub use solver::shared::ENERGY_ERROR_BOUND;
 pub use solver::uniaxial::{FreeSurfaceReading, Layer, PLATE_IMPACT_FIELDS, PlateImpact};
+pub use state_format::FORMAT as STATE_FORMAT;
 
 /// Material models and their composition into a [`Material`](materials::Material):
 /// an equation of state ([`Eos`](materials::Eos)), a strength model
@@ -170,17 +171,17 @@ pub mod internals {
         pub use crate::approx::weak::TractionOperator;
         pub use crate::approx::weak::VOIGT;
         pub use crate::scene::penetration::penetration;
+        pub use crate::solver::mlpg3d::SMOOTHING;
         pub use crate::solver::mlpg3d::penetration::{Penetration, PenetrationSetup};
         pub use crate::solver::mlpg3d::scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
         pub use crate::solver::mlpg3d::{Body, Mlpg3d, RodSetup};
-        pub use crate::solver::mlpg3d::{SMOOTHING, WeakForm};
     }
     pub use crate::approx::msph::{Neighbourhood, Row2};
     pub use crate::kernel::kernel2;
     pub use crate::lanes::W;
     pub use crate::neighbours::{cell_list, naive, padded_rows};
-    pub use crate::run::SPACING_COLLAPSE_BOUND;
     pub use crate::solver::axisymmetric::TaylorSolver;
+    pub use crate::solver::shared::SPACING_COLLAPSE_BOUND;
 }
 
 /// The library version (the crate version).

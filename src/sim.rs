@@ -75,6 +75,8 @@ impl Clone for Simulation {
 /// [`Simulation::serialize_state`], postcard inside the FMU state.
 #[derive(serde::Serialize)]
 struct SavedRef<'a> {
+    /// [`crate::state_format::FORMAT`].
+    format: u32,
     scene: &'a Scene,
     solver: SolverRef<'a>,
     history: &'a History,
@@ -86,6 +88,7 @@ struct SavedRef<'a> {
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Saved {
+    format: u32,
     scene: Scene,
     solver: SolverState,
     history: History,
@@ -208,6 +211,7 @@ impl serde::Serialize for Simulation {
         serializer: S,
     ) -> std::result::Result<S::Ok, S::Error> {
         SavedRef {
+            format: crate::state_format::FORMAT,
             scene: &self.scene,
             solver: SolverRef(self.scene.kind(), self.solver.as_ref()),
             history: &self.history,
@@ -227,6 +231,14 @@ impl<'de> serde::Deserialize<'de> for Simulation {
     ) -> std::result::Result<Self, D::Error> {
         use serde::de::Error as _;
         let saved = Saved::deserialize(deserializer)?;
+        if saved.format != crate::state_format::FORMAT {
+            return Err(D::Error::custom(format!(
+                "its format {} is not this build's {} (a state of an older format is read by \
+                 Simulation::deserialize_state)",
+                saved.format,
+                crate::state_format::FORMAT
+            )));
+        }
         let kind = saved.scene.kind();
         let SolverState(solver_kind, solver) = saved.solver;
         // The key names the row; the material choice is the scene's, and
@@ -252,7 +264,7 @@ impl Simulation {
         scene.validate()?;
         let solver = (scene.kind().row().build)(&scene)?;
         let record_interval = solver.record_interval();
-        crate::run::check_derived("record interval", record_interval, "")?;
+        crate::solver::shared::check_derived("record interval", record_interval, "")?;
         let mut sim = Simulation {
             history: History::new(scene.kind().observable_specs()),
             observed: Observed::new(scene.kind()),
@@ -460,13 +472,19 @@ impl Simulation {
         serde_json::to_vec(self).expect("the state holds only finite numbers")
     }
 
-    /// Restores a run from [`Simulation::serialize_state`] bytes.
-    /// The state is checked as a new run is, and refused with
+    /// Restores a run from [`Simulation::serialize_state`] bytes, of this
+    /// build's format ([`crate::STATE_FORMAT`]) or an older one, which is
+    /// brought up to this one first; a newer or unknown format is refused
+    /// with [`Error::InvalidState`], naming it. The state is checked as a new run is, and refused with
     /// [`Error::InvalidState`] unless it is one that a run of its scene can
     /// reach: see [`Simulation::check_restored`].
     pub fn deserialize_state(bytes: &[u8]) -> Result<Self> {
-        let sim: Simulation =
-            serde_json::from_slice(bytes).map_err(|e| Error::InvalidState(e.to_string()))?;
+        let invalid = |e: String| Error::InvalidState(e);
+        let mut saved: serde_json::Value =
+            serde_json::from_slice(bytes).map_err(|e| invalid(e.to_string()))?;
+        crate::state_format::upgrade(&mut saved)
+            .map_err(|e| invalid(format!("the state cannot be read: {e}")))?;
+        let sim: Simulation = serde_json::from_value(saved).map_err(|e| invalid(e.to_string()))?;
         sim.check_restored()
             .map_err(|e| Error::InvalidState(format!("the state is not valid: {e}")))?;
         Ok(sim)

@@ -140,33 +140,29 @@ fn tungsten() -> Material {
 
 fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
     let setup = PenetrationSetup {
-        projectile: Cylinder {
-            radius: 5e-3,
-            length: 10e-3,
-        },
         plate: Cylinder {
             radius: 40e-3,
             length: 5e-3,
         },
-        impact_speed: 1500.0,
-        rings,
-        end_time,
         until_outcome: false,
         clamped_rim: false,
     };
-    let mut numerics = RodSetup::new(setup.projectile, rings, 1500.0, end_time);
-    numerics.smoothing = smoothing;
-    numerics.shifting = std::env::var("MI_SHIFT")
+    let projectile = Cylinder {
+        radius: 5e-3,
+        length: 10e-3,
+    };
+    let mut numerics = RodSetup::new(projectile, rings, 1500.0, end_time);
+    numerics.scheme.smoothing = smoothing;
+    numerics.scheme.shifting = std::env::var("MI_SHIFT")
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0.0);
     if std::env::var("MI_WEAK").is_ok_and(|w| w == "1") {
-        numerics.weak_form = meshless_impact::internals::mlpg::WeakForm::Nodal;
+        numerics.scheme.forces = meshless_impact::internals::mlpg::Forces::Nodal;
     }
-    numerics.smoothing_order = std::env::var("MI_ORDER")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
+    if std::env::var("MI_ORDER").is_ok_and(|o| o == "2") {
+        numerics.scheme.order = meshless_impact::internals::mlpg::SmoothingOrder::Two;
+    }
     numerics.quarter = std::env::var("MI_QUARTER").is_ok_and(|w| w == "1");
     Penetration::new(
         setup,

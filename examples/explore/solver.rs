@@ -3,7 +3,7 @@
 
 use crate::rod::*;
 use meshless_impact::internals::mlpg::{
-    Cylinder, Mlpg3d, Penetration, RodSetup, Surfaces, WeakForm, penetration,
+    Cylinder, Forces, Mlpg3d, Penetration, RodSetup, Surfaces, penetration,
 };
 use meshless_impact::{Scene, Taylor3dParams};
 
@@ -24,13 +24,13 @@ pub fn explore_elastic_rebound() {
     let mut setup = RodSetup::new(cyl, rings, 10.0, 40e-6);
     setup.damping = zeta;
     if let Ok(w) = std::env::var("WEAK") {
-        setup.weak_form = match w.as_str() {
-            "0" => WeakForm::Sphere,
-            _ => WeakForm::Nodal,
+        setup.scheme.forces = match w.as_str() {
+            "0" => Forces::Sphere,
+            _ => Forces::Nodal,
         };
     }
     if let Ok(a) = std::env::var("ALPHA") {
-        setup.smoothing = a.parse().unwrap();
+        setup.scheme.smoothing = a.parse().unwrap();
     }
     let every: usize = std::env::var("EVERY")
         .map(|s| s.parse().unwrap())
@@ -482,7 +482,7 @@ pub fn explore_energy_jump() {
 pub fn explore_contact_by_rings() {
     let rings = std::env::var("RINGS").unwrap_or_else(|_| "5,7,9".into());
     for rings in rings.split(',').map(|r| r.parse::<usize>().unwrap()) {
-        for form in [WeakForm::Sphere, WeakForm::Nodal] {
+        for form in [Forces::Sphere, Forces::Nodal] {
             for alpha in [meshless_impact::internals::mlpg::SMOOTHING, 0.0] {
                 let (s, passing, unloaded) = elastic_rebound_with(rings, alpha, form);
                 let [front, contact, length] = rebound_errors(&s, passing);

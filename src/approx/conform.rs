@@ -610,9 +610,9 @@ pub fn conform(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::approx::nodal::NodalOperator;
     use crate::approx::lattice::{Cylinder, NodeLattice};
     use crate::approx::mls::{SupportParams, Supports};
+    use crate::approx::nodal::NodalOperator;
 
     /// The largest force on a node off the surfaces under a uniform stress
     /// (1 Pa in every component), relative to a face node's load `Δ²`.

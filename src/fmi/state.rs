@@ -758,7 +758,7 @@ mod tests {
         // A NaN or an infinity in place of the internal energy (postcard
         // holds them; JSON cannot).
         let energy =
-            fmu.state_to_json(&bytes).unwrap()["sim"]["solver"]["Taylor3d"]["internal_energy"]
+            fmu.state_to_json(&bytes).unwrap()["sim"]["solver"]["Taylor3d"]["energy"]["internal"]
                 .as_f64()
                 .unwrap();
         assert!(energy > 0.0);

@@ -323,22 +323,18 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     let plate_material = ceramic_material(v)?;
     let end_time = v("end_time")?;
     let setup = PenetrationSetup {
-        projectile,
         plate,
-        impact_speed: v("impact_speed")?,
-        rings,
-        end_time,
         until_outcome: v("run_until")? >= 0.5,
         clamped_rim: v("plate_rim")? >= 0.5,
     };
-    let mut numerics = RodSetup::new(projectile, rings, setup.impact_speed, end_time);
+    let mut numerics = RodSetup::new(projectile, rings, v("impact_speed")?, end_time);
     numerics.damping = DAMPING;
     numerics.rebuild_strain = REBUILD_STRAIN;
     numerics.quarter = quarter;
     // Two free bodies conserve momentum, and so does the shifting's carry
     // here (issue 50; README, "Ballistic penetration").
     numerics.conservative_carry = true;
-    MlpgScheme::decode(v)?.apply(&mut numerics);
+    numerics.scheme = MlpgScheme::decode(v)?;
     Ok((setup, (projectile_material, plate_material), numerics))
 }
 
@@ -346,7 +342,7 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
 mod tests {
     use super::*;
     use crate::material::presets::Preset;
-    use crate::solver::mlpg3d::WeakForm;
+    use crate::solver::mlpg3d::scheme::{Forces, SmoothingOrder};
 
     /// The projectile's defaults are the preset `tungsten_seed`, by value.
     #[test]
@@ -393,9 +389,9 @@ mod tests {
         let (setup, (projectile, plate), numerics) = setup(&s).unwrap();
         let run = Penetration::new(setup, projectile, plate, numerics).unwrap();
         let chosen = run.run().setup();
-        assert_eq!(chosen.weak_form, WeakForm::Nodal);
-        assert_eq!(chosen.smoothing_order, 2);
-        assert_eq!(chosen.smoothing, 0.3);
+        assert_eq!(chosen.scheme.forces, Forces::Nodal);
+        assert_eq!(chosen.scheme.order, SmoothingOrder::Two);
+        assert_eq!(chosen.scheme.smoothing, 0.3);
         assert_eq!(chosen.impact_speed, 1500.0);
     }
 

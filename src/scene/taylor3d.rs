@@ -400,7 +400,7 @@ impl Taylor3dParams {
         s.damping = self.damping;
         s.rebuild_strain = self.rebuild_strain;
         s.quarter = self.symmetry >= 0.5;
-        self.scheme()?.apply(&mut s);
+        s.scheme = self.scheme()?;
         Ok(s)
     }
 

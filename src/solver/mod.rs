@@ -7,6 +7,7 @@
 pub mod axisymmetric;
 pub mod mlpg3d;
 pub mod radial;
+pub mod shared;
 pub mod uniaxial;
 
 /// Courant number of eq. (3.22).

@@ -43,8 +43,8 @@ use crate::kernel::kernel1;
 use crate::material::ideal_gas::IdealGas;
 use crate::neighbours::{NeighbourList, cell_list};
 use crate::observe::{FieldSpec, NOH_OBSERVABLES};
-use crate::run::{check_derived, check_time_step, first_non_finite};
 use crate::solver::setup_struct;
+use crate::solver::shared::{Clock, EnergyBook, check_derived, first_non_finite};
 use rayon::prelude::*;
 
 /// Window `(r_min, r_max)` of `post_shock_density`.
@@ -112,11 +112,10 @@ pub struct NohSolver {
     signal: Vec<f64>,
     /// Divergence of the velocity, for the volume-change limit on the step.
     div: Vec<f64>,
-    time: f64,
-    steps: u64,
-    dt: f64,
-    dt0: f64,
-    initial_energy: f64,
+    clock: Clock,
+    /// The impact's kinetic energy; the internal energy is summed from the
+    /// particles when asked.
+    energy: EnergyBook<0>,
 }
 
 impl NohSolver {
@@ -147,16 +146,12 @@ impl NohSolver {
             r,
             v,
             mass,
-            time: 0.0,
-            steps: 0,
-            dt: 0.0,
-            dt0: 0.0,
-            initial_energy,
+            clock: Clock::default(),
+            energy: EnergyBook::new(initial_energy),
             p,
         };
-        s.dt = s.stable_dt();
-        check_derived("time step", s.dt, "")?;
-        s.dt0 = s.dt;
+        s.clock = Clock::start(s.stable_dt());
+        check_derived("time step", s.clock.dt, "")?;
         Ok(s)
     }
 
@@ -170,21 +165,21 @@ impl NohSolver {
     /// follows from the parameters must be the same bits, and every field
     /// one finite value per particle.
     pub(crate) fn check_restored(&self, fresh: &NohSolver) -> std::result::Result<(), String> {
-        use crate::run::json;
+        use crate::solver::shared::json;
         if json(&(
             &self.p,
             &self.gas,
             self.h,
             &self.mass,
-            self.dt0,
-            self.initial_energy,
+            self.clock.dt0,
+            self.energy.initial,
         )) != json(&(
             &fresh.p,
             &fresh.gas,
             fresh.h,
             &fresh.mass,
-            fresh.dt0,
-            fresh.initial_energy,
+            fresh.clock.dt0,
+            fresh.energy.initial,
         )) {
             return Err("its lattice, masses or gas do not follow from its parameters".into());
         }
@@ -212,27 +207,27 @@ impl NohSolver {
         }
         // Each step ends by taking the next one from the fields, so a
         // restored step is at most the stable one of its fields.
-        let stable = self.dt > 0.0 && self.dt <= self.stable_dt() * (1.0 + 1e-9);
-        if !(self.time.is_finite() && self.time >= 0.0 && stable) {
+        let stable = self.clock.dt > 0.0 && self.clock.dt <= self.stable_dt() * (1.0 + 1e-9);
+        if !(self.clock.time.is_finite() && self.clock.time >= 0.0 && stable) {
             return Err(format!(
                 "its clock (t = {}, dt = {}) is not valid",
-                self.time, self.dt
+                self.clock.time, self.clock.dt
             ));
         }
-        if (self.steps == 0) != (self.time == 0.0) {
+        if (self.clock.steps == 0) != (self.clock.time == 0.0) {
             return Err(format!(
                 "its step count {} does not match its time {}",
-                self.steps, self.time
+                self.clock.steps, self.clock.time
             ));
         }
         Ok(())
     }
 
-    crate::run::clock_getters!();
+    crate::solver::shared::clock_getters!();
 
     /// Whether `end_time` has been reached.
     pub fn finished(&self) -> bool {
-        self.time >= self.p.end_time
+        self.clock.time >= self.p.end_time
     }
 
     fn stable_dt(&self) -> f64 {
@@ -279,14 +274,14 @@ impl NohSolver {
                 Ok(())
             })
             .collect();
-        first_degenerate(status, self.time)?;
+        first_degenerate(status, self.clock.time)?;
         Ok(w)
     }
 
     /// Advances one step (the last one is shortened to land on `end_time`).
     pub fn step(&mut self) -> Result<()> {
         let n = self.particles();
-        let dt = self.dt.min(self.p.end_time - self.time);
+        let dt = self.clock.dt.min(self.p.end_time - self.clock.time);
         let alpha = self.p.smoothing_coefficient;
         let (r, src) = self.with_mirror();
         let mirrored = |f: &[f64], sign: f64| -> Vec<[f64; 1]> {
@@ -393,8 +388,8 @@ impl NohSolver {
             self.r[i] += dt * vs[i];
         }
         self.v = vs;
-        self.time += dt;
-        self.steps += 1;
+        self.clock.time += dt;
+        self.clock.steps += 1;
         if let Some((field, i)) = first_non_finite(&[
             ("radius", &self.r),
             ("velocity", &self.v),
@@ -404,19 +399,19 @@ impl NohSolver {
             return Err(Error::NonFinite {
                 field,
                 particle: i,
-                time: self.time,
+                time: self.clock.time,
             });
         }
         if let Some(i) = (1..n).find(|&i| self.r[i] <= 0.0) {
             return Err(Error::ThroughBoundary {
                 particle: i,
                 boundary: "axis",
-                time: self.time,
+                time: self.clock.time,
                 position: self.r[i],
             });
         }
-        self.dt = self.stable_dt();
-        check_time_step(self.dt, self.dt0, self.time)?;
+        self.clock.dt = self.stable_dt();
+        self.clock.check_step(self.clock.dt)?;
         Ok(())
     }
 
@@ -431,7 +426,7 @@ impl NohSolver {
 
     /// Current values of [`NOH_OBSERVABLES`], in that order.
     pub fn observables(&self) -> Vec<f64> {
-        let t = self.time;
+        let t = self.clock.time;
         let n = self.particles();
         // Shock: outermost particle whose density reaches the mean of the exact
         // pre- and post-shock values, interpolated to the crossing.
@@ -495,7 +490,7 @@ impl NohSolver {
             l1,
             ke,
             ie,
-            (ke + ie - self.initial_energy).abs() / self.initial_energy,
+            self.energy.error_given(ke, ie),
         ];
         debug_assert_eq!(values.len(), NOH_OBSERVABLES.len());
         values

@@ -8,7 +8,7 @@ mod rod;
 use rod::*;
 
 use meshless_impact::Scene;
-use meshless_impact::internals::mlpg::{Mlpg3d, RodSetup, WeakForm};
+use meshless_impact::internals::mlpg::{Forces, Mlpg3d, RodSetup};
 use meshless_impact::materials::{Bilinear, Strength};
 
 /// An elastic rod (R0 = 2 mm, L0 = 20 mm, 4340 steel without yield) hit
@@ -90,7 +90,7 @@ fn the_default_rebounds_on_time_with_the_energy_within_one_percent_from_7_rings(
 #[test]
 fn the_nodal_form_rebounds_with_the_energy_within_one_percent() {
     for alpha in [meshless_impact::internals::mlpg::SMOOTHING, 0.0] {
-        let (s, passing, _) = elastic_rebound_with(5, alpha, WeakForm::Nodal);
+        let (s, passing, _) = elastic_rebound_with(5, alpha, Forces::Nodal);
         let [front, contact, length] = rebound_errors(&s, passing);
         let e = s.energies();
         println!(
@@ -163,7 +163,7 @@ fn the_anvils_pressure_ends_with_the_axisymmetric_solvers_contact() {
         reference * 1e6,
         2.0 * ROD.length / cbar * 1e6
     );
-    for form in [WeakForm::Sphere, WeakForm::Nodal] {
+    for form in [Forces::Sphere, Forces::Nodal] {
         for alpha in [meshless_impact::internals::mlpg::SMOOTHING, 0.0] {
             let (s, _, unloaded) = elastic_rebound_with(5, alpha, form);
             println!(
@@ -171,7 +171,7 @@ fn the_anvils_pressure_ends_with_the_axisymmetric_solvers_contact() {
                 unloaded * 1e6,
                 s.last_release() * 1e6
             );
-            let bound = if form == WeakForm::Sphere && alpha == 0.0 {
+            let bound = if form == Forces::Sphere && alpha == 0.0 {
                 0.02
             } else {
                 0.01

@@ -110,12 +110,12 @@ fn forged_taylor_states_are_refused() {
         ),
         (
             "a zero time step",
-            |s| solver(s, "Taylor")["dt"] = json!(0.0),
+            |s| solver(s, "Taylor")["clock"]["dt"] = json!(0.0),
             "clock",
         ),
         (
             "steps reset at a later time",
-            |s| solver(s, "Taylor")["steps"] = json!(0),
+            |s| solver(s, "Taylor")["clock"]["steps"] = json!(0),
             "step count",
         ),
         (
@@ -314,17 +314,17 @@ fn forged_taylor3d_states_are_refused() {
         ),
         (
             "a zero time step",
-            |s| solver(s, "Taylor3d")["dt"] = json!(0.0),
+            |s| solver(s, "Taylor3d")["clock"]["dt"] = json!(0.0),
             "clock",
         ),
         (
             "a time step of seconds",
-            |s| solver(s, "Taylor3d")["dt"] = json!(1.0),
+            |s| solver(s, "Taylor3d")["clock"]["dt"] = json!(1.0),
             "clock",
         ),
         (
             "steps reset at a later time",
-            |s| solver(s, "Taylor3d")["steps"] = json!(0),
+            |s| solver(s, "Taylor3d")["clock"]["steps"] = json!(0),
             "step count",
         ),
         (

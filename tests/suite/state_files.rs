@@ -3,9 +3,10 @@
 //! load into this build and go on to the bits of a run that was never
 //! interrupted: clock, every observable, every field and the histories.
 //!
-//! `v1/` is the layout of the states saved up to 2026-11-29 (no `format`
-//! key; each solver's fields flat under its kind's key), written at commit
-//! 1e8cb70 by `record_states` below.
+//! `v1/` is format 1, the layout of the states saved up to 2026-11-29 (no
+//! `format` key; each solver's fields flat under its kind's key), written
+//! at commit 1e8cb70 by `record_states` below; `v2/` is format 2
+//! (`src/state_format.rs`), written when it was introduced.
 
 use crate::common::bits;
 use meshless_impact::{Scene, Simulation};
@@ -83,12 +84,19 @@ fn scene(case: &Case) -> Scene {
     scene
 }
 
-/// Each state of layout `v1` loads, is the run at its time bit for bit, and
-/// goes on to the bits of the uninterrupted run.
+/// The folders of committed states, one a format.
+const FORMATS: &[&str] = &["v1", "v2"];
+
+/// Each committed state of every format loads, is the run at its time bit
+/// for bit, and goes on to the bits of the uninterrupted run.
 #[test]
-fn states_of_the_first_layout_load_and_continue_to_the_same_bits() {
-    for case in CASES {
-        let path = folder("v1").join(case.file);
+fn states_of_every_format_load_and_continue_to_the_same_bits() {
+    for case in CASES
+        .iter()
+        .flat_map(|c| FORMATS.iter().map(move |f| (f, c)))
+    {
+        let (format, case) = case;
+        let path = folder(format).join(case.file);
         let bytes = std::fs::read(&path).unwrap();
         let mut back = Simulation::deserialize_state(&bytes)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));

@@ -1,9 +1,10 @@
 //! What a Taylor run reports: its observables, its particle fields and the
 //! rod's particle sets.
 
-use super::{TaylorSolver, kinetic};
+use super::{LOST_CONTACT, LOST_SMOOTHING, TaylorSolver, kinetic};
 use crate::observe::{FieldSpec, TAYLOR_OBSERVABLES};
 use crate::rod::{self, RodSets};
+use crate::solver::shared::SolidNodes;
 
 impl TaylorSolver {
     fn kinetic_energy(&self) -> f64 {
@@ -17,10 +18,7 @@ impl TaylorSolver {
     /// The energy error with the kinetic energy given (the update pass sums
     /// it in chunks).
     pub(super) fn energy_error_with(&self, kinetic: f64) -> f64 {
-        (kinetic + self.internal_energy + self.smoothing_dissipation + self.contact_dissipation
-            - self.initial_energy)
-            .abs()
-            / self.initial_energy
+        self.energy.error(kinetic)
     }
 
     /// The centre-of-mass axial velocity toward the anvil.
@@ -70,9 +68,9 @@ impl TaylorSolver {
             "max_plastic_strain" => self.eps_p.iter().copied().fold(0.0, f64::max),
             "max_temperature" => self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max),
             "kinetic_energy" => self.kinetic_energy(),
-            "internal_energy" => self.internal_energy,
-            "smoothing_dissipation" => self.smoothing_dissipation,
-            "contact_dissipation" => self.contact_dissipation,
+            "internal_energy" => self.energy.internal,
+            "smoothing_dissipation" => self.energy.lost[LOST_SMOOTHING],
+            "contact_dissipation" => self.energy.lost[LOST_CONTACT],
             "energy_error" => self.energy_error(),
             "at_rest" => {
                 if self.at_rest {
@@ -88,21 +86,21 @@ impl TaylorSolver {
     /// The values of the particle field `name` (one of [`TAYLOR_FIELDS`]),
     /// interleaved per particle.
     pub fn field(&self, name: &str) -> Option<Vec<f64>> {
-        Some(match name {
-            "position" => self.pos.iter().flatten().copied().collect(),
-            "density" => self.rho.clone(),
-            "velocity" => self.vel.iter().flatten().copied().collect(),
-            "pressure" => self.pressure.clone(),
-            "stress" => self
-                .dev
+        SolidNodes {
+            pos: &self.pos,
+            vel: &self.vel,
+            rho: &self.rho,
+            pressure: &self.pressure,
+            eps_p: &self.eps_p,
+            temp: &self.temp,
+            contact: &self.contact,
+        }
+        .field(name, || {
+            self.dev
                 .iter()
                 .zip(&self.pressure)
                 .flat_map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3]])
-                .collect(),
-            "plastic_strain" => self.eps_p.clone(),
-            "temperature" => self.temp.clone(),
-            "in_contact" => self.contact.iter().map(|&c| c as u8 as f64).collect(),
-            _ => return None,
+                .collect()
         })
     }
 }

@@ -45,6 +45,8 @@ mod fields;
 mod mirror;
 mod neighbours;
 mod pairs;
+#[cfg(test)]
+mod pass_tests;
 mod passes;
 mod restore;
 pub mod scheme;
@@ -65,7 +67,12 @@ pub use setup::TaylorParams;
 use crate::isa::Isa;
 use crate::material::{Material, MaterialState};
 use crate::observe::FieldSpec;
-use crate::run::QuietEnd;
+use crate::solver::shared::{Clock, EnergyBook, QuietEnd};
+
+/// The place in the energy book of the kinetic energy the smoothing removed.
+const LOST_SMOOTHING: usize = 0;
+/// The place in the energy book of the kinetic energy lost on the anvil.
+const LOST_CONTACT: usize = 1;
 use crate::solver::COURANT;
 use crate::solver::axisymmetric::boundary::{Stress, Surface};
 use workspace::Workspace;
@@ -81,7 +88,7 @@ pub const SURFACE_BAND: f64 = 1.0;
 
 /// Distance from the axis, relative to the initial spacing, that a particle
 /// leaving it is moved to: its mirror image is then twice that away, above
-/// [`SPACING_COLLAPSE_BOUND`](crate::run::SPACING_COLLAPSE_BOUND).
+/// [`SPACING_COLLAPSE_BOUND`](crate::solver::shared::SPACING_COLLAPSE_BOUND).
 pub const AXIS_LEAVE: f64 = 0.1;
 
 /// State of a Taylor impact run.
@@ -92,7 +99,6 @@ pub struct TaylorSolver {
     /// Per-particle state of the material's models: its damage variables
     /// are saved (none for a material without damage), its caches rebuilt
     /// after a restore ([`MaterialState`]'s saved form).
-    #[serde(default)]
     material_state: MaterialState,
     nr: usize,
     nz: usize,
@@ -118,19 +124,14 @@ pub struct TaylorSolver {
     top: Surface,
     face: Surface,
     // Bookkeeping.
-    time: f64,
-    steps: u64,
-    dt: f64,
-    dt0: f64,
-    initial_energy: f64,
-    internal_energy: f64,
-    smoothing_dissipation: f64,
-    contact_dissipation: f64,
+    clock: Clock,
+    /// The impact's kinetic energy, the internal energy, and the losses to
+    /// the smoothing ([`LOST_SMOOTHING`]) and the anvil ([`LOST_CONTACT`]).
+    energy: EnergyBook<2>,
     at_rest: bool,
     /// The rest detector: the time since which the kinetic energy has
-    /// stayed at or below [`QUIET_FRACTION`](crate::run::QUIET_FRACTION) of
+    /// stayed at or below [`QUIET_FRACTION`](crate::solver::shared::QUIET_FRACTION) of
     /// the impact energy (`None` while it is above).
-    #[serde(default)]
     quiet_since: QuietEnd,
     /// Smallest spacing seen between neighbours, relative to the initial one.
     min_spacing: f64,
@@ -185,12 +186,12 @@ impl TaylorSolver {
         self.h
     }
 
-    crate::run::clock_getters!(dt);
+    crate::solver::shared::clock_getters!(dt);
 
     /// Whether the end condition holds: the rod is at rest, or `end_time` has
     /// been reached.
     pub fn finished(&self) -> bool {
-        self.at_rest || self.time >= self.p.end_time
+        self.at_rest || self.clock.time >= self.p.end_time
     }
 
     /// Smallest distance between neighbouring particles relative to the

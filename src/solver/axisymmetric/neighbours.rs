@@ -8,9 +8,9 @@ use super::{MIN_LEN, SKIN, TaylorSolver};
 use crate::kernel::SUPPORT;
 use crate::lanes::W;
 use crate::neighbours::padded_rows;
-use crate::run::SPACING_COLLAPSE_BOUND;
 use crate::solver::axisymmetric::pairs::PairPass;
 use crate::solver::axisymmetric::scheme::{MsphScheme, SmoothingOrder};
+use crate::solver::shared::SPACING_COLLAPSE_BOUND;
 
 impl TaylorSolver {
     /// Height above the anvil below which a particle counts as on it and has

@@ -1,9 +1,9 @@
 //! The checks of a restored Taylor run against a fresh one of the same
 //! parameters.
 
-use super::TaylorSolver;
+use super::{LOST_CONTACT, LOST_SMOOTHING, TaylorSolver};
 use crate::material::Damage;
-use crate::run::json;
+use crate::solver::shared::json;
 
 impl TaylorSolver {
     /// Checks a restored state against `fresh`, a new run of the same
@@ -35,8 +35,8 @@ impl TaylorSolver {
         )?;
         same(
             "first step and impact energy",
-            json(&(self.dt0, self.initial_energy)),
-            json(&(fresh.dt0, fresh.initial_energy)),
+            json(&(self.clock.dt0, self.energy.initial)),
+            json(&(fresh.clock.dt0, fresh.energy.initial)),
         )?;
         let n = fresh.particles();
         let lens = [
@@ -91,25 +91,19 @@ impl TaylorSolver {
             "temperatures",
             self.temp.iter().all(|&x| x.is_finite() && x > 0.0),
         )?;
-        crate::run::check_restored_clock(
-            self.time,
-            self.dt,
-            self.dt0,
-            self.steps,
-            &[
-                self.internal_energy,
-                self.smoothing_dissipation,
-                self.contact_dissipation,
-                self.min_spacing,
-                self.quiet_since.since().unwrap_or(0.0),
-            ],
-        )?;
+        self.clock.check_restored(&[
+            self.energy.internal,
+            self.energy.lost[LOST_SMOOTHING],
+            self.energy.lost[LOST_CONTACT],
+            self.min_spacing,
+            self.quiet_since.since().unwrap_or(0.0),
+        ])?;
         // Finite is not enough: a velocity of 1e300 overflows the energies.
         let fastest = |v: &[f64; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
-        let bounds = crate::run::RestoreBounds::new(
+        let bounds = crate::solver::shared::RestoreBounds::new(
             &fresh.pos,
             fresh.vel.iter().map(fastest).fold(0.0, f64::max) + fresh.wave_speed(),
-            self.time,
+            self.clock.time,
         );
         bounds.speeds("velocities", &self.vel)?;
         bounds.places("positions", &self.pos)?;

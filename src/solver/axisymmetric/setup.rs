@@ -9,9 +9,9 @@ use crate::error::{Error, Result};
 use crate::isa::Isa;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Material, MaterialState};
-use crate::run::{QuietEnd, check_derived};
 use crate::solver::axisymmetric::boundary::Surface;
 use crate::solver::setup_struct;
+use crate::solver::shared::{Clock, EnergyBook, QuietEnd, check_derived};
 
 setup_struct! {
     /// The parameters of a Taylor run that the solver keeps (SI units):
@@ -137,14 +137,8 @@ impl TaylorSolver {
             face,
             pos,
             mass,
-            time: 0.0,
-            steps: 0,
-            dt: 0.0,
-            dt0: 0.0,
-            initial_energy: 0.5 * total_mass * p.impact_speed * p.impact_speed,
-            internal_energy: 0.0,
-            smoothing_dissipation: 0.0,
-            contact_dissipation: 0.0,
+            clock: Clock::default(),
+            energy: EnergyBook::new(0.5 * total_mass * p.impact_speed * p.impact_speed),
             at_rest: false,
             quiet_since: QuietEnd::default(),
             min_spacing: 1.0,
@@ -153,9 +147,8 @@ impl TaylorSolver {
             p,
         };
         check_derived("wave speed", s.wave_speed(), " m/s")?;
-        s.dt = s.stable_dt();
-        check_derived("time step", s.dt, " s")?;
-        s.dt0 = s.dt;
+        s.clock = Clock::start(s.stable_dt());
+        check_derived("time step", s.clock.dt, " s")?;
         Ok(s)
     }
 }

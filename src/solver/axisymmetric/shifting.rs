@@ -5,13 +5,13 @@
 use super::mirror::fill_images;
 use super::surfaces::{FACE_ON_AXIS, TOP_ON_AXIS, normal_from_axis};
 use super::workspace::Workspace;
-use super::{AXIS_CROWD, AXIS_LEAVE, SURFACE_BAND, TaylorSolver, kinetic1};
+use super::{AXIS_CROWD, AXIS_LEAVE, LOST_SMOOTHING, SURFACE_BAND, TaylorSolver, kinetic1};
 use crate::error::{Error, Result};
-use crate::run::{SHIFT_CAP, SHIFT_RANGE};
 use crate::solver::axisymmetric::boundary::Surface;
 use crate::solver::axisymmetric::shift::{
     Candidates, Freedom, carry, leaving, shifts, surface_band,
 };
+use crate::solver::shared::{SHIFT_CAP, SHIFT_RANGE};
 
 impl TaylorSolver {
     /// The directions each particle may shift in: along the surface on the
@@ -155,7 +155,7 @@ impl TaylorSolver {
                 .pressure(fi[6], fi[8])
                 .map_err(|l| Error::CompressionLimit {
                     particle: i,
-                    time: self.time,
+                    time: self.clock.time,
                     compression: l.compression,
                     limit: l.limit,
                 })?;
@@ -167,7 +167,7 @@ impl TaylorSolver {
             }
             self.pos[i] = [self.pos[i][0] + di[0], self.pos[i][1] + di[1]];
         }
-        self.smoothing_dissipation += ke[0] - ke[1];
+        self.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
         // A surface particle that slid carries the stress of its new place:
         // the traction-free condition again, on the new normals.
         let slid = |s: &Surface| s.particles.iter().any(|&i| d[i] != [0.0; 2]);

@@ -11,14 +11,14 @@ use super::passes::{
     pair_pass, smooth_velocity, update,
 };
 use super::workspace::{BatchTally, Tally, Workspace};
-use super::{MIN_LEN, TaylorSolver};
+use super::{LOST_CONTACT, LOST_SMOOTHING, MIN_LEN, TaylorSolver};
 use crate::error::{Error, Result};
 use crate::lanes::W;
-use crate::run::{ENERGY_ERROR_BOUND, SPACING_COLLAPSE_BOUND, above, below, check_time_step};
 use crate::solver::COURANT;
 use crate::solver::axisymmetric::pairs::{PairInputs, Rows};
 use crate::solver::axisymmetric::scheme::{MsphScheme, SmoothingOrder};
 use crate::solver::axisymmetric::team::{Chunks, Team};
+use crate::solver::shared::{ENERGY_ERROR_BOUND, above, check_spacing};
 
 impl TaylorSolver {
     /// Advances one step.
@@ -49,7 +49,7 @@ impl TaylorSolver {
 
     fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
         let n = self.particles();
-        let dt = self.dt;
+        let dt = self.clock.dt;
         let scheme = MsphScheme::of(&self.p);
         ws.rate.resize(n, [0.0; 4]);
         self.material_state.fit(n);
@@ -109,28 +109,25 @@ impl TaylorSolver {
             return Err(Error::SingularMomentMatrix {
                 method: crate::error::MomentMethod::Msph,
                 particle,
-                time: self.time,
+                time: self.clock.time,
                 condition,
             });
         }
         let d0 = self.spacing();
         let ratio = a.min_d2.sqrt() / d0;
         self.min_spacing = self.min_spacing.min(ratio);
-        if below(ratio, SPACING_COLLAPSE_BOUND) {
-            return Err(Error::SpacingCollapse {
-                ratio,
-                bound: SPACING_COLLAPSE_BOUND,
-                time: self.time,
-                hint: if self.p.shifting == 0.0 {
-                    "; at large strain, use scheme = large_strain, the default (it sets \
-                     smoothing_order = 2, smoothing_ratio = 2 and shifting = 0.1; README, \
-                     \"Particle shifting\")"
-                } else {
-                    ""
-                },
-            });
-        }
-        self.contact_dissipation += a.held;
+        check_spacing(
+            ratio,
+            self.clock.time,
+            if self.p.shifting == 0.0 {
+                "; at large strain, use scheme = large_strain, the default (it sets \
+                 smoothing_order = 2, smoothing_ratio = 2 and shifting = 0.1; README, \
+                 \"Particle shifting\")"
+            } else {
+                ""
+            },
+        )?;
+        self.energy.lost[LOST_CONTACT] += a.held;
 
         let p = Pass {
             team,
@@ -167,7 +164,7 @@ impl TaylorSolver {
             &mut f.vel_s[..n],
             &mut ws.sums.smoothing,
         );
-        self.smoothing_dissipation += ke.before - ke.after;
+        self.energy.lost[LOST_SMOOTHING] += ke.before - ke.after;
 
         // 4. Velocity gradients and continuity.
         fill_images(&mut f.vel_s, n, images);
@@ -215,23 +212,23 @@ impl TaylorSolver {
     /// the clock, the stops, the stress boundary conditions (and the work
     /// they take), the next time step and the rest test.
     fn end_step(&mut self, ws: &mut Workspace, t: &Tally, dt: f64) -> Result<()> {
-        self.internal_energy += t.internal;
-        self.contact_dissipation += t.contact_lost;
+        self.energy.internal += t.internal;
+        self.energy.lost[LOST_CONTACT] += t.contact_lost;
         ws.shift_margin = Some(2.0 * dt * t.fastest2.sqrt());
-        self.time += dt;
-        self.steps += 1;
+        self.clock.time += dt;
+        self.clock.steps += 1;
         if let Some(b) = t.through {
             return Err(Error::ThroughBoundary {
                 particle: b.particle,
                 boundary: b.boundary,
-                time: self.time,
+                time: self.clock.time,
                 position: b.position,
             });
         }
         if let Some(c) = t.compression {
             return Err(Error::CompressionLimit {
                 particle: c.particle,
-                time: self.time,
+                time: self.clock.time,
                 compression: c.compression,
                 limit: c.limit,
             });
@@ -240,7 +237,7 @@ impl TaylorSolver {
             return Err(Error::NonFinite {
                 field,
                 particle,
-                time: self.time,
+                time: self.clock.time,
             });
         }
         // The boundary conditions on the new stress, and the work they take
@@ -254,18 +251,18 @@ impl TaylorSolver {
                 booked += (bc[c] - raw[c]) * w[c];
             }
         }
-        self.internal_energy += booked;
+        self.energy.internal += booked;
 
         let e = self.energy_error_with(t.kinetic);
         if above(e, ENERGY_ERROR_BOUND) {
             return Err(Error::EnergyDrift {
                 error: e,
                 bound: ENERGY_ERROR_BOUND,
-                time: self.time,
+                time: self.clock.time,
             });
         }
-        self.dt = COURANT * self.h / t.worst_speed;
-        check_time_step(self.dt, self.dt0, self.time)?;
+        self.clock.dt = COURANT * self.h / t.worst_speed;
+        self.clock.check_step(self.clock.dt)?;
         // The rod is at rest once its momentum toward the anvil is spent: the
         // centre of mass no longer moves toward the anvil.
         if -t.momentum / t.mass <= 0.0 && !t.touching {
@@ -276,10 +273,13 @@ impl TaylorSolver {
         // energy is spent once the kinetic energy has stayed below
         // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
         let (length, speed) = (self.p.initial_length, self.wave_speed());
-        if self
-            .quiet_since
-            .at_rest(self.time, t.kinetic, self.initial_energy, length, speed)
-        {
+        if self.quiet_since.at_rest(
+            self.clock.time,
+            t.kinetic,
+            self.energy.initial,
+            length,
+            speed,
+        ) {
             self.at_rest = true;
         }
         Ok(())

@@ -98,9 +98,9 @@ impl Mlpg3d {
     /// Rebuilds the geometry at `built_at` (and the supports at
     /// `supports_at` when `supports` is true or none exist).
     pub(super) fn build_geometry(&mut self, supports: bool) -> Result<()> {
-        let time = self.time;
+        let time = self.clock.time;
         let stamp = |e: Error| at_time(e, time);
-        let mut clock = self.profile.clock();
+        let mut watch = self.profile.stopwatch();
         let mut g = self.geometry.take().unwrap_or_default();
         // The old traction operator goes before the new is built; the
         // shapes and the nodal operator are rebuilt in their own buffers.
@@ -113,13 +113,13 @@ impl Mlpg3d {
             g.mirror = mirror;
             self.profile.supports += 1;
         }
-        self.profile.lap(Phase::Supports, &mut clock);
+        self.profile.lap(Phase::Supports, &mut watch);
         let sup = g.supports.as_ref().expect("computed above");
         let mut buf = Vec::new();
         let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
         g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
-        self.profile.lap(Phase::Shapes, &mut clock);
-        if self.setup.conforming {
+        self.profile.lap(Phase::Shapes, &mut watch);
+        if self.setup.scheme.forces == Forces::Conforming {
             let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
             let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
             // The start: the last build's multipliers in this process, or
@@ -139,11 +139,11 @@ impl Mlpg3d {
             );
             self.profile.conform_iterations += c.iterations as u64;
         }
-        self.profile.lap(Phase::Conform, &mut clock);
-        match self.setup.weak_form {
-            WeakForm::Sphere => {
+        self.profile.lap(Phase::Conform, &mut watch);
+        match self.setup.scheme.forces {
+            Forces::Sphere => {
                 g.spheres = self.spheres(pts, &g.mirror, sup, &g.shapes);
-                self.profile.lap(Phase::Spheres, &mut clock);
+                self.profile.lap(Phase::Spheres, &mut watch);
                 g.op = TractionOperator::build(
                     self.isa,
                     pts,
@@ -154,16 +154,16 @@ impl Mlpg3d {
                 )
                 .map_err(stamp)?;
             }
-            WeakForm::Nodal => {
+            Forces::Nodal | Forces::Conforming => {
                 g.spheres.clear();
             }
         }
-        if self.setup.weak_form == WeakForm::Nodal || self.setup.smoothing_order >= 2 {
+        if self.setup.scheme.forces.nodal() || self.setup.scheme.order == SmoothingOrder::Two {
             g.nodal.rebuild(&g.shapes, pts.len());
         } else {
             g.nodal = NodalOperator::default();
         }
-        self.profile.lap(Phase::Operator, &mut clock);
+        self.profile.lap(Phase::Operator, &mut watch);
         self.profile.operators += 1;
         self.geometry = Some(g);
         self.rebuilds += 1;
@@ -211,7 +211,7 @@ impl Mlpg3d {
                 return Err(Error::NonFinite {
                     field: "support radius",
                     particle: sup.radius.iter().position(|r| !r.is_finite()).unwrap_or(0),
-                    time: self.time,
+                    time: self.clock.time,
                 });
             }
             if widest + dk < layer {

@@ -78,6 +78,8 @@ pub mod contact;
 mod geometry;
 mod motion;
 mod observe;
+#[cfg(test)]
+mod pass_tests;
 pub mod penetration;
 pub mod profile;
 mod restore;
@@ -101,9 +103,7 @@ use crate::approx::nodal::NodalOperator;
 use crate::approx::sphere::{
     ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii,
 };
-use crate::approx::step::{
-    OMEGA_FACTOR, OMEGA_FACTOR_CONFORMING, OMEGA_FACTOR_NODAL, stable_step_with,
-};
+use crate::approx::step::stable_step_with;
 use crate::approx::weak::TractionOperator;
 use crate::error::{Error, Result};
 use crate::isa::Isa;
@@ -111,17 +111,25 @@ use crate::material::tensor::{Full, SymTensor};
 use crate::material::{Loading, Material, MaterialState, Point};
 use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
 use crate::rod::{RodObservables, radius};
-use crate::run::{
-    ENERGY_ERROR_BOUND, QuietEnd, SHIFT_CAP, SHIFT_RANGE, SPACING_COLLAPSE_BOUND, above, below,
-    check_derived, check_time_step,
+/// The place in the energy book of the damping's loss.
+const LOST_DAMPING: usize = 0;
+/// The place in the energy book of the loss at the anvil or between bodies.
+const LOST_CONTACT: usize = 1;
+/// The place in the energy book of the smoothing's loss (node shifting's
+/// included).
+const LOST_SMOOTHING: usize = 2;
+
+use crate::solver::shared::{
+    Clock, ENERGY_ERROR_BOUND, EnergyBook, QuietEnd, SHIFT_CAP, SHIFT_RANGE, above, check_derived,
+    check_spacing,
 };
 use geometry::Geometry;
 pub use observe::{Energies, MLPG_FIELDS};
-use profile::{Clock, Phase, PhaseTimes};
+use profile::{Phase, PhaseTimes, Stopwatch};
 use rayon::prelude::*;
+use scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
 use scratch::{CARRIED, Scratch, Tally};
-use setup::anvil_default;
-pub use setup::{Body, DAMPING, REBUILD_STRAIN, RodSetup, SMOOTHING, WeakForm};
+pub use setup::{Body, DAMPING, REBUILD_STRAIN, RodSetup, SMOOTHING};
 use shift::{Freedom, carry, exchange, shifts};
 use spheres::{nanson, radial};
 use util::{at_time, extended, kinetic, kinetic1, material_of, norm, pin};
@@ -131,55 +139,44 @@ use util::{at_time, extended, kinetic, kinetic1, material_of, norm, pin};
 pub struct Mlpg3d {
     setup: RodSetup,
     material: Material,
-    #[serde(default)]
     material_state: MaterialState,
     /// The reference lattice (positions at impact, volumes, surfaces, sets):
     /// the rod's nodes first, then those of each further body; the sets
     /// are the rod's.
     lattice: NodeLattice,
     /// The bodies after the rod (none for a Taylor run).
-    #[serde(default)]
     others: Vec<Body>,
     /// The body of each node (0: the rod), empty for a run of one body.
-    #[serde(default)]
     group: Vec<u8>,
     /// Whether the rigid anvil at z = 0 is there (a Taylor run).
-    #[serde(default = "anvil_default")]
     anvil: bool,
     /// Contact reach between the nodes of different bodies
     /// ([`contact`]): the smallest radial spacing of the bodies (m).
-    #[serde(default)]
     reach: f64,
     /// The place at impact of the material each node is on: the lattice
     /// position, carried along when the node shifts (the reference map of
     /// the Nanson normals).
-    #[serde(default)]
     reference: Vec<[f64; 3]>,
     /// `reference` at the last build of the operator (the test spheres'
     /// Nanson normals are built from it, so a restored run rebuilds them
     /// as they were).
-    #[serde(default)]
     built_reference: Vec<[f64; 3]>,
     /// `contact` at the last build of the operator (the test sphere of a
     /// face node held on the anvil is cut by the anvil's plane, of a free one
     /// by its Nanson plane, so a restored run rebuilds them as they were).
-    #[serde(default)]
     built_contact: Vec<bool>,
     /// `rho` at the last build of the operator (conforming gradients weigh
     /// the constraint by the nodal volumes `m / ρ` of the build, so a
     /// restored run rebuilds them as they were).
-    #[serde(default)]
     built_rho: Vec<f64>,
     /// The multipliers the conforming correction started from at the last
     /// build (those of the build before; empty: from zero), so a restored
     /// run rebuilds its gradients as they were ([`conform`]'s warm start).
-    #[serde(default)]
     built_multipliers: Vec<[f64; 3]>,
     /// The anvil's reaction on each node held on it at the last step's
     /// forces, `−F_z ≥ 0` (N; zero on a free node): a release is timed by
     /// the zero of the node's net axial force between that step and the
     /// next ([`Mlpg3d::last_release`]).
-    #[serde(default)]
     reaction: Vec<f64>,
     // Node fields (structure of arrays).
     pos: Vec<[f64; 3]>,
@@ -195,11 +192,9 @@ pub struct Mlpg3d {
     contact: Vec<bool>,
     /// The symmetry planes each node lies on (bits `X`,
     /// `Y` of `src/approx/mirror.rs`) in the quarter model; empty for the whole body.
-    #[serde(default)]
     plane: Vec<u8>,
     /// The nodes held still (a clamped rim, [`Body::clamped_rim`]); empty
     /// when none is.
-    #[serde(default)]
     held: Vec<bool>,
     /// Positions the supports were computed from.
     supports_at: Vec<[f64; 3]>,
@@ -208,24 +203,18 @@ pub struct Mlpg3d {
     #[serde(skip)]
     geometry: Option<Geometry>,
     // Bookkeeping.
-    time: f64,
-    steps: u64,
-    dt: f64,
-    dt0: f64,
+    clock: Clock,
     /// Damping time `c = 2 ζ / ω_max` of the viscous stress (s).
     damping_time: f64,
     d_min0: f64,
     min_spacing: f64,
-    initial_energy: f64,
-    internal_energy: f64,
+    /// The impact's kinetic energy, the internal energy and the losses to
+    /// the damping ([`LOST_DAMPING`]), the anvil or the contact between
+    /// bodies ([`LOST_CONTACT`]) and the smoothing ([`LOST_SMOOTHING`]).
+    energy: EnergyBook<3>,
     plastic_work: f64,
-    damping_dissipation: f64,
-    contact_dissipation: f64,
-    smoothing_dissipation: f64,
-    /// The part of `smoothing_dissipation` that node shifting booked: the
-    /// kinetic energy its carry of the velocities changed (a state saved
-    /// before this tally loads with 0).
-    #[serde(default)]
+    /// The part of the smoothing's loss that node shifting booked: the
+    /// kinetic energy its carry of the velocities changed.
     shift_dissipation: f64,
     rebuilds: u64,
     at_rest: bool,
@@ -279,13 +268,12 @@ impl Mlpg3d {
             })
         };
         let density = density_of(&material)?;
-        if setup.conforming && (setup.quarter || setup.weak_form != WeakForm::Nodal) {
-            return Err(Error::Inconsistent(
-                "conforming gradients (weak_form = 2) need the nodal form on the whole body (symmetry = 0)"
-                    .into(),
-            ));
-        }
-        let mut lattice = NodeLattice::cylinder_with(setup.cylinder, setup.rings, setup.staggered);
+        setup.scheme.check(setup.quarter)?;
+        let mut lattice = NodeLattice::cylinder_with(
+            setup.cylinder,
+            setup.rings,
+            setup.scheme.lattice == Lattice::Staggered,
+        );
         let mut plane = Vec::new();
         if setup.quarter {
             (lattice, plane) = lattice.quarter();
@@ -379,19 +367,12 @@ impl Mlpg3d {
             anvil,
             reach,
             geometry: None,
-            time: 0.0,
-            steps: 0,
-            dt: 0.0,
-            dt0: 0.0,
+            clock: Clock::default(),
             damping_time: 0.0,
             d_min0: 0.0,
             min_spacing: 1.0,
-            initial_energy,
-            internal_energy: 0.0,
+            energy: EnergyBook::new(initial_energy),
             plastic_work: 0.0,
-            damping_dissipation: 0.0,
-            contact_dissipation: 0.0,
-            smoothing_dissipation: 0.0,
             shift_dissipation: 0.0,
             rebuilds: 0,
             at_rest: false,
@@ -411,9 +392,8 @@ impl Mlpg3d {
         // own speed, so that no body crosses a spacing (and past a contact)
         // in the first step.
         let fastest = s.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max);
-        s.dt = s.stable_dt(cp + fastest, s.d_min0);
-        check_derived("time step", s.dt, " s")?;
-        s.dt0 = s.dt;
+        s.clock = Clock::start(s.stable_dt(cp + fastest, s.d_min0));
+        check_derived("time step", s.clock.dt, " s")?;
         Ok(s)
     }
 
@@ -448,14 +428,7 @@ impl Mlpg3d {
     }
 
     fn energy_error_with(&self, kinetic: f64) -> f64 {
-        (kinetic
-            + self.internal_energy
-            + self.damping_dissipation
-            + self.contact_dissipation
-            + self.smoothing_dissipation
-            - self.initial_energy)
-            .abs()
-            / self.initial_energy
+        self.energy.error(kinetic)
     }
 
     /// One step (see the module docs).
@@ -466,14 +439,14 @@ impl Mlpg3d {
             self.rebuilds -= 1;
         }
         let n = self.particles();
-        let clock = self.profile.clock();
+        let watch = self.profile.stopwatch();
         self.material_state.fit(n);
         let mut scratch = std::mem::take(&mut self.scratch);
         scratch.fit(n);
-        if self.setup.shifting > 0.0 {
+        if self.setup.scheme.shifting > 0.0 {
             scratch.fit_shift(n);
         }
-        let result = self.step_with(&mut scratch, clock);
+        let result = self.step_with(&mut scratch, watch);
         self.scratch = scratch;
         result
     }

@@ -3,6 +3,7 @@
 //! seam.
 
 use super::*;
+use crate::solver::shared::SolidNodes;
 
 impl Mlpg3d {
     /// Number of nodes.
@@ -10,7 +11,7 @@ impl Mlpg3d {
         self.pos.len()
     }
 
-    crate::run::clock_getters!(dt);
+    crate::solver::shared::clock_getters!(dt);
 
     /// Builds of the operator so far (the first included).
     pub fn rebuilds(&self) -> u64 {
@@ -53,7 +54,7 @@ impl Mlpg3d {
     /// Whether the end condition holds: the rod is at rest or has left the
     /// anvil, or `end_time` has been reached.
     pub fn finished(&self) -> bool {
-        self.at_rest || self.time >= self.setup.end_time
+        self.at_rest || self.clock.time >= self.setup.end_time
     }
 
     /// Smallest distance between named neighbours relative to the initial
@@ -69,13 +70,13 @@ impl Mlpg3d {
         let kinetic = kinetic(&self.vel, &self.mass);
         let k = self.multiplicity();
         Energies {
-            initial: k * self.initial_energy,
+            initial: k * self.energy.initial,
             kinetic: k * kinetic,
-            internal: k * self.internal_energy,
+            internal: k * self.energy.internal,
             plastic_work: k * self.plastic_work,
-            damping: k * self.damping_dissipation,
-            contact: k * self.contact_dissipation,
-            smoothing: k * self.smoothing_dissipation,
+            damping: k * self.energy.lost[LOST_DAMPING],
+            contact: k * self.energy.lost[LOST_CONTACT],
+            smoothing: k * self.energy.lost[LOST_SMOOTHING],
             error: self.energy_error_with(kinetic),
         }
     }
@@ -341,17 +342,16 @@ impl Mlpg3d {
     /// The values of the node field `name` (one of [`MLPG_FIELDS`]),
     /// interleaved per node.
     pub fn field(&self, name: &str) -> Option<Vec<f64>> {
-        Some(match name {
-            "position" => self.pos.iter().flatten().copied().collect(),
-            "density" => self.rho.clone(),
-            "velocity" => self.vel.iter().flatten().copied().collect(),
-            "pressure" => self.pressure.clone(),
-            "stress" => self.stress().into_iter().flatten().collect(),
-            "plastic_strain" => self.eps_p.clone(),
-            "temperature" => self.temp.clone(),
-            "in_contact" => self.contact.iter().map(|&c| c as u8 as f64).collect(),
-            _ => return None,
-        })
+        SolidNodes {
+            pos: &self.pos,
+            vel: &self.vel,
+            rho: &self.rho,
+            pressure: &self.pressure,
+            eps_p: &self.eps_p,
+            temp: &self.temp,
+            contact: &self.contact,
+        }
+        .field(name, || self.stress().into_iter().flatten().collect())
     }
 }
 

@@ -22,28 +22,21 @@ use crate::material::rajendran_grove::RajendranGrove;
 use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
 use crate::solver::mlpg3d::{Body, Energies, MLPG_FIELDS, Mlpg3d, RodSetup};
 
-/// The geometry and resolution of a penetration run.
+/// What a penetration run adds to its projectile's [`RodSetup`] (which
+/// holds the projectile, its speed, the resolution and the end time): the
+/// plate and how the run ends.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PenetrationSetup {
-    /// The projectile (m).
-    pub projectile: Cylinder,
     /// The plate: its radius and thickness (m).
     pub plate: Cylinder,
-    /// Speed of the projectile toward the plate (m/s).
-    pub impact_speed: f64,
-    /// Rings across the projectile's radius.
-    pub rings: usize,
-    /// Latest simulated time (s).
-    pub end_time: f64,
     /// The run ends as soon as the shot's outcome is decided
     /// ([`Penetration::outcome`]), with `end_time` as its cap; false (the
     /// default): it runs to `end_time`.
-    #[serde(default)]
     pub until_outcome: bool,
     /// The plate's rim is clamped (its outer ring of nodes held still,
     /// [`crate::solver::mlpg3d::Body::clamped_rim`]); false (the default,
     /// the seed's case): free.
-    #[serde(default)]
     pub clamped_rim: bool,
 }
 
@@ -68,25 +61,23 @@ pub struct Penetration {
 
 impl Penetration {
     /// The projectile of `projectile` material over the plate of `plate`
-    /// material at the instant of impact; `numerics` gives the solver's
-    /// choices (damping, smoothing, safety, rebuild strain, shifting).
+    /// material at the instant of impact; `numerics` is the projectile's
+    /// rod (its cylinder, speed, rings and end time) with the solver's
+    /// choices (damping, scheme, safety, rebuild strain).
     pub fn new(
         setup: PenetrationSetup,
         projectile: Material,
         plate: Material,
         numerics: RodSetup,
     ) -> Result<Self> {
-        let rings = setup.rings.max(1);
-        let spacing = setup.projectile.radius / rings as f64;
+        let rings = numerics.rings.max(1);
+        let spacing = numerics.cylinder.radius / rings as f64;
         let plate_rings = ((setup.plate.radius / spacing).round() as usize).max(1);
         let reach = spacing.min(setup.plate.radius / plate_rings as f64);
         // Every choice of `numerics` (the weak form and the smoothing's
         // order too), on the projectile of `setup`.
         let rod = RodSetup {
-            cylinder: setup.projectile,
             rings,
-            impact_speed: setup.impact_speed,
-            end_time: setup.end_time,
             base: reach,
             ..numerics
         };
@@ -162,7 +153,8 @@ impl Penetration {
             self.run.masses(),
         );
         if self.projectile_clearance() > 0.0 {
-            let spacing = self.setup.projectile.radius / self.setup.rings.max(1) as f64;
+            let rod = self.run.setup();
+            let spacing = rod.cylinder.radius / rod.rings as f64;
             let reach = self.hole_radius() + 2.0 * spacing;
             let points = self.run.material_points();
             let (mut p, mut total) = (0.0, 0.0);
@@ -431,7 +423,7 @@ impl crate::model::Model for Penetration {
     }
     /// 40 records over the run.
     fn record_interval(&self) -> f64 {
-        self.setup.end_time / 40.0
+        self.run.setup().end_time / 40.0
     }
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.run.min_spacing_ratio())

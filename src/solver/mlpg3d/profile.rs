@@ -112,7 +112,7 @@ fn thread_cpu() -> Option<Duration> {
 /// A phase's start: the wall clock and, when serial time is counted, the
 /// stepping thread's processor time.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Clock {
+pub(crate) struct Stopwatch {
     at: Instant,
     cpu: Option<Duration>,
 }
@@ -154,8 +154,8 @@ impl PhaseTimes {
     }
 
     /// A clock started now.
-    pub(crate) fn clock(&self) -> Clock {
-        Clock {
+    pub(crate) fn stopwatch(&self) -> Stopwatch {
+        Stopwatch {
             at: Instant::now(),
             cpu: if self.counting_serial {
                 thread_cpu()
@@ -166,8 +166,8 @@ impl PhaseTimes {
     }
 
     /// Adds the time since `*since` to `phase` and restarts the clock.
-    pub(crate) fn lap(&mut self, phase: Phase, since: &mut Clock) {
-        let now = self.clock();
+    pub(crate) fn lap(&mut self, phase: Phase, since: &mut Stopwatch) {
+        let now = self.stopwatch();
         self.wall[phase as usize] += now.at - since.at;
         if let (Some(a), Some(b)) = (since.cpu, now.cpu) {
             self.serial[phase as usize] += b.saturating_sub(a);
@@ -240,12 +240,12 @@ mod tests {
     #[test]
     fn serial_time_counts_the_thread_on_a_processor_not_its_waits() {
         let mut p = PhaseTimes::default();
-        let mut clock = p.clock();
+        let mut clock = p.stopwatch();
         std::thread::sleep(Duration::from_millis(20));
         p.lap(Phase::Force, &mut clock);
         assert_eq!(p.serial_total(), Duration::ZERO);
         p.count_serial(true);
-        let mut clock = p.clock();
+        let mut clock = p.stopwatch();
         std::thread::sleep(Duration::from_millis(20));
         p.lap(Phase::Kick, &mut clock);
         let mut x = 1.0f64;

@@ -9,7 +9,7 @@ impl Mlpg3d {
     /// first step, damping time, impact energy) must be the same bits, and
     /// every node field must have one finite value per node.
     pub(crate) fn check_restored(&self, fresh: &Mlpg3d) -> std::result::Result<(), String> {
-        use crate::run::json;
+        use crate::solver::shared::json;
         let fixed = |s: &Mlpg3d| {
             json(&(
                 &s.setup,
@@ -17,10 +17,10 @@ impl Mlpg3d {
                 (&s.others, &s.group, s.anvil, s.reach, &s.plane, &s.held),
                 &s.lattice,
                 &s.mass,
-                s.dt0,
+                s.clock.dt0,
                 s.d_min0,
                 s.damping_time,
-                s.initial_energy,
+                s.energy.initial,
             ))
         };
         if fixed(self) != fixed(fresh) {
@@ -100,22 +100,22 @@ impl Mlpg3d {
                 return Err(format!("its node {i} is off its side of a symmetry plane"));
             }
         }
-        if self.damaging() && self.steps > 0 && !self.material_state.has_damage() {
+        if self.damaging() && self.clock.steps > 0 && !self.material_state.has_damage() {
             return Err("its damage variables are missing".into());
         }
         self.material_state.check_len(n)?;
-        crate::run::check_restored_clock(
-            self.time,
-            self.dt,
-            self.dt0,
-            self.steps,
+        crate::solver::shared::check_restored_clock(
+            self.clock.time,
+            self.clock.dt,
+            self.clock.dt0,
+            self.clock.steps,
             &[
                 self.min_spacing,
-                self.internal_energy,
+                self.energy.internal,
                 self.plastic_work,
-                self.damping_dissipation,
-                self.contact_dissipation,
-                self.smoothing_dissipation,
+                self.energy.lost[LOST_DAMPING],
+                self.energy.lost[LOST_CONTACT],
+                self.energy.lost[LOST_SMOOTHING],
                 self.shift_dissipation,
                 self.quiet_since.since().unwrap_or(0.0),
                 self.last_release,
@@ -123,10 +123,10 @@ impl Mlpg3d {
         )?;
         // Finite is not enough: a position of 1e300 overflows the search
         // of the supports, a velocity of 1e300 the energies.
-        let bounds = crate::run::RestoreBounds::new(
+        let bounds = crate::solver::shared::RestoreBounds::new(
             &fresh.pos,
             fresh.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max) + fresh.wave_speed(),
-            self.time,
+            self.clock.time,
         );
         bounds.speeds("velocities", &self.vel)?;
         for (what, f) in [

@@ -4,32 +4,73 @@
 //! their combination with the model's `symmetry`, for every scene on this
 //! solver (`taylor3d`, `penetration`).
 
+use crate::approx::step::{OMEGA_FACTOR, OMEGA_FACTOR_CONFORMING, OMEGA_FACTOR_NODAL};
 use crate::error::{Error, Result};
-use crate::solver::mlpg3d::{RodSetup, WeakForm};
 
 /// The forces of the MLPG solver (`weak_form`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Forces {
-    /// 0: the seed's local weak form over test spheres (eq. 10).
+    /// 0: the seed's local weak form with the Heaviside test function over
+    /// each node's test sphere (eq. 10, `TractionOperator`), the sphere's
+    /// inertia `ρ V_s`.
     Sphere,
-    /// 1: the nodal Galerkin form, the adjoint of the collocated gradients.
+    /// 1: the nodal Galerkin form, the adjoint of the collocated gradients
+    /// (eq. 4; `src/approx/nodal.rs`), the nodal mass as inertia: it
+    /// conserves momentum and creates no energy, and node shifting also
+    /// moves the nodes of the mantle in its tangent plane and the face
+    /// nodes held on the anvil in its plane (README, "3-D MLPG mixed
+    /// method").
     Nodal,
-    /// 2: the nodal form with conforming gradients (`src/approx/conform.rs`):
+    /// 2: the nodal form with gradients corrected to meet the integration
+    /// constraint at the surfaces (`src/approx/conform.rs`), so that a
+    /// uniform stress leaves every node off the surfaces in equilibrium:
     /// the whole body only.
     Conforming,
 }
 
+impl Forces {
+    /// Whether the forces are the nodal form's (with or without conforming
+    /// gradients): the nodal mass as inertia.
+    pub fn nodal(self) -> bool {
+        self != Forces::Sphere
+    }
+
+    /// `κ` of the forces' highest frequency, `ω_max = κ c_p / d_min`
+    /// (`src/approx/step.rs`, measured by power iteration on each form's
+    /// elastic operator).
+    pub fn omega_factor(self) -> f64 {
+        match self {
+            Forces::Sphere => OMEGA_FACTOR,
+            Forces::Nodal => OMEGA_FACTOR_NODAL,
+            Forces::Conforming => OMEGA_FACTOR_CONFORMING,
+        }
+    }
+}
+
 /// The velocity smoothing's order (`smoothing_order`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum SmoothingOrder {
     /// 1: `v ← v − α H v`.
     One,
-    /// 2: `v ← v − α M⁻¹ Hᵀ M H v`, which spares smooth fields.
+    /// 2: `v ← v − α M⁻¹ Hᵀ M H v` (M the nodal masses), the symmetric
+    /// square of order 1: it conserves momentum, only removes kinetic
+    /// energy, and damps smooth fields far less than the modes the shapes
+    /// cannot represent.
     Two,
 }
 
+impl SmoothingOrder {
+    /// The power of `H = I − Φ` it applies: 1 or 2.
+    pub fn power(self) -> u32 {
+        match self {
+            SmoothingOrder::One => 1,
+            SmoothingOrder::Two => 2,
+        }
+    }
+}
+
 /// The node lattice of a rod (`lattice`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Lattice {
     /// 0: every layer's nodes on the same radial lines.
     Aligned,
@@ -37,19 +78,44 @@ pub enum Lattice {
     Staggered,
 }
 
-/// A scheme of the MLPG solver, decoded from a scene's knobs.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A scheme of the MLPG solver, decoded from a scene's knobs: it reaches
+/// the passes as it is (in [`crate::solver::mlpg3d::RodSetup::scheme`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MlpgScheme {
     /// The forces.
     pub forces: Forces,
     /// The smoothing's order.
     pub order: SmoothingOrder,
-    /// α of the velocity smoothing.
+    /// α of the velocity smoothing `v ← v − α (I − Φ)^k v` after each
+    /// velocity update, with `(Φ v)_i = Σ_J φ_J(x_i) v_J` the MLS
+    /// approximation at the node (`SMOOTHING`). α is per step of the
+    /// seed's form; a form with a shorter stable step applies it in
+    /// proportion to its step ([`MlpgScheme::step_scale`]), so that the
+    /// smoothing per unit time does not depend on the form's step.
     pub smoothing: f64,
-    /// β of the node shifting (0: Lagrangian nodes).
+    /// β of the node shifting (`src/solver/mlpg3d/shift.rs`; the `taylor`
+    /// scene's `shifting`): pairs closer than `SHIFT_RANGE` of the initial
+    /// spacing push apart by up to β times the spacing per step
+    /// (`SHIFT_CAP` at most; both per step of the seed's form, as the
+    /// smoothing's α); 0: Lagrangian nodes.
     pub shifting: f64,
     /// The rod's lattice.
     pub lattice: Lattice,
+}
+
+/// The seed's scheme: its weak form, the smoothing of order 1 with
+/// `SMOOTHING`, Lagrangian nodes, the layers aligned.
+impl Default for MlpgScheme {
+    fn default() -> Self {
+        MlpgScheme {
+            forces: Forces::Sphere,
+            order: SmoothingOrder::One,
+            smoothing: crate::solver::mlpg3d::SMOOTHING,
+            shifting: 0.0,
+            lattice: Lattice::Aligned,
+        }
+    }
 }
 
 impl MlpgScheme {
@@ -73,36 +139,43 @@ impl MlpgScheme {
         } else {
             Lattice::Aligned
         };
-        let symmetry = get("symmetry")?;
-        if forces == Forces::Conforming && symmetry >= 0.5 {
-            return Err(Error::Inconsistent(format!(
-                "weak_form = {weak_form} (conforming gradients) needs the whole body, but symmetry = {symmetry} \
-                 asks for the quarter model: set weak_form = 1 (the nodal form, which the quarter model \
-                 runs) or symmetry = 0 (scheme large_strain sets weak_form = 2)"
-            )));
-        }
-        Ok(MlpgScheme {
+        let scheme = MlpgScheme {
             forces,
             order,
             smoothing: get("smoothing_coefficient")?,
             shifting: get("shifting")?,
             lattice,
-        })
+        };
+        scheme.check(get("symmetry")? >= 0.5)?;
+        Ok(scheme)
     }
 
-    /// Puts the scheme into a run's setup.
-    pub fn apply(&self, setup: &mut RodSetup) {
-        setup.weak_form = match self.forces {
-            Forces::Sphere => WeakForm::Sphere,
-            Forces::Nodal | Forces::Conforming => WeakForm::Nodal,
-        };
-        setup.conforming = self.forces == Forces::Conforming;
-        setup.smoothing_order = match self.order {
-            SmoothingOrder::One => 1,
-            SmoothingOrder::Two => 2,
-        };
-        setup.smoothing = self.smoothing;
-        setup.shifting = self.shifting;
-        setup.staggered = self.lattice == Lattice::Staggered;
+    /// The one check of the scheme's combination with the model: the
+    /// conforming gradients need the whole body, so on the quarter model
+    /// they are refused, naming both parameters.
+    pub fn check(&self, quarter: bool) -> Result<()> {
+        if self.forces == Forces::Conforming && quarter {
+            return Err(Error::Inconsistent(
+                "weak_form = 2 (conforming gradients) needs the whole body, but symmetry = 1 \
+                 asks for the quarter model: set weak_form = 1 (the nodal form, which the quarter \
+                 model runs) or symmetry = 0 (scheme large_strain sets weak_form = 2)"
+                    .into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// `κ` of the highest frequency of the forces, `ω_max = κ c_p / d_min`
+    /// ([`Forces::omega_factor`]).
+    pub fn omega_factor(&self) -> f64 {
+        self.forces.omega_factor()
+    }
+
+    /// The ratio of this scheme's stable step to the seed's form's,
+    /// `OMEGA_FACTOR / κ`: the factor on the per-step rates (the
+    /// smoothing's α, the shifting's β and cap), so that they act at the
+    /// same rate per unit time whatever the step.
+    pub fn step_scale(&self) -> f64 {
+        OMEGA_FACTOR / self.omega_factor()
     }
 }

@@ -1,5 +1,5 @@
 //! The setup of a 3-D MLPG run: the rod and the solver's numerical
-//! choices ([`RodSetup`], [`WeakForm`]), the further bodies of a run of
+//! choices ([`RodSetup`], with its typed scheme), the further bodies of a run of
 //! several ([`Body`]), and the defaults with the measurements behind them.
 
 use super::*;
@@ -40,10 +40,6 @@ pub const REBUILD_STRAIN: f64 = 0.05;
 /// chosen for the smallest energy error (README, "3-D MLPG").
 pub const SMOOTHING: f64 = 0.1;
 
-/// Default order of the velocity smoothing ([`RodSetup::smoothing_order`]):
-/// 1, the relaxation toward the MLS approximation.
-pub const SMOOTHING_ORDER: u32 = 1;
-
 /// A rod on the ring lattice at the instant of impact, and the solver's
 /// numerical choices.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -62,108 +58,30 @@ pub struct RodSetup {
     pub end_time: f64,
     /// See `REBUILD_STRAIN`.
     pub rebuild_strain: f64,
-    /// α of the velocity smoothing `v ← v − α (I − Φ)^k v` after each
-    /// velocity update, with `(Φ v)_i = Σ_J φ_J(x_i) v_J` the MLS
-    /// approximation at the node ([`SMOOTHING`]). α is per step of the
-    /// seed's form; a form with a shorter stable step applies it in
-    /// proportion to its step ([`WeakForm::step_scale`]), so that the
-    /// smoothing per unit time does not depend on the form's step.
-    pub smoothing: f64,
-    /// The order of the smoothing (default 1): 1,
-    /// `v ← v − α H v` with `H = I − Φ`, relaxes each node toward the MLS
-    /// approximation; 2, `v ← v − α M⁻¹ Hᵀ M H v` (M the nodal masses), is
-    /// its symmetric square: it conserves momentum, only removes kinetic
-    /// energy, and damps smooth fields far less than the modes the shapes
-    /// cannot represent.
-    #[serde(default = "one")]
-    pub smoothing_order: u32,
-    /// β of the node shifting (`src/solver/mlpg3d/shift.rs`; the `taylor` scene's
-    /// `shifting`): pairs closer than `SHIFT_RANGE` of the initial
-    /// spacing push apart by up to β times the spacing per step
-    /// (`SHIFT_CAP` at most; both per step of the seed's form, as the
-    /// smoothing's α); 0 (the default): Lagrangian nodes.
-    #[serde(default)]
-    pub shifting: f64,
+    /// The scheme: the forces, the smoothing and its order, the shifting,
+    /// the lattice ([`MlpgScheme`]; the seed's by default).
+    pub scheme: MlpgScheme,
     /// Height of the rod's face at impact (m): 0, on the anvil, for a
     /// Taylor run; above the plate for a penetration run.
-    #[serde(default)]
     pub base: f64,
-    /// The weak form of the forces ([`WeakForm`]; the seed's by default).
-    #[serde(default)]
-    pub weak_form: WeakForm,
     /// The quarter model: only the nodes with `x ≥ 0`, `y ≥ 0`, with the
     /// symmetry planes `x = 0` and `y = 0` by mirror images
     /// (`src/approx/mirror.rs`); false (the default): the whole body.
-    #[serde(default)]
     pub quarter: bool,
-    /// With the nodal form: gradients corrected to meet the integration
-    /// constraint at the surfaces (`src/approx/conform.rs`), so that a
-    /// uniform stress leaves every node off the surfaces in equilibrium.
-    /// The whole body only.
-    #[serde(default)]
-    pub conforming: bool,
-    /// The rod's lattice with its odd layers turned by half a node's angle
-    /// ([`NodeLattice::cylinder_with`]); false (the default): the layers
-    /// stand on the same radial lines.
-    #[serde(default)]
-    pub staggered: bool,
     /// The shifting carries the velocities conservatively
     /// (`solver::mlpg3d::shift::exchange`): a moved node's momentum increment is
     /// drawn from the nodes around it, so that a shift changes the total
     /// momentum by round-off only; false (the default): a moved node takes
     /// the velocity of its new place (`solver::mlpg3d::shift::carry`). Either way
     /// the kinetic energy a shift changes is booked with the smoothing's.
-    #[serde(default)]
     pub conservative_carry: bool,
-}
-
-/// The weak form of the nodal forces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub enum WeakForm {
-    /// The seed's local weak form with the Heaviside test function over
-    /// each node's test sphere (eq. 10, [`TractionOperator`]), the sphere's
-    /// inertia `ρ V_s`.
-    #[default]
-    Sphere,
-    /// The nodal Galerkin form, the adjoint of the collocated gradients
-    /// (eq. 4; `src/approx/nodal.rs`), the nodal mass as inertia: it conserves
-    /// momentum and creates no energy, and node shifting also moves the
-    /// nodes of the mantle in its tangent plane and the face nodes held on
-    /// the anvil in its plane (README, "3-D MLPG mixed method").
-    Nodal,
-}
-
-impl WeakForm {
-    /// The ratio of this form's stable step to the seed's form's,
-    /// `OMEGA_FACTOR / κ` (1 for the sphere form, 0.78 for the nodal form):
-    /// the factor on the per-step rates, the smoothing's α and the
-    /// shifting's β and cap, so that they act at the same rate per unit
-    /// time in both forms.
-    pub fn step_scale(self) -> f64 {
-        OMEGA_FACTOR / self.omega_factor()
-    }
-
-    /// `κ` of its highest frequency, `ω_max = κ c_p / d_min`
-    /// (`src/approx/step.rs`, measured by power iteration on each form's
-    /// elastic operator).
-    pub fn omega_factor(self) -> f64 {
-        match self {
-            WeakForm::Sphere => OMEGA_FACTOR,
-            WeakForm::Nodal => OMEGA_FACTOR_NODAL,
-        }
-    }
 }
 
 impl RodSetup {
     /// `κ` of the highest frequency of the forces chosen, `ω_max = κ c_p /
-    /// d_min`: the weak form's ([`WeakForm::omega_factor`]), or
-    /// [`OMEGA_FACTOR_CONFORMING`] with conforming gradients.
+    /// d_min` ([`MlpgScheme::omega_factor`]).
     pub fn omega_factor(&self) -> f64 {
-        if self.conforming {
-            OMEGA_FACTOR_CONFORMING
-        } else {
-            self.weak_form.omega_factor()
-        }
+        self.scheme.omega_factor()
     }
 
     /// The ratio of this setup's stable step to the seed's form's,
@@ -171,7 +89,7 @@ impl RodSetup {
     /// smoothing's α, the shifting's β and cap), so that they act at the
     /// same rate per unit time whatever the step.
     pub fn step_scale(&self) -> f64 {
-        OMEGA_FACTOR / self.omega_factor()
+        self.scheme.step_scale()
     }
 
     /// A rod with the default numerical choices ([`DAMPING`], [`SAFETY`],
@@ -185,14 +103,9 @@ impl RodSetup {
             safety: SAFETY,
             end_time,
             rebuild_strain: REBUILD_STRAIN,
-            smoothing: SMOOTHING,
-            smoothing_order: SMOOTHING_ORDER,
-            shifting: 0.0,
+            scheme: MlpgScheme::default(),
             base: 0.0,
-            weak_form: WeakForm::Sphere,
             quarter: false,
-            conforming: false,
-            staggered: false,
             conservative_carry: false,
         }
     }
@@ -216,14 +129,5 @@ pub struct Body {
     /// Whether its rim is clamped: the nodes of its outer ring are held
     /// still (their velocities zero, never shifted); a held node's
     /// reaction does no work. Default: free.
-    #[serde(default)]
     pub clamped_rim: bool,
-}
-
-pub(super) fn one() -> u32 {
-    1
-}
-
-pub(super) fn anvil_default() -> bool {
-    true
 }

@@ -33,7 +33,7 @@ impl Mlpg3d {
             geometry: g,
             spacing: self.d_min0,
             anvil: self.anvil,
-            nodal: self.setup.weak_form == WeakForm::Nodal,
+            nodal: self.setup.scheme.forces.nodal(),
             surfaces: &self.lattice.surfaces,
             contact: &self.contact,
             plane: &self.plane,
@@ -41,7 +41,7 @@ impl Mlpg3d {
             mass: &self.mass,
             points: self.material_state.points(),
             materials: (&self.material, &self.others, &self.group),
-            time: self.time,
+            time: self.clock.time,
         };
         let (buffers, ext) = (&mut scratch.shifting, &mut scratch.images);
         let images = &g.mirror;
@@ -55,7 +55,7 @@ impl Mlpg3d {
             &buffers.free,
             spacing,
             SHIFT_RANGE * spacing,
-            self.setup.shifting * step_scale,
+            self.setup.scheme.shifting * step_scale,
             SHIFT_CAP * spacing * step_scale,
             &mut buffers.shift,
         );
@@ -97,7 +97,7 @@ impl Mlpg3d {
         if conservative {
             ke[1] = kinetic(fields.vel, frame.mass);
         }
-        self.smoothing_dissipation += ke[0] - ke[1];
+        self.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
         self.shift_dissipation += ke[0] - ke[1];
         Ok(())
     }

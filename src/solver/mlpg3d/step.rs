@@ -11,9 +11,9 @@ use super::*;
 impl Mlpg3d {
     /// The step with its buffers (reused from step to step: the step
     /// allocates nothing once they have their size).
-    pub(super) fn step_with(&mut self, scratch: &mut Scratch, mut clock: Clock) -> Result<()> {
-        let dt = self.dt;
-        let nodal = self.setup.weak_form == WeakForm::Nodal;
+    pub(super) fn step_with(&mut self, scratch: &mut Scratch, mut watch: Stopwatch) -> Result<()> {
+        let dt = self.clock.dt;
+        let nodal = self.setup.scheme.forces.nodal();
         // 1. Forces from σ^n and the viscous stress.
         let g = self.geometry.as_ref().expect("built above");
         total_stress(
@@ -29,7 +29,7 @@ impl Mlpg3d {
             &mut scratch.forces,
             &mut scratch.images.total,
         );
-        self.profile.lap(Phase::Force, &mut clock);
+        self.profile.lap(Phase::Force, &mut watch);
         // 2-3. Velocities, contact, positions.
         let damaging = self.damaging();
         if !self.group.is_empty() || damaging {
@@ -37,7 +37,7 @@ impl Mlpg3d {
         }
         let frame = Frame {
             dt,
-            now: self.time,
+            now: self.clock.time,
             nodal,
             spacing: self.d_min0,
             reach: self.reach,
@@ -56,20 +56,20 @@ impl Mlpg3d {
             &mut self.reaction,
             &mut scratch.kicks,
         );
-        self.profile.lap(Phase::Kick, &mut clock);
+        self.profile.lap(Phase::Kick, &mut watch);
         // Velocity smoothing toward the MLS approximation at the node.
-        let alpha = self.setup.smoothing * self.setup.step_scale();
+        let alpha = self.setup.scheme.smoothing * self.setup.step_scale();
         if alpha > 0.0 {
-            self.smoothing_dissipation += motion::smooth(
+            self.energy.lost[LOST_SMOOTHING] += motion::smooth(
                 &frame,
-                (alpha, self.setup.smoothing_order),
+                (alpha, self.setup.scheme.order.power()),
                 &mut self.vel,
                 &self.contact,
                 &mut scratch.smoothing,
                 &mut scratch.images.vel,
             );
         }
-        self.profile.lap(Phase::Smoothing, &mut clock);
+        self.profile.lap(Phase::Smoothing, &mut watch);
         // Contact between the bodies, then between pulverized nodes closer
         // than half a spacing.
         motion::collide(
@@ -79,9 +79,9 @@ impl Mlpg3d {
             &mut self.vel,
             &mut scratch.contact,
             &mut scratch.images,
-            &mut self.contact_dissipation,
+            &mut self.energy.lost[LOST_CONTACT],
         );
-        motion::clamp(&frame, &mut self.vel, &mut self.contact_dissipation);
+        motion::clamp(&frame, &mut self.vel, &mut self.energy.lost[LOST_CONTACT]);
         motion::drift(
             &frame,
             self.anvil,
@@ -91,22 +91,22 @@ impl Mlpg3d {
             &scratch.kicks,
             &mut scratch.moves,
         );
-        self.time += dt;
-        self.steps += 1;
+        self.clock.time += dt;
+        self.clock.steps += 1;
         motion::settle(
             &scratch.moves,
-            &mut self.contact_dissipation,
+            &mut self.energy.lost[LOST_CONTACT],
             &mut self.last_release,
-            self.time,
+            self.clock.time,
         )?;
-        motion::check_planes(&self.pos, &self.plane, self.time)?;
-        self.profile.lap(Phase::Move, &mut clock);
-        if self.setup.shifting > 0.0 {
+        motion::check_planes(&self.pos, &self.plane, self.clock.time)?;
+        self.profile.lap(Phase::Move, &mut watch);
+        if self.setup.scheme.shifting > 0.0 {
             self.shift(scratch)?;
         }
-        self.profile.lap(Phase::Shift, &mut clock);
+        self.profile.lap(Phase::Shift, &mut watch);
         // 4. The geometry follows the body.
-        let d_min = self.follow(scratch, &mut clock)?;
+        let d_min = self.follow(scratch, &mut watch)?;
         // 5. Velocity gradients and the material.
         let g = self.geometry.as_ref().expect("built above");
         let vel_ext = extended(
@@ -116,7 +116,7 @@ impl Mlpg3d {
             mirror::vector,
         );
         g.shapes.velocity_gradients(vel_ext, &mut scratch.grad);
-        self.profile.lap(Phase::Gradients, &mut clock);
+        self.profile.lap(Phase::Gradients, &mut watch);
         update::update_material(
             &MaterialInputs {
                 dt,
@@ -139,23 +139,23 @@ impl Mlpg3d {
             },
             &mut scratch.results,
         );
-        let t = update::sum(&scratch.results, self.time)?;
-        self.profile.lap(Phase::Material, &mut clock);
-        self.internal_energy += t.internal;
+        let t = update::sum(&scratch.results, self.clock.time)?;
+        self.profile.lap(Phase::Material, &mut watch);
+        self.energy.internal += t.internal;
         self.plastic_work += t.plastic;
-        self.damping_dissipation += t.damping;
+        self.energy.lost[LOST_DAMPING] += t.damping;
         // 6. Checks and the next step.
         self.end_step(&t, d_min)?;
-        self.profile.lap(Phase::Checks, &mut clock);
+        self.profile.lap(Phase::Checks, &mut watch);
         Ok(())
     }
 
     /// Step 4: the spacing check over the named pairs, and the supports
     /// or the operator rebuilt when a pair has left its range or moved past
-    /// [`RodSetup::rebuild_strain`] (the clock restarted after a rebuild,
+    /// [`RodSetup::rebuild_strain`] (the watch restarted after a rebuild,
     /// which books its own phases). Returns the smallest distance between
     /// named nodes.
-    fn follow(&mut self, scratch: &mut Scratch, clock: &mut Clock) -> Result<f64> {
+    fn follow(&mut self, scratch: &mut Scratch, watch: &mut Stopwatch) -> Result<f64> {
         let images = &self.geometry.as_ref().expect("built above").mirror;
         let x = extended(images, &self.pos, &mut scratch.images.pos, mirror::vector);
         let b = extended(
@@ -165,18 +165,11 @@ impl Mlpg3d {
             mirror::vector,
         );
         let pairs = self.named_pairs(x, b);
-        self.profile.lap(Phase::Pairs, clock);
+        self.profile.lap(Phase::Pairs, watch);
         let d_min = pairs.nearest;
         let ratio = d_min / self.d_min0;
         self.min_spacing = self.min_spacing.min(ratio);
-        if below(ratio, SPACING_COLLAPSE_BOUND) {
-            return Err(Error::SpacingCollapse {
-                ratio,
-                bound: SPACING_COLLAPSE_BOUND,
-                time: self.time,
-                hint: "",
-            });
-        }
+        check_spacing(ratio, self.clock.time, "")?;
         let supports = pairs.recompute;
         if supports || pairs.strained {
             if supports {
@@ -187,7 +180,7 @@ impl Mlpg3d {
             self.built_contact.clone_from(&self.contact);
             self.built_rho.clone_from(&self.rho);
             self.build_geometry(supports)?;
-            *clock = self.profile.clock();
+            *watch = self.profile.stopwatch();
         }
         Ok(d_min)
     }
@@ -195,7 +188,7 @@ impl Mlpg3d {
     /// Step 6: the checks of the step (non-finite positions, energy drift),
     /// the next step (eq. 15) and its floor, and the end of a Taylor run:
     /// the rod has left the anvil, or it has been quiet for
-    /// [`crate::run::QUIET_TRANSITS`] transits ([`QuietEnd`]).
+    /// [`crate::solver::shared::QUIET_TRANSITS`] transits ([`QuietEnd`]).
     fn end_step(&mut self, t: &Tally, d_min: f64) -> Result<()> {
         if let Some(i) = self
             .pos
@@ -205,7 +198,7 @@ impl Mlpg3d {
             return Err(Error::NonFinite {
                 field: "position",
                 particle: i,
-                time: self.time,
+                time: self.clock.time,
             });
         }
         let e = self.energy_error_with(t.kinetic);
@@ -213,11 +206,11 @@ impl Mlpg3d {
             return Err(Error::EnergyDrift {
                 error: e,
                 bound: ENERGY_ERROR_BOUND,
-                time: self.time,
+                time: self.clock.time,
             });
         }
-        self.dt = self.stable_dt(t.worst_speed, d_min);
-        check_time_step(self.dt, self.dt0, self.time)?;
+        self.clock.dt = self.stable_dt(t.worst_speed, d_min);
+        self.clock.check_step(self.clock.dt)?;
         let touching = self.contact.par_iter().any(|&c| c);
         if self.anvil && -t.momentum / t.mass <= 0.0 && !touching {
             self.at_rest = true;
@@ -225,9 +218,9 @@ impl Mlpg3d {
         // A run of several bodies (no anvil) ends at its end time.
         if self.anvil
             && self.quiet_since.at_rest(
-                self.time,
+                self.clock.time,
                 t.kinetic,
-                self.initial_energy,
+                self.energy.initial,
                 self.setup.cylinder.length,
                 self.wave_speed(),
             )

@@ -6,7 +6,7 @@ use crate::material::eos::LinearEos;
 use crate::material::{Damage, Eos, Strength};
 
 /// 4340-like steel with bilinear hardening (yield 500 MPa, H = 1 GPa).
-fn plastic_steel() -> Material {
+pub(super) fn plastic_steel() -> Material {
     Material {
         eos: Eos::Linear(LinearEos {
             bulk_modulus: 169.1e9,
@@ -55,9 +55,9 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
         let mut drift = [0.0; 2];
         for conservative in [true, false] {
             let mut setup = RodSetup::new(small_rod(), 3, 300.0, 1.0);
-            setup.weak_form = WeakForm::Nodal;
-            setup.smoothing_order = 2;
-            setup.shifting = 0.1;
+            setup.scheme.forces = Forces::Nodal;
+            setup.scheme.order = SmoothingOrder::Two;
+            setup.scheme.shifting = 0.1;
             setup.quarter = quarter;
             setup.conservative_carry = conservative;
             let mut run = Mlpg3d::bodies(setup, plastic_steel(), Vec::new()).unwrap();
@@ -83,7 +83,7 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             }
             if amplitude == 0.0 {
                 // The run's energy balance starts from this field.
-                run.initial_energy = kinetic(&run.vel, &run.mass);
+                run.energy.initial = kinetic(&run.vel, &run.mass);
             }
             run.step().unwrap();
             // Three interior nodes, each pushed toward a neighbour.
@@ -118,7 +118,10 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
                 (p, scale)
             };
             let (p0, scale) = momentum(&run);
-            let (ke0, booked0) = (kinetic(&run.vel, &run.mass), run.smoothing_dissipation);
+            let (ke0, booked0) = (
+                kinetic(&run.vel, &run.mass),
+                run.energy.lost[LOST_SMOOTHING],
+            );
             let pos0 = run.pos.clone();
             let mut scratch = std::mem::take(&mut run.scratch);
             scratch.fit(n);
@@ -131,7 +134,7 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             drift[usize::from(!conservative)] =
                 axes.map(|k| (p1[k] - p0[k]).abs()).fold(0.0, f64::max) / scale;
             let ke1 = kinetic(&run.vel, &run.mass);
-            let booked = run.smoothing_dissipation - booked0;
+            let booked = run.energy.lost[LOST_SMOOTHING] - booked0;
             assert!(
                 (ke1 + booked - ke0).abs() < 1e-13 * ke0,
                 "quarter {quarter}: {ke0} J before, {ke1} J after, {booked} J booked"
@@ -209,11 +212,14 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
 /// 0.54 % after.
 #[test]
 fn the_quarter_model_is_the_whole_body_restricted() {
-    for (form, order, shifting) in [(WeakForm::Sphere, 1, 0.0), (WeakForm::Nodal, 2, 0.1)] {
+    for (form, order, shifting) in [
+        (Forces::Sphere, SmoothingOrder::One, 0.0),
+        (Forces::Nodal, SmoothingOrder::Two, 0.1),
+    ] {
         let mut setup = RodSetup::new(small_rod(), 3, 300.0, 1.0);
-        setup.weak_form = form;
-        setup.smoothing_order = order;
-        setup.shifting = shifting;
+        setup.scheme.forces = form;
+        setup.scheme.order = order;
+        setup.scheme.shifting = shifting;
         let mut full = Mlpg3d::new(setup, plastic_steel()).unwrap();
         let quarter_setup = RodSetup {
             quarter: true,

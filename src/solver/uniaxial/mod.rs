@@ -27,6 +27,10 @@ mod step;
 use crate::error::{Error, Result};
 use crate::material::rajendran_grove::CeramicPoint;
 use crate::observe::FieldSpec;
+use crate::solver::shared::{Clock, EnergyBook};
+
+/// The place in the energy book of the energy lost at the contact.
+const LOST_CONTACT: usize = 0;
 pub use fields::PLATE_IMPACT_FIELDS;
 use layer::CellState;
 pub use layer::Layer;
@@ -49,14 +53,14 @@ pub struct PlateImpact {
     density0: Vec<f64>,
     state: Vec<CellState>,
     stress: Vec<f64>,
-    energy: Vec<f64>,
-    time: f64,
-    steps: u64,
+    specific_energy: Vec<f64>,
+    clock: Clock,
     /// Where [`PlateImpact::finished`] holds (s); infinite unless set by
     /// [`PlateImpact::until`].
     end_time: f64,
-    initial_kinetic: f64,
-    contact_loss: f64,
+    /// The impact's kinetic energy and the loss at the contact
+    /// ([`LOST_CONTACT`]); the internal energy is summed from the cells.
+    energy: EnergyBook<1>,
     reading: FreeSurfaceReading,
     /// The depth below the target's impact face of the first target cell
     /// that failed in tension, and when (m, s).
@@ -125,12 +129,10 @@ impl PlateImpact {
             density0: Vec::new(),
             state: Vec::new(),
             stress: Vec::new(),
-            energy: Vec::new(),
-            time: 0.0,
-            steps: 0,
+            specific_energy: Vec::new(),
+            clock: Clock::default(),
             end_time: f64::INFINITY,
-            initial_kinetic: 0.0,
-            contact_loss: 0.0,
+            energy: EnergyBook::new(0.0),
             reading: FreeSurfaceReading::default(),
             spall: None,
             free_surface: Vec::new(),
@@ -157,13 +159,13 @@ impl PlateImpact {
                 sim.density0.push(rho);
                 sim.state.push(layer.initial_state());
                 sim.stress.push(0.0);
-                sim.energy.push(0.0);
+                sim.specific_energy.push(0.0);
                 sim.mass[first + i] += 0.5 * rho * h;
                 sim.mass[first + i + 1] += 0.5 * rho * h;
             }
             start = 0.0;
         }
-        sim.initial_kinetic = sim.kinetic();
+        sim.energy.initial = sim.kinetic();
         sim.record();
         Ok(sim)
     }
@@ -193,9 +195,9 @@ impl PlateImpact {
     fn record(&mut self) {
         let u = *self.v.last().expect("nodes");
         if self.keep_history {
-            self.free_surface.push((self.time, u));
+            self.free_surface.push((self.clock.time, u));
         }
-        self.reading.read(self.time, u, self.impact_speed);
+        self.reading.read(self.clock.time, u, self.impact_speed);
     }
 
     /// Runs until `end_time` (s) from now on: [`PlateImpact::finished`]
@@ -216,10 +218,10 @@ impl PlateImpact {
 
     /// Whether the run has reached its end time ([`PlateImpact::until`]).
     pub fn finished(&self) -> bool {
-        self.time >= self.end_time
+        self.clock.time >= self.end_time
     }
 
-    crate::run::clock_getters!();
+    crate::solver::shared::clock_getters!();
 
     /// The end time (s), infinite if none was set.
     pub fn end_time(&self) -> f64 {
@@ -264,15 +266,15 @@ impl PlateImpact {
     /// the contact's merging, per unit area (J/m2).
     pub fn energies(&self) -> [f64; 3] {
         let internal: f64 = (0..self.state.len())
-            .map(|c| self.density0[c] * self.length0[c] * self.energy[c])
+            .map(|c| self.density0[c] * self.length0[c] * self.specific_energy[c])
             .sum();
-        [self.kinetic(), internal, self.contact_loss]
+        [self.kinetic(), internal, self.energy.lost[LOST_CONTACT]]
     }
 
     /// The relative energy error `|KE + IE + contact loss - KE0| / KE0`.
     pub fn energy_error(&self) -> f64 {
-        let total: f64 = self.energies().iter().sum();
-        (total - self.initial_kinetic).abs() / self.initial_kinetic
+        let [kinetic, internal, _] = self.energies();
+        self.energy.error_given(kinetic, internal)
     }
 
     /// The target's cells from the impact face: `(position, stress)` with
@@ -300,10 +302,10 @@ impl PlateImpact {
 
 impl crate::model::Model for PlateImpact {
     fn time(&self) -> f64 {
-        self.time
+        self.clock.time
     }
     fn steps(&self) -> u64 {
-        self.steps
+        self.clock.steps
     }
     fn particles(&self) -> usize {
         Self::particles(self)

@@ -1,7 +1,7 @@
 //! The check of a restored plate-impact run.
 
-use super::PlateImpact;
 use super::layer::{CellState, Layer};
+use super::{LOST_CONTACT, PlateImpact};
 
 impl PlateImpact {
     /// Checks a restored run against `fresh`, a new run of the same
@@ -16,7 +16,7 @@ impl PlateImpact {
             && self.length0 == fresh.length0
             && self.density0 == fresh.density0
             && self.end_time.to_bits() == fresh.end_time.to_bits()
-            && self.initial_kinetic.to_bits() == fresh.initial_kinetic.to_bits();
+            && self.energy.initial.to_bits() == fresh.energy.initial.to_bits();
         if !same {
             return Err("its plates, cells or masses do not follow from its parameters".into());
         }
@@ -25,7 +25,7 @@ impl PlateImpact {
             ("positions", &self.x, nodes),
             ("velocities", &self.v, nodes),
             ("stresses", &self.stress, cells),
-            ("specific energies", &self.energy, cells),
+            ("specific energies", &self.specific_energy, cells),
         ] {
             if f.len() != n || !f.iter().all(|x| x.is_finite()) {
                 return Err(format!("its {what} are not {n} finite numbers"));
@@ -84,14 +84,14 @@ impl PlateImpact {
                 ));
             }
         }
-        let clock = self.time.is_finite()
-            && self.time >= 0.0
-            && self.time <= self.end_time
-            && ((self.steps == 0) == (self.time == 0.0));
+        let clock = self.clock.time.is_finite()
+            && self.clock.time >= 0.0
+            && self.clock.time <= self.end_time
+            && ((self.clock.steps == 0) == (self.clock.time == 0.0));
         if !clock {
             return Err(format!(
                 "its clock (t = {}, {} steps) is not valid",
-                self.time, self.steps
+                self.clock.time, self.clock.steps
             ));
         }
         let r = self.reading;
@@ -99,16 +99,17 @@ impl PlateImpact {
             && r.pullback_minimum.is_finite()
             && r.last.abs() <= bound
             && r.phase <= 2
-            && r.arrival.is_none_or(|t| t.is_finite() && t <= self.time)
+            && r.arrival
+                .is_none_or(|t| t.is_finite() && t <= self.clock.time)
             && r.precursor
                 .is_none_or(|u| u.is_finite() && u.abs() <= bound)
             && r.peak.abs() <= bound
             && r.pullback_minimum.abs() <= bound
-            && self.contact_loss.is_finite()
-            && self.contact_loss >= 0.0
-            && self
-                .spall
-                .is_none_or(|(d, t)| d >= 0.0 && d <= thickness && t >= 0.0 && t <= self.time);
+            && self.energy.lost[LOST_CONTACT].is_finite()
+            && self.energy.lost[LOST_CONTACT] >= 0.0
+            && self.spall.is_none_or(|(d, t)| {
+                d >= 0.0 && d <= thickness && t >= 0.0 && t <= self.clock.time
+            });
         if !finite {
             return Err("its free-surface reading or spall is not one a run can reach".into());
         }

@@ -1,7 +1,7 @@
 //! The central-difference step of the plates and its stable size.
 
-use super::PlateImpact;
 use super::layer::Layer;
+use super::{LOST_CONTACT, PlateImpact};
 use crate::error::{Error, Result};
 use crate::material::Loading;
 use crate::material::tensor::Full;
@@ -15,8 +15,8 @@ const COURANT: f64 = 0.5;
 impl PlateImpact {
     /// Runs to `end_time` (s).
     pub fn run(&mut self, end_time: f64) -> Result<()> {
-        while self.time < end_time {
-            let dt = self.stable_step().min(end_time - self.time);
+        while self.clock.time < end_time {
+            let dt = self.stable_step().min(end_time - self.clock.time);
             self.step(dt)?;
         }
         Ok(())
@@ -24,7 +24,7 @@ impl PlateImpact {
 
     /// One stable step, ending at the end time at the latest.
     pub fn advance(&mut self) -> Result<()> {
-        let dt = self.stable_step().min(self.end_time - self.time);
+        let dt = self.stable_step().min(self.end_time - self.clock.time);
         self.step(dt)
     }
 
@@ -61,12 +61,12 @@ impl PlateImpact {
             let common = (mf * self.v[f] + mt * self.v[t]) / (mf + mt);
             self.v[f] = common;
             self.v[t] = common;
-            self.contact_loss += 0.5 * mf * mt / (mf + mt) * closing * closing;
+            self.energy.lost[LOST_CONTACT] += 0.5 * mf * mt / (mf + mt) * closing * closing;
         }
         for i in 0..self.x.len() {
             self.x[i] += self.v[i] * dt;
         }
-        self.time += dt;
+        self.clock.time += dt;
         for c in 0..n {
             let (a, b) = self.nodes(c);
             let len = self.x[b] - self.x[a];
@@ -74,7 +74,7 @@ impl PlateImpact {
                 return Err(Error::ThroughBoundary {
                     particle: c,
                     boundary: "neighbouring node (cell inverted)",
-                    time: self.time,
+                    time: self.clock.time,
                     position: self.x[a],
                 });
             }
@@ -94,16 +94,19 @@ impl PlateImpact {
             let new = match layer {
                 // The ceramic's porous pressure takes the cell's specific
                 // internal energy.
-                Layer::Ceramic(_) => {
-                    materials[k].update_with_energy(&load, &old, self.energy[c], &mut point_state)
-                }
+                Layer::Ceramic(_) => materials[k].update_with_energy(
+                    &load,
+                    &old,
+                    self.specific_energy[c],
+                    &mut point_state,
+                ),
                 // A metal's pressure is at its temperature, as in the other
                 // solvers.
                 Layer::Solid(_) => materials[k].update(&load, &old, &mut point_state),
             }
             .map_err(|e| Error::CompressionLimit {
                 particle: c,
-                time: self.time,
+                time: self.clock.time,
                 compression: e.compression,
                 limit: e.limit,
             })?;
@@ -120,7 +123,7 @@ impl PlateImpact {
                     .is_some_and(|z| z.volumetric_strain > 0.0)
             {
                 let depth = (c - self.flyer_cells) as f64;
-                self.spall = Some(((depth + 0.5) * self.length0[c], self.time));
+                self.spall = Some(((depth + 0.5) * self.length0[c], self.clock.time));
             }
             let material = new.deviator[0] - new.pressure;
             let q = if d < 0.0 {
@@ -135,20 +138,20 @@ impl PlateImpact {
                 return Err(Error::NonFinite {
                     field: "stress",
                     particle: c,
-                    time: self.time,
+                    time: self.clock.time,
                 });
             }
-            self.energy[c] += 0.5 * (self.stress[c] + stress) * d * dt / rho;
+            self.specific_energy[c] += 0.5 * (self.stress[c] + stress) * d * dt / rho;
             self.stress[c] = stress;
         }
         if let Some(i) = self.v.iter().position(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 field: "velocity",
                 particle: i,
-                time: self.time,
+                time: self.clock.time,
             });
         }
-        self.steps += 1;
+        self.clock.steps += 1;
         self.record();
         Ok(())
     }

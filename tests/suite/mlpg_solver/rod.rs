@@ -4,7 +4,7 @@
 //! explorations of `examples/explore/` (which include this file by its
 //! path).
 
-use meshless_impact::internals::mlpg::{Cylinder, Mlpg3d, RodSetup, WeakForm};
+use meshless_impact::internals::mlpg::{Cylinder, Forces, Mlpg3d, RodSetup};
 use meshless_impact::materials::{Bilinear, Damage, Eos, LinearEos, Material, Strength};
 use meshless_impact::{Scene, Taylor3dParams};
 
@@ -59,19 +59,19 @@ pub(crate) const ROD: Cylinder = Cylinder {
 /// time the anvil's pressure ([`face_traction`]) fell to zero after the
 /// first transit (linear between steps).
 pub(crate) fn elastic_rebound(rings: usize, smoothing: f64) -> (Mlpg3d, [f64; 2], f64) {
-    elastic_rebound_with(rings, smoothing, WeakForm::Sphere)
+    elastic_rebound_with(rings, smoothing, Forces::Sphere)
 }
 
 /// [`elastic_rebound`] with the weak form `form`.
 pub(crate) fn elastic_rebound_with(
     rings: usize,
     smoothing: f64,
-    form: WeakForm,
+    form: Forces,
 ) -> (Mlpg3d, [f64; 2], f64) {
     let v0 = 10.0;
     let mut setup = RodSetup::new(ROD, rings, v0, 40e-6);
-    setup.smoothing = smoothing;
-    setup.weak_form = form;
+    setup.scheme.smoothing = smoothing;
+    setup.scheme.forces = form;
     let mut s = Mlpg3d::new(setup, elastic()).unwrap();
     let stations = [0.25 * ROD.length, 0.75 * ROD.length];
     let dz = s.lattice().axial_spacing;

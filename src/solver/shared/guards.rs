@@ -1,9 +1,6 @@
-//! The run's guards and bounds, shared by every solver (the axisymmetric
-//! and radial MSPH solvers in [`crate::solver`], the 3-D MLPG solver in
-//! [`crate::solver::mlpg3d`]): the named stops (energy drift, spacing collapse, time
-//! step collapse, NaN), the quiet end and its detector ([`QuietEnd`]), the
-//! shifting bounds, and the checks of a restored run's clock and bounds. No
-//! solver imports these from another solver's file.
+//! The run's guards and bounds, shared by every solver: the named stops
+//! (energy drift, spacing collapse, time step collapse, NaN), the quiet end
+//! and its detector ([`QuietEnd`]), and the shifting bounds.
 
 /// Smallest distance between two neighbouring particles (every pair, mirror
 /// images included), relative to the initial spacing, below which a run
@@ -82,33 +79,6 @@ impl QuietEnd {
     }
 }
 
-/// The clock's getters of a solver, `time()` (s) and `steps()`, and with
-/// `dt` also `dt()` (s), over its fields of those names: written once for
-/// every solver (the fields stay in each solver's struct, flat in its saved
-/// state).
-macro_rules! clock_getters {
-    () => {
-        /// Simulated time (s).
-        pub fn time(&self) -> f64 {
-            self.time
-        }
-
-        /// Steps taken.
-        pub fn steps(&self) -> u64 {
-            self.steps
-        }
-    };
-    (dt) => {
-        $crate::run::clock_getters!();
-
-        /// Current time step (s).
-        pub fn dt(&self) -> f64 {
-            self.dt
-        }
-    };
-}
-pub(crate) use clock_getters;
-
 /// The smallest accepted step, as a fraction of the first step: below it the
 /// run stops with [`crate::Error::TimeStepCollapse`].
 pub const MIN_DT_FRACTION: f64 = 1e-4;
@@ -144,6 +114,22 @@ pub(crate) fn below(value: f64, bound: f64) -> bool {
     value.is_nan() || value < bound
 }
 
+/// Stops a run whose smallest neighbour distance, relative to the initial
+/// spacing, fell below [`SPACING_COLLAPSE_BOUND`]; `hint` ends the message
+/// (a scheme that would help, or nothing).
+pub(crate) fn check_spacing(ratio: f64, time: f64, hint: &'static str) -> crate::Result<()> {
+    if below(ratio, SPACING_COLLAPSE_BOUND) {
+        Err(crate::Error::SpacingCollapse {
+            ratio,
+            bound: SPACING_COLLAPSE_BOUND,
+            time,
+            hint,
+        })
+    } else {
+        Ok(())
+    }
+}
+
 /// Stops a run whose stable step fell below [`MIN_DT_FRACTION`] of the first.
 pub(crate) fn check_time_step(dt: f64, dt0: f64, time: f64) -> crate::Result<()> {
     if below(dt, MIN_DT_FRACTION * dt0) {
@@ -155,104 +141,6 @@ pub(crate) fn check_time_step(dt: f64, dt0: f64, time: f64) -> crate::Result<()>
     } else {
         Ok(())
     }
-}
-
-/// Checks the clock of a restored run (the message says what is wrong): a
-/// finite time from zero; a positive step no longer than four times the
-/// first (the step follows the wave speed, which a run cannot raise
-/// fourfold, as that would take the density to a sixteenth; a forged step
-/// of seconds would fling the particles across the lattice); steps taken
-/// exactly when time has passed; and finite `bookkeeping` (energies, the
-/// smallest spacing, ...).
-pub(crate) fn check_restored_clock(
-    time: f64,
-    dt: f64,
-    dt0: f64,
-    steps: u64,
-    bookkeeping: &[f64],
-) -> std::result::Result<(), String> {
-    if !bookkeeping
-        .iter()
-        .chain([&time, &dt])
-        .all(|x| x.is_finite())
-    {
-        return Err("its clock and energies are not all finite and in range".into());
-    }
-    if !(time >= 0.0 && dt > 0.0 && dt <= 4.0 * dt0) {
-        return Err("its clock are not all finite and in range".into());
-    }
-    if (steps == 0) != (time == 0.0) {
-        return Err(format!(
-            "its step count {steps} does not match its time {time}"
-        ));
-    }
-    Ok(())
-}
-
-/// How fast a restored node may move, in units of the fastest speed at the
-/// start (the nodes' speed plus the wave speed): a running solver never comes
-/// near ten.
-pub(crate) const RESTORED_SPEED_FACTOR: f64 = 10.0;
-
-/// The physical bounds of a restored run, from a new run of its parameters:
-/// no node faster than [`RESTORED_SPEED_FACTOR`] times the fastest speed at
-/// the start, none further from the origin than the bodies' extent plus that
-/// speed times the run's time. A forged state of finite but absurd values
-/// (a velocity of 1e300, a node a light-year away) is refused by them.
-pub(crate) struct RestoreBounds {
-    /// Largest coordinate of the bodies at the start (m).
-    pub extent: f64,
-    speed: f64,
-    reach: f64,
-}
-
-impl RestoreBounds {
-    /// The bounds of a run whose nodes start at `start` with speeds up to
-    /// `fastest` (m/s, node speed plus wave speed), restored at `time`.
-    pub fn new<const D: usize>(start: &[[f64; D]], fastest: f64, time: f64) -> Self {
-        let extent = start.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-        let speed = RESTORED_SPEED_FACTOR * fastest;
-        RestoreBounds {
-            extent,
-            speed,
-            reach: extent + speed * time,
-        }
-    }
-
-    /// Refuses a node faster than the bound.
-    pub fn speeds<const D: usize>(&self, what: &str, v: &[[f64; D]]) -> Result<(), String> {
-        match v
-            .iter()
-            .position(|v| above(v.iter().map(|x| x * x).sum::<f64>().sqrt(), self.speed))
-        {
-            Some(i) => Err(format!(
-                "its {what} are not physical: node {i} is faster than {} m/s",
-                crate::error::number(self.speed)
-            )),
-            None => Ok(()),
-        }
-    }
-
-    /// Refuses a place further out than the bodies can have gone.
-    pub fn places<const D: usize>(&self, what: &str, x: &[[f64; D]]) -> Result<(), String> {
-        match x
-            .iter()
-            .position(|x| x.iter().any(|c| above(c.abs(), self.reach)))
-        {
-            Some(i) => Err(format!(
-                "its {what} are not physical: node {i} is further than {} m out",
-                crate::error::number(self.reach)
-            )),
-            None => Ok(()),
-        }
-    }
-}
-
-/// Index and field of the first non-finite value, if any.
-pub(crate) fn first_non_finite(fields: &[(&'static str, &[f64])]) -> Option<(&'static str, usize)> {
-    fields
-        .iter()
-        .find_map(|(name, v)| v.iter().position(|x| !x.is_finite()).map(|i| (*name, i)))
 }
 
 #[cfg(test)]

@@ -1,0 +1,289 @@
+//! The format of a saved run ([`crate::Simulation::serialize_state`]) and
+//! the readers of the formats before it.
+//!
+//! A saved run carries its format's number under the key `format`. This
+//! build writes [`FORMAT`] and reads every format from 1 up: a state of an
+//! older format is brought up to this one in its JSON tree, one format at a
+//! time, before it is read; a newer or unknown one is refused, naming both
+//! numbers. `tests/data/states/` holds a state of each format, written by
+//! the build that introduced it, and `tests/suite/state_files.rs` holds
+//! this build to loading each and going on to the same bits.
+//!
+//! | Format | Written by | What changed |
+//! | --- | --- | --- |
+//! | 1 | up to 2026-11-29 (no `format` key) | — |
+//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; the 3-D runs' typed scheme |
+
+use serde_json::{Map, Value};
+
+/// The format this build writes.
+pub const FORMAT: u32 = 2;
+
+/// Brings a saved run of any format this build reads up to [`FORMAT`], in
+/// place; the message says why one cannot be.
+pub(crate) fn upgrade(saved: &mut Value) -> Result<(), String> {
+    let root = saved
+        .as_object_mut()
+        .ok_or("it is not a saved run: a JSON object with its scene, solver and history")?;
+    let format = match root.get("format") {
+        None => 1,
+        Some(v) => v
+            .as_u64()
+            .filter(|&f| f >= 1)
+            .ok_or_else(|| format!("its format {v} is not a format number (1 to {FORMAT})"))?,
+    };
+    if format > u64::from(FORMAT) {
+        return Err(format!(
+            "it is of format {format}, newer than this build's {FORMAT}: load it with the build \
+             that wrote it, or a newer one"
+        ));
+    }
+    if format < 2 {
+        from_1(root)?;
+    }
+    root.insert("format".into(), Value::from(FORMAT));
+    Ok(())
+}
+
+/// Format 1 to 2: each solver's clock (`time`, `steps`, `dt`, `dt0`) and
+/// energy book (the energy at the start, the internal energy and the
+/// losses, in the order of the solver's balance) gathered under `clock`
+/// and `energy`; the 3-D solver's scheme typed under `setup.scheme`; a
+/// penetration run's setup keeping only what its rod's does not say; the
+/// plate impact's cell energies renamed `specific_energy`; and every field
+/// that a state of format 1 may lack (it was read with a default) put in
+/// with that default.
+fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
+    let solver = root
+        .get_mut("solver")
+        .and_then(Value::as_object_mut)
+        .ok_or("it holds no solver")?;
+    let Some((kind, state)) = solver.iter_mut().next() else {
+        return Err("it holds no solver".into());
+    };
+    let state = state
+        .as_object_mut()
+        .ok_or_else(|| format!("its solver {kind} is not an object"))?;
+    match kind.as_str() {
+        "Taylor" => {
+            defaults(
+                state,
+                &[
+                    ("material_state", Value::Null),
+                    ("quiet_since", Value::Null),
+                ],
+            );
+            clock(state)?;
+            energy(
+                state,
+                "initial_energy",
+                Some("internal_energy"),
+                &["smoothing_dissipation", "contact_dissipation"],
+            )
+        }
+        "Noh" => {
+            clock(state)?;
+            energy(state, "initial_energy", None, &[])
+        }
+        "Plate_impact" => {
+            // The cells' specific energies make room for the book.
+            let cells = take(state, "energy")?;
+            state.insert("specific_energy".into(), cells);
+            clock(state)?;
+            energy(state, "initial_kinetic", None, &["contact_loss"])
+        }
+        "Taylor3d" => mlpg(state),
+        "Penetration" => {
+            let run = state
+                .get_mut("run")
+                .and_then(Value::as_object_mut)
+                .ok_or("its penetration run is missing")?;
+            mlpg(run)?;
+            let setup = state
+                .get_mut("setup")
+                .and_then(Value::as_object_mut)
+                .ok_or("its penetration setup is missing")?;
+            for key in ["projectile", "impact_speed", "rings", "end_time"] {
+                setup.remove(key);
+            }
+            defaults(
+                setup,
+                &[
+                    ("until_outcome", Value::Bool(false)),
+                    ("clamped_rim", Value::Bool(false)),
+                ],
+            );
+            Ok(())
+        }
+        other => Err(format!("its solver {other} is not one this build knows")),
+    }
+}
+
+/// Puts in each key of `defaults` that `state` lacks, with its value: what
+/// the solvers' `serde(default)` marks gave the fields that states saved
+/// before them lack (format 2 has no such marks).
+fn defaults(state: &mut Map<String, Value>, defaults: &[(&str, Value)]) {
+    for (key, value) in defaults {
+        state
+            .entry(key.to_string())
+            .or_insert_with(|| value.clone());
+    }
+}
+
+/// Moves `key` out of `state`, or says that it is missing.
+fn take(state: &mut Map<String, Value>, key: &str) -> Result<Value, String> {
+    state
+        .remove(key)
+        .ok_or_else(|| format!("its solver has no {key}"))
+}
+
+/// `time`, `steps`, `dt` and `dt0` under `clock` (a solver without a
+/// stored step, the plate impact's, has neither `dt` nor `dt0`).
+fn clock(state: &mut Map<String, Value>) -> Result<(), String> {
+    let mut clock = Map::new();
+    for key in ["time", "steps"] {
+        clock.insert(key.into(), take(state, key)?);
+    }
+    for key in ["dt", "dt0"] {
+        clock.insert(key.into(), state.remove(key).unwrap_or(Value::from(0.0)));
+    }
+    state.insert("clock".into(), Value::Object(clock));
+    Ok(())
+}
+
+/// The energy book under `energy`: `initial` from `initial`, `internal`
+/// from `internal` (zero for a solver that sums it from its cells), and the
+/// `lost` terms in the order given.
+fn energy(
+    state: &mut Map<String, Value>,
+    initial: &str,
+    internal: Option<&str>,
+    lost: &[&str],
+) -> Result<(), String> {
+    let mut book = Map::new();
+    book.insert("initial".into(), take(state, initial)?);
+    let internal = match internal {
+        Some(key) => take(state, key)?,
+        None => Value::from(0.0),
+    };
+    book.insert("internal".into(), internal);
+    let lost = lost
+        .iter()
+        .map(|key| take(state, key))
+        .collect::<Result<Vec<_>, _>>()?;
+    book.insert("lost".into(), Value::Array(lost));
+    state.insert("energy".into(), Value::Object(book));
+    Ok(())
+}
+
+/// The 3-D solver's state of format 1 in format 2.
+fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
+    let empty = || Value::Array(Vec::new());
+    defaults(
+        state,
+        &[
+            ("material_state", Value::Null),
+            ("others", empty()),
+            ("group", empty()),
+            ("anvil", Value::Bool(true)),
+            ("reach", Value::from(0.0)),
+            ("reference", empty()),
+            ("built_reference", empty()),
+            ("built_contact", empty()),
+            ("built_rho", empty()),
+            ("built_multipliers", empty()),
+            ("reaction", empty()),
+            ("plane", empty()),
+            ("held", empty()),
+            ("shift_dissipation", Value::from(0.0)),
+        ],
+    );
+    if let Some(others) = state.get_mut("others").and_then(Value::as_array_mut) {
+        for body in others.iter_mut().filter_map(Value::as_object_mut) {
+            defaults(body, &[("clamped_rim", Value::Bool(false))]);
+        }
+    }
+    clock(state)?;
+    energy(
+        state,
+        "initial_energy",
+        Some("internal_energy"),
+        &[
+            "damping_dissipation",
+            "contact_dissipation",
+            "smoothing_dissipation",
+        ],
+    )?;
+    let setup = state
+        .get_mut("setup")
+        .and_then(Value::as_object_mut)
+        .ok_or("its setup is missing")?;
+    defaults(
+        setup,
+        &[
+            ("base", Value::from(0.0)),
+            ("quarter", Value::Bool(false)),
+            ("conservative_carry", Value::Bool(false)),
+            ("weak_form", Value::from("Sphere")),
+        ],
+    );
+    let weak_form = take(setup, "weak_form")?;
+    let conforming = setup.remove("conforming").unwrap_or(Value::Bool(false));
+    let forces = match (weak_form.as_str(), conforming.as_bool()) {
+        (Some("Sphere"), _) => "Sphere",
+        (Some("Nodal"), Some(true)) => "Conforming",
+        (Some("Nodal"), _) => "Nodal",
+        _ => return Err(format!("its weak form {weak_form} is not Sphere or Nodal")),
+    };
+    let order = match setup.remove("smoothing_order").and_then(|v| v.as_u64()) {
+        Some(2) => "Two",
+        // A state saved before the order was saved smooths to order 1.
+        _ => "One",
+    };
+    let lattice = match setup.remove("staggered").and_then(|v| v.as_bool()) {
+        Some(true) => "Staggered",
+        _ => "Aligned",
+    };
+    let mut scheme = Map::new();
+    scheme.insert("forces".into(), Value::from(forces));
+    scheme.insert("order".into(), Value::from(order));
+    scheme.insert("smoothing".into(), take(setup, "smoothing")?);
+    scheme.insert(
+        "shifting".into(),
+        setup.remove("shifting").unwrap_or(Value::from(0.0)),
+    );
+    scheme.insert("lattice".into(), Value::from(lattice));
+    setup.insert("scheme".into(), Value::Object(scheme));
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// A newer format, and a format that is not a number, are refused
+    /// naming them.
+    #[test]
+    fn newer_and_unknown_formats_are_refused() {
+        let mut newer = json!({"format": FORMAT + 1, "solver": {}});
+        let e = upgrade(&mut newer).unwrap_err();
+        assert!(e.contains(&format!("format {}", FORMAT + 1)), "{e}");
+        for bad in [json!("two"), json!(0), json!(-1), json!(1.5)] {
+            let mut s = json!({"format": bad, "solver": {}});
+            let e = upgrade(&mut s).unwrap_err();
+            assert!(e.contains("is not a format number"), "{e}");
+        }
+        let e = upgrade(&mut json!([1, 2])).unwrap_err();
+        assert!(e.contains("not a saved run"), "{e}");
+    }
+
+    /// A state of this format passes unchanged.
+    #[test]
+    fn the_current_format_is_left_as_it_is() {
+        let mut s = json!({"format": FORMAT, "solver": {"Noh": {"clock": 1}}});
+        let before = s.clone();
+        upgrade(&mut s).unwrap();
+        assert_eq!(s, before);
+    }
+}
