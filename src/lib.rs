@@ -104,7 +104,7 @@ mod test_rng;
 pub use budget::{DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_VAR, MemoryPerNode, memory_budget};
 pub use error::{Error, MomentMethod, Result};
 pub use isa::Isa;
-pub use model::{Model, ModelState};
+pub use model::{Model, ModelState, SavedSolver};
 pub use observe::{
     Field, FieldSpec, History, LOG10_NO_CRACKS, NOH_OBSERVABLES, ObservableSpec,
     PLATE_IMPACT_OBSERVABLES, Snapshot, TAYLOR_OBSERVABLES, write_pvd,

@@ -15,13 +15,12 @@ pub trait ModelState {
     fn boxed_clone(&self) -> Box<dyn Model>;
 
     /// The run's state, for any serde format (JSON in the C ABI's saved
-    /// states, postcard in the FMU's), restored by its registry row's
-    /// `restore`.
+    /// states, postcard in the FMU's), loaded by [`Model::load_state`].
     fn save(&self) -> &dyn erased_serde::Serialize;
 
     /// The run's state in postcard, encoded by its own type (no dynamic
-    /// call per value): what the FMU state holds, restored by its row's
-    /// `restore` from `SavedSolver::Postcard` (`src/scene/registry.rs`).
+    /// call per value): what the FMU state holds, loaded by
+    /// [`Model::load_state`] from [`SavedSolver::Postcard`].
     fn save_compact(&self) -> Vec<u8>;
 
     /// This run as [`Any`], for [`Model::check_restored`] to reach `fresh`'s
@@ -123,10 +122,16 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// without compiled copies ignores it.
     fn set_isa(&mut self, _isa: Isa) {}
 
+    /// Replaces the state of this run, a new run of its scene, with the
+    /// saved one (of [`ModelState::save`] or [`ModelState::save_compact`]),
+    /// read but not yet checked ([`Model::check_restored`]). The message
+    /// says why it cannot be read; on an error this run is left as it was.
+    fn load_state(&mut self, saved: SavedSolver<'_>) -> std::result::Result<(), String>;
+
     /// Checks a restored run against `fresh`, a new run of the same scene
-    /// built by the same row: the same lattice, masses and material, bit
-    /// for bit, one finite value per particle in every field, and a clock a
-    /// run of this scene can reach.
+    /// built by the same row: what follows from the parameters the same,
+    /// bit for bit, one finite value per particle in every field, and a
+    /// clock, places and speeds a run of this scene can reach.
     fn check_restored(&self, fresh: &dyn Model) -> std::result::Result<(), String>;
 }
 
@@ -137,6 +142,29 @@ pub(crate) fn same_solver<T: 'static>(fresh: &dyn Model) -> std::result::Result<
         .as_any()
         .downcast_ref::<T>()
         .ok_or_else(|| "its solver is not its scene's".to_string())
+}
+
+/// A solver's saved state as [`Model::load_state`] reads it.
+pub enum SavedSolver<'a> {
+    /// As a JSON tree ([`crate::Simulation::serialize_state`]).
+    Json(serde_json::Value),
+    /// The postcard bytes of [`ModelState::save_compact`], decoded by the
+    /// solver's own type (no dynamic call per value).
+    Postcard(&'a [u8]),
+}
+
+/// `saved` read as a `T` (not yet checked).
+pub(crate) fn read_saved<T: serde::de::DeserializeOwned>(
+    saved: SavedSolver<'_>,
+) -> std::result::Result<T, String> {
+    match saved {
+        SavedSolver::Json(value) => serde_json::from_value(value).map_err(|e| e.to_string()),
+        SavedSolver::Postcard(bytes) => match postcard::take_from_bytes::<T>(bytes) {
+            Ok((value, [])) => Ok(value),
+            Ok((_, left)) => Err(format!("{} bytes follow its solver", left.len())),
+            Err(e) => Err(e.to_string()),
+        },
+    }
 }
 
 /// Inside `impl Model for T`: the methods that call `T`'s inherent methods

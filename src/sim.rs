@@ -5,9 +5,8 @@
 
 use crate::error::{Error, Result};
 use crate::isa::Isa;
-use crate::model::Model;
+use crate::model::{Model, SavedSolver};
 use crate::observe::{FieldSpec, History, ObservableSpec, Snapshot};
-use crate::scene::registry::SavedSolver;
 use crate::scene::{Scene, SceneKind};
 use std::sync::OnceLock;
 
@@ -130,9 +129,16 @@ impl serde::Serialize for Bytes<'_> {
     }
 }
 
-/// [`SolverRef`] read back: the kind its key names and its solver, restored
-/// by that kind's row (not yet checked).
-struct SolverState(SceneKind, Box<dyn Model>);
+/// [`SolverRef`] read back: the kind its key names and its saved state,
+/// not yet read (it is loaded into a new run of the scene,
+/// [`Model::load_state`]).
+struct SolverState(SceneKind, RawSolver);
+
+/// A solver's saved state as it came: a JSON tree, or postcard bytes.
+enum RawSolver {
+    Json(serde_json::Value),
+    Postcard(Vec<u8>),
+}
 
 /// Why a solver state is refused when its key does not name one kind.
 const NOT_THE_SCENES: &str = "its solver is not its scene's";
@@ -164,28 +170,27 @@ impl<'de> serde::de::Visitor<'de> for SolverVisitor {
             .next_key::<String>()?
             .and_then(|key| SceneKind::with_saved_key(&key))
             .ok_or_else(|| A::Error::custom(NOT_THE_SCENES))?;
-        let solver = map.next_value_seed(Restore(kind))?;
+        let raw = map.next_value_seed(Raw)?;
         if map.next_key::<serde::de::IgnoredAny>()?.is_some() {
             return Err(A::Error::custom(NOT_THE_SCENES));
         }
-        Ok(SolverState(kind, solver))
+        Ok(SolverState(kind, raw))
     }
 }
 
-/// Restores a solver of one kind through its row, from any format.
-struct Restore(SceneKind);
+/// Reads a solver's state as it came, in either format.
+struct Raw;
 
-impl<'de> serde::de::DeserializeSeed<'de> for Restore {
-    type Value = Box<dyn Model>;
+impl<'de> serde::de::DeserializeSeed<'de> for Raw {
+    type Value = RawSolver;
 
     fn deserialize<D: serde::Deserializer<'de>>(
         self,
         deserializer: D,
-    ) -> std::result::Result<Box<dyn Model>, D::Error> {
-        use serde::de::Error as _;
+    ) -> std::result::Result<RawSolver, D::Error> {
+        use serde::Deserialize as _;
         if deserializer.is_human_readable() {
-            let mut erased = <dyn erased_serde::Deserializer>::erase(deserializer);
-            (self.0.row().restore)(SavedSolver::Serde(&mut erased)).map_err(D::Error::custom)
+            serde_json::Value::deserialize(deserializer).map(RawSolver::Json)
         } else {
             deserializer.deserialize_bytes(self)
         }
@@ -193,15 +198,25 @@ impl<'de> serde::de::DeserializeSeed<'de> for Restore {
 }
 
 /// The solver's postcard bytes inside a binary format.
-impl<'de> serde::de::Visitor<'de> for Restore {
-    type Value = Box<dyn Model>;
+impl<'de> serde::de::Visitor<'de> for Raw {
+    type Value = RawSolver;
 
     fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         f.write_str("the bytes of a solver state")
     }
 
-    fn visit_bytes<E: serde::de::Error>(self, bytes: &[u8]) -> std::result::Result<Self::Value, E> {
-        (self.0.row().restore)(SavedSolver::Postcard(bytes)).map_err(E::custom)
+    fn visit_bytes<E: serde::de::Error>(self, bytes: &[u8]) -> std::result::Result<RawSolver, E> {
+        Ok(RawSolver::Postcard(bytes.to_vec()))
+    }
+}
+
+impl RawSolver {
+    /// Loads the state into `solver`, a new run of its scene.
+    fn load_into(self, solver: &mut dyn Model) -> std::result::Result<(), String> {
+        match self {
+            RawSolver::Json(value) => solver.load_state(SavedSolver::Json(value)),
+            RawSolver::Postcard(bytes) => solver.load_state(SavedSolver::Postcard(&bytes)),
+        }
     }
 }
 
@@ -222,9 +237,10 @@ impl serde::Serialize for Simulation {
     }
 }
 
-/// The run as saved, not yet checked: [`Simulation::deserialize_state`]
-/// checks it ([`Simulation::check_restored`]), and so must every other
-/// reader.
+/// The run as saved: a new run of its scene with the saved solver state
+/// loaded into it ([`Model::load_state`]), not yet checked:
+/// [`Simulation::deserialize_state`] checks it ([`Simulation::check_restored`]),
+/// and so must every other reader.
 impl<'de> serde::Deserialize<'de> for Simulation {
     fn deserialize<D: serde::Deserializer<'de>>(
         deserializer: D,
@@ -239,22 +255,22 @@ impl<'de> serde::Deserialize<'de> for Simulation {
                 crate::state_format::FORMAT
             )));
         }
-        let kind = saved.scene.kind();
-        let SolverState(solver_kind, solver) = saved.solver;
-        // The key names the row; the material choice is the scene's, and
-        // the restore check holds the solver to it.
-        if solver_kind.saved_key() != kind.saved_key() {
+        let SolverState(solver_kind, raw) = saved.solver;
+        // The key names the row; the material choice is the scene's.
+        if solver_kind.saved_key() != saved.scene.kind().saved_key() {
             return Err(D::Error::custom(NOT_THE_SCENES));
         }
-        Ok(Simulation {
-            observed: Observed::new(kind),
-            scene: saved.scene,
-            solver,
-            history: saved.history,
-            record_interval: saved.record_interval,
-            next_record: saved.next_record,
-            error: None,
-        })
+        // A new run of the scene, and the saved state loaded into it.
+        let mut sim = Simulation::new(saved.scene)
+            .map_err(|e| D::Error::custom(format!("the state is not valid: its scene: {e}")))?;
+        raw.load_into(sim.solver.as_mut())
+            .map_err(D::Error::custom)?;
+        // The new run's observables were read at its start.
+        sim.observed.clear();
+        sim.history = saved.history;
+        sim.record_interval = saved.record_interval;
+        sim.next_record = saved.next_record;
+        Ok(sim)
     }
 }
 
@@ -490,11 +506,11 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// Checks a restored run: its scene passes the checks of a new one, and
-    /// its solver and history agree with a new run of that scene (the same
-    /// lattice, masses and material, bit for bit; one finite value per
-    /// particle in every field; histories of the scene's observables with
-    /// finite values at increasing times).
+    /// Checks a restored run: its solver and history agree with a new run
+    /// of its scene (what follows from the parameters the same, bit for
+    /// bit; one finite value per particle in every field; histories of the
+    /// scene's observables with finite values at increasing times). Its
+    /// scene passed the checks of a new run when it was read.
     pub fn check_restored(&self) -> std::result::Result<(), String> {
         let fresh = Simulation::new(self.scene.clone()).map_err(|e| format!("its scene: {e}"))?;
         self.solver.check_restored(fresh.solver.as_ref())?;
@@ -620,6 +636,9 @@ mod tests {
         fn record_interval(&self) -> f64 {
             Model::record_interval(&self.inner)
         }
+        fn load_state(&mut self, saved: SavedSolver<'_>) -> std::result::Result<(), String> {
+            Model::load_state(&mut self.inner, saved)
+        }
         fn check_restored(&self, fresh: &dyn Model) -> std::result::Result<(), String> {
             Model::check_restored(&self.inner, fresh)
         }
@@ -631,11 +650,12 @@ mod tests {
         scene.set("particles_radial", 4.0).unwrap();
         let mut sim = Simulation::new(scene).unwrap();
         let asked = Arc::new(Mutex::new(Vec::new()));
-        let inner = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
-            sim.solver.as_ref(),
-        )
-        .unwrap()
-        .clone();
+        let inner = sim
+            .solver
+            .as_any()
+            .downcast_ref::<crate::solver::axisymmetric::TaylorSolver>()
+            .unwrap()
+            .clone();
         sim.solver = Box::new(Counting {
             inner,
             asked: Arc::clone(&asked),
@@ -716,18 +736,20 @@ mod tests {
         let mut scene = Scene::builtin("taylor").unwrap();
         scene.set("particles_radial", 5.0).unwrap();
         let mut sim = Simulation::new(scene).unwrap();
-        let solver = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
-            sim.solver.as_ref(),
-        )
-        .unwrap();
+        let solver = sim
+            .solver
+            .as_any()
+            .downcast_ref::<crate::solver::axisymmetric::TaylorSolver>()
+            .unwrap();
         let n = crate::TAYLOR_OBSERVABLES.len();
         assert_eq!(solver.observable(n), None);
         for t in [0.0, 2e-6, 8e-6, 30e-6] {
             sim.advance_to(t).unwrap();
-            let solver = crate::model::same_solver::<crate::solver::axisymmetric::TaylorSolver>(
-                sim.solver.as_ref(),
-            )
-            .unwrap();
+            let solver = sim
+                .solver
+                .as_any()
+                .downcast_ref::<crate::solver::axisymmetric::TaylorSolver>()
+                .unwrap();
             let all = solver.observables();
             assert_eq!(all.len(), n);
             for (k, v) in all.iter().enumerate() {

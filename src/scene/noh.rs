@@ -4,7 +4,7 @@
 
 use super::Scene;
 use super::params::{ParamSpec, Range, spec};
-use super::registry::{SceneRow, no_variants, restore};
+use super::registry::{SceneRow, no_variants};
 use crate::budget::MemoryPerNode;
 use crate::observe::NOH_OBSERVABLES;
 use crate::solver::radial::NohSolver;
@@ -40,7 +40,6 @@ pub static ROW: SceneRow = SceneRow {
             s.values(),
         ))?))
     },
-    restore: restore::<NohSolver>,
     fmu: None,
 };
 

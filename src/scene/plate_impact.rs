@@ -15,7 +15,7 @@
 
 use super::Scene;
 use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
-use super::registry::{FmuIdentity, SceneRow, no_variants, restore};
+use super::registry::{FmuIdentity, SceneRow, no_variants};
 use crate::budget::MemoryPerNode;
 use crate::error::{Error, Result};
 use crate::material::Damage;
@@ -44,7 +44,6 @@ pub static ROW: SceneRow = SceneRow {
     // 0.4 kB (the ceramic point is the largest part); twice that for room.
     memory: |_| MemoryPerNode { bytes: 1000.0 },
     build: |s: &Scene| Ok(Box::new(setup(s)?)),
-    restore: restore::<PlateImpact>,
     fmu: Some(FmuIdentity {
         model_identifier: "PlateImpact",
         model_name: "PlateImpact",

@@ -70,21 +70,8 @@ pub struct SceneRow {
     pub memory: fn(&Scene) -> MemoryPerNode,
     /// Builds the initial state of a run of a valid scene of this kind.
     pub build: fn(&Scene) -> Result<Box<dyn Model>>,
-    /// Rebuilds a run from [`crate::model::ModelState::save`]; the result is checked
-    /// afterwards ([`Model::check_restored`]).
-    pub restore: fn(SavedSolver<'_, '_>) -> std::result::Result<Box<dyn Model>, String>,
     /// The FMU of this kind (of its default material choice), if it has one.
     pub fmu: Option<FmuIdentity>,
-}
-
-/// A solver's saved state as its row's `restore` reads it.
-pub enum SavedSolver<'a, 'de> {
-    /// In a self-describing format (JSON), through a type-erased
-    /// deserializer.
-    Serde(&'a mut dyn erased_serde::Deserializer<'de>),
-    /// The postcard bytes of [`crate::model::ModelState::save_compact`],
-    /// decoded by the solver's own type (no dynamic call per value).
-    Postcard(&'a [u8]),
 }
 
 /// Every FMU the registry declares, with the kind of scene (material choice
@@ -125,22 +112,6 @@ pub fn row(name: &str) -> Result<&'static SceneRow> {
             name: name.to_string(),
             allowed: SCENES.iter().map(|r| r.name).collect::<Vec<_>>().join(", "),
         })
-}
-
-/// [`SceneRow::restore`] for a solver type that serde restores whole.
-pub(crate) fn restore<T>(state: SavedSolver<'_, '_>) -> std::result::Result<Box<dyn Model>, String>
-where
-    T: Model + serde::de::DeserializeOwned,
-{
-    let solver = match state {
-        SavedSolver::Serde(d) => erased_serde::deserialize::<T>(d).map_err(|e| e.to_string())?,
-        SavedSolver::Postcard(bytes) => match postcard::take_from_bytes::<T>(bytes) {
-            Ok((solver, [])) => solver,
-            Ok((_, left)) => return Err(format!("{} bytes follow its solver", left.len())),
-            Err(e) => return Err(e.to_string()),
-        },
-    };
-    Ok(Box::new(solver))
 }
 
 /// No named variants.

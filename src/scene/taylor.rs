@@ -13,7 +13,7 @@
 
 use super::Scene;
 use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec};
-use super::registry::{FmuIdentity, MaterialSlot, SceneRow, restore};
+use super::registry::{FmuIdentity, MaterialSlot, SceneRow};
 use crate::budget::MemoryPerNode;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::observe::TAYLOR_OBSERVABLES;
@@ -80,7 +80,6 @@ pub static ROW: SceneRow = SceneRow {
             material,
         )?))
     },
-    restore: restore::<TaylorSolver>,
     fmu: Some(FmuIdentity {
         model_identifier: "TaylorImpact",
         model_name: "TaylorImpact",

@@ -548,6 +548,13 @@ impl crate::model::Model for NohSolver {
     fn record_interval(&self) -> f64 {
         self.p.end_time / 600.0
     }
+    fn load_state(
+        &mut self,
+        saved: crate::model::SavedSolver<'_>,
+    ) -> std::result::Result<(), String> {
+        *self = crate::model::read_saved(saved)?;
+        Ok(())
+    }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)
     }

@@ -249,6 +249,13 @@ impl crate::model::Model for TaylorSolver {
     fn set_isa(&mut self, isa: Isa) {
         self.set_isa(isa);
     }
+    fn load_state(
+        &mut self,
+        saved: crate::model::SavedSolver<'_>,
+    ) -> std::result::Result<(), String> {
+        *self = crate::model::read_saved(saved)?;
+        Ok(())
+    }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)
     }

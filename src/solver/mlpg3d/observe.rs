@@ -370,6 +370,13 @@ impl crate::model::Model for Mlpg3d {
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.min_spacing_ratio())
     }
+    fn load_state(
+        &mut self,
+        saved: crate::model::SavedSolver<'_>,
+    ) -> std::result::Result<(), String> {
+        *self = crate::model::read_saved(saved)?;
+        Ok(())
+    }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)
     }

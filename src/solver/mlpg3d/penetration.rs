@@ -428,6 +428,13 @@ impl crate::model::Model for Penetration {
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.run.min_spacing_ratio())
     }
+    fn load_state(
+        &mut self,
+        saved: crate::model::SavedSolver<'_>,
+    ) -> std::result::Result<(), String> {
+        *self = crate::model::read_saved(saved)?;
+        Ok(())
+    }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         let fresh: &Penetration = crate::model::same_solver(fresh)?;
         if self.setup != fresh.setup {
