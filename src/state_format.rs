@@ -12,7 +12,7 @@
 //! | Format | Written by | What changed |
 //! | --- | --- | --- |
 //! | 1 | up to 2026-11-29 (no `format` key) | — |
-//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; the 3-D runs' typed scheme |
+//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; the 3-D runs save their state alone (node fields, the record of the last build, clock, energy, material state, tallies), not their setup |
 
 use serde_json::{Map, Value};
 
@@ -48,11 +48,11 @@ pub(crate) fn upgrade(saved: &mut Value) -> Result<(), String> {
 /// Format 1 to 2: each solver's clock (`time`, `steps`, `dt`, `dt0`) and
 /// energy book (the energy at the start, the internal energy and the
 /// losses, in the order of the solver's balance) gathered under `clock`
-/// and `energy`; the 3-D solver's scheme typed under `setup.scheme`; a
-/// penetration run's setup keeping only what its rod's does not say; the
-/// plate impact's cell energies renamed `specific_energy`; and every field
-/// that a state of format 1 may lack (it was read with a default) put in
-/// with that default.
+/// and `energy`; the 3-D runs' setup dropped (a restored run is built from
+/// its scene; a penetration run saves its run's state alone); the plate
+/// impact's cell energies renamed `specific_energy`; and every field that a
+/// state of format 1 may lack (it was read with a default) put in with that
+/// default.
 fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
     let solver = root
         .get_mut("solver")
@@ -94,25 +94,14 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
         }
         "Taylor3d" => mlpg(state),
         "Penetration" => {
-            let run = state
-                .get_mut("run")
-                .and_then(Value::as_object_mut)
-                .ok_or("its penetration run is missing")?;
-            mlpg(run)?;
-            let setup = state
-                .get_mut("setup")
-                .and_then(Value::as_object_mut)
-                .ok_or("its penetration setup is missing")?;
-            for key in ["projectile", "impact_speed", "rings", "end_time"] {
-                setup.remove(key);
-            }
-            defaults(
-                setup,
-                &[
-                    ("until_outcome", Value::Bool(false)),
-                    ("clamped_rim", Value::Bool(false)),
-                ],
-            );
+            // The run's state alone: the plate and the projectile follow
+            // from the scene.
+            let mut run = match state.remove("run") {
+                Some(Value::Object(run)) => run,
+                _ => return Err("its penetration run is missing".into()),
+            };
+            mlpg(&mut run)?;
+            *state = run;
             Ok(())
         }
         other => Err(format!("its solver {other} is not one this build knows")),
@@ -176,32 +165,42 @@ fn energy(
     Ok(())
 }
 
-/// The 3-D solver's state of format 1 in format 2.
+/// The fields of a 3-D run's setup, which format 1 saved and format 2
+/// builds from the scene.
+const MLPG_SETUP: &[&str] = &[
+    "setup",
+    "material",
+    "lattice",
+    "others",
+    "group",
+    "anvil",
+    "reach",
+    "mass",
+    "plane",
+    "held",
+    "d_min0",
+    "damping_time",
+];
+
+/// The 3-D solver's state of format 1 in format 2: the setup dropped (it
+/// follows from the scene), the clock and the energy book gathered.
 fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
     let empty = || Value::Array(Vec::new());
     defaults(
         state,
         &[
             ("material_state", Value::Null),
-            ("others", empty()),
-            ("group", empty()),
-            ("anvil", Value::Bool(true)),
-            ("reach", Value::from(0.0)),
             ("reference", empty()),
             ("built_reference", empty()),
             ("built_contact", empty()),
             ("built_rho", empty()),
             ("built_multipliers", empty()),
             ("reaction", empty()),
-            ("plane", empty()),
-            ("held", empty()),
             ("shift_dissipation", Value::from(0.0)),
         ],
     );
-    if let Some(others) = state.get_mut("others").and_then(Value::as_array_mut) {
-        for body in others.iter_mut().filter_map(Value::as_object_mut) {
-            defaults(body, &[("clamped_rim", Value::Bool(false))]);
-        }
+    for key in MLPG_SETUP {
+        state.remove(*key);
     }
     clock(state)?;
     energy(
@@ -213,48 +212,7 @@ fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
             "contact_dissipation",
             "smoothing_dissipation",
         ],
-    )?;
-    let setup = state
-        .get_mut("setup")
-        .and_then(Value::as_object_mut)
-        .ok_or("its setup is missing")?;
-    defaults(
-        setup,
-        &[
-            ("base", Value::from(0.0)),
-            ("quarter", Value::Bool(false)),
-            ("conservative_carry", Value::Bool(false)),
-            ("weak_form", Value::from("Sphere")),
-        ],
-    );
-    let weak_form = take(setup, "weak_form")?;
-    let conforming = setup.remove("conforming").unwrap_or(Value::Bool(false));
-    let forces = match (weak_form.as_str(), conforming.as_bool()) {
-        (Some("Sphere"), _) => "Sphere",
-        (Some("Nodal"), Some(true)) => "Conforming",
-        (Some("Nodal"), _) => "Nodal",
-        _ => return Err(format!("its weak form {weak_form} is not Sphere or Nodal")),
-    };
-    let order = match setup.remove("smoothing_order").and_then(|v| v.as_u64()) {
-        Some(2) => "Two",
-        // A state saved before the order was saved smooths to order 1.
-        _ => "One",
-    };
-    let lattice = match setup.remove("staggered").and_then(|v| v.as_bool()) {
-        Some(true) => "Staggered",
-        _ => "Aligned",
-    };
-    let mut scheme = Map::new();
-    scheme.insert("forces".into(), Value::from(forces));
-    scheme.insert("order".into(), Value::from(order));
-    scheme.insert("smoothing".into(), take(setup, "smoothing")?);
-    scheme.insert(
-        "shifting".into(),
-        setup.remove("shifting").unwrap_or(Value::from(0.0)),
-    );
-    scheme.insert("lattice".into(), Value::from(lattice));
-    setup.insert("scheme".into(), Value::Object(scheme));
-    Ok(())
+    )
 }
 
 #[cfg(test)]

@@ -223,7 +223,7 @@ impl NohSolver {
         Ok(())
     }
 
-    crate::solver::shared::clock_getters!();
+    crate::solver::shared::clock_getters!(clock);
 
     /// Whether `end_time` has been reached.
     pub fn finished(&self) -> bool {

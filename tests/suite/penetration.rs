@@ -241,7 +241,7 @@ fn a_penetration_run_saved_mid_way_resumes_to_the_same_bits() {
     assert_eq!(bits(&back), bits(&whole));
     // Cut the damage variables short: refused by name.
     let mut forged = state.clone();
-    let damage = &mut forged["solver"]["Penetration"]["run"]["material_state"];
+    let damage = &mut forged["solver"]["Penetration"]["material_state"];
     let list = damage
         .as_array_mut()
         .expect("the damage variables are saved");
@@ -251,8 +251,8 @@ fn a_penetration_run_saved_mid_way_resumes_to_the_same_bits() {
 }
 
 /// The quarter model saved mid-way resumes to the same bits; a saved state
-/// with a node moved across a symmetry plane, or with its planes dropped,
-/// is refused.
+/// with a node moved off or across a symmetry plane, or holding planes of
+/// its own (they follow from the scene), is refused.
 #[test]
 fn a_quarter_model_saved_mid_way_resumes_and_a_forged_one_is_refused() {
     let whole = coarse_with(1.5e-6, &[("symmetry", 1.0)]);
@@ -271,23 +271,28 @@ fn a_quarter_model_saved_mid_way_resumes_and_a_forged_one_is_refused() {
         v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
     };
     assert_eq!(bits(&back), bits(&whole));
-    let run = &state["solver"]["Penetration"]["run"];
-    let plane = run["plane"].as_array().expect("the planes are saved");
-    let on = plane
-        .iter()
-        .position(|p| p.as_u64() == Some(1))
+    // The planes follow from the scene (the state holds none): a node on
+    // x = 0 is on its plane, one off both planes is free.
+    let pos = state["solver"]["Penetration"]["pos"]
+        .as_array()
+        .expect("the positions are saved");
+    let at = |i: usize, d: usize| pos[i][d].as_f64().unwrap();
+    let on = (0..pos.len())
+        .find(|&i| at(i, 0) == 0.0 && at(i, 1) > 0.0)
         .expect("a node on x = 0");
+    let free = (0..pos.len())
+        .find(|&i| at(i, 0) > 0.0 && at(i, 1) > 0.0)
+        .unwrap();
     let mut off = state.clone();
-    off["solver"]["Penetration"]["run"]["pos"][on][0] = serde_json::json!(1e-4);
+    off["solver"]["Penetration"]["pos"][on][0] = serde_json::json!(1e-4);
     let mut across = state.clone();
-    let free = plane.iter().position(|p| p.as_u64() == Some(0)).unwrap();
-    across["solver"]["Penetration"]["run"]["pos"][free][1] = serde_json::json!(-1e-4);
-    let mut dropped = state.clone();
-    dropped["solver"]["Penetration"]["run"]["plane"] = serde_json::json!([]);
+    across["solver"]["Penetration"]["pos"][free][1] = serde_json::json!(-1e-4);
+    let mut given = state.clone();
+    given["solver"]["Penetration"]["plane"] = serde_json::json!([]);
     for (what, forged) in [
         ("off its plane", off),
         ("across a plane", across),
-        ("planes dropped", dropped),
+        ("planes given", given),
     ] {
         let e = Simulation::deserialize_state(&serde_json::to_vec(&forged).unwrap()).unwrap_err();
         assert_eq!(e.name(), "InvalidState", "{what}: {e}");

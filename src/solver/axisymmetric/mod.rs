@@ -186,7 +186,7 @@ impl TaylorSolver {
         self.h
     }
 
-    crate::solver::shared::clock_getters!(dt);
+    crate::solver::shared::clock_getters!(clock; dt);
 
     /// Whether the end condition holds: the rod is at rest, or `end_time` has
     /// been reached.

@@ -63,8 +63,8 @@ impl Mlpg3d {
     pub(super) fn nearest_distance(&self) -> f64 {
         let sup = self.supports();
         let mut buf = Vec::new();
-        let pos = extended(self.mirror(), &self.pos, &mut buf, mirror::vector);
-        (0..self.pos.len())
+        let pos = extended(self.mirror(), &self.state.pos, &mut buf, mirror::vector);
+        (0..self.state.pos.len())
             .into_par_iter()
             .map(|i| {
                 sup.named
@@ -82,6 +82,7 @@ impl Mlpg3d {
     /// for the whole body).
     pub(super) fn mirror(&self) -> &Mirror {
         &self
+            .pipe
             .geometry
             .as_ref()
             .expect("the geometry is built before use")
@@ -89,7 +90,8 @@ impl Mlpg3d {
     }
 
     pub(super) fn supports(&self) -> &Supports {
-        self.geometry
+        self.pipe
+            .geometry
             .as_ref()
             .and_then(|g| g.supports.as_ref())
             .expect("the geometry is built before use")
@@ -98,38 +100,46 @@ impl Mlpg3d {
     /// Rebuilds the geometry at `built_at` (and the supports at
     /// `supports_at` when `supports` is true or none exist).
     pub(super) fn build_geometry(&mut self, supports: bool) -> Result<()> {
-        let time = self.clock.time;
+        let time = self.state.clock.time;
         let stamp = |e: Error| at_time(e, time);
-        let mut watch = self.profile.stopwatch();
-        let mut g = self.geometry.take().unwrap_or_default();
+        let mut watch = self.pipe.profile.stopwatch();
+        let mut g = self.pipe.geometry.take().unwrap_or_default();
         // The old traction operator goes before the new is built; the
         // shapes and the nodal operator are rebuilt in their own buffers.
         // They are most of the heap (BENCHMARKS.md, memory).
         g.op = TractionOperator::default();
-        let n = self.pos.len();
+        let n = self.state.pos.len();
         if supports || g.supports.is_none() {
             let (sup, mirror) = self.supports_with_images().map_err(stamp)?;
             g.supports = Some(sup);
             g.mirror = mirror;
-            self.profile.supports += 1;
+            self.pipe.profile.supports += 1;
         }
-        self.profile.lap(Phase::Supports, &mut watch);
+        self.pipe.profile.lap(Phase::Supports, &mut watch);
         let sup = g.supports.as_ref().expect("computed above");
         let mut buf = Vec::new();
-        let pts = extended(&g.mirror, &self.built_at, &mut buf, mirror::vector);
+        let pts = extended(&g.mirror, &self.state.built_at, &mut buf, mirror::vector);
         g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
-        self.profile.lap(Phase::Shapes, &mut watch);
-        if self.setup.scheme.forces == Forces::Conforming {
-            let volume: Vec<f64> = (0..n).map(|i| self.mass[i] / self.built_rho[i]).collect();
-            let inner: Vec<bool> = self.lattice.surfaces.iter().map(|s| s.interior()).collect();
+        self.pipe.profile.lap(Phase::Shapes, &mut watch);
+        if self.setup.rod.scheme.forces == Forces::Conforming {
+            let volume: Vec<f64> = (0..n)
+                .map(|i| self.setup.mass[i] / self.state.built_rho[i])
+                .collect();
+            let inner: Vec<bool> = self
+                .setup
+                .lattice
+                .surfaces
+                .iter()
+                .map(|s| s.interior())
+                .collect();
             // The start: the last build's multipliers in this process, or
             // the saved start of a restored run's last build.
             if !g.multipliers.is_empty() {
-                self.built_multipliers.clone_from(&g.multipliers);
+                self.state.built_multipliers.clone_from(&g.multipliers);
             }
-            g.multipliers.clone_from(&self.built_multipliers);
+            g.multipliers.clone_from(&self.state.built_multipliers);
             let c = conform(
-                self.isa,
+                self.pipe.isa,
                 &mut g.shapes,
                 pts,
                 &volume,
@@ -137,15 +147,15 @@ impl Mlpg3d {
                 CONFORM_TOLERANCE,
                 &mut g.multipliers,
             );
-            self.profile.conform_iterations += c.iterations as u64;
+            self.pipe.profile.conform_iterations += c.iterations as u64;
         }
-        self.profile.lap(Phase::Conform, &mut watch);
-        match self.setup.scheme.forces {
+        self.pipe.profile.lap(Phase::Conform, &mut watch);
+        match self.setup.rod.scheme.forces {
             Forces::Sphere => {
                 g.spheres = self.spheres(pts, &g.mirror, sup, &g.shapes);
-                self.profile.lap(Phase::Spheres, &mut watch);
+                self.pipe.profile.lap(Phase::Spheres, &mut watch);
                 g.op = TractionOperator::build(
-                    self.isa,
+                    self.pipe.isa,
                     pts,
                     sup,
                     &g.spheres,
@@ -158,15 +168,17 @@ impl Mlpg3d {
                 g.spheres.clear();
             }
         }
-        if self.setup.scheme.forces.nodal() || self.setup.scheme.order == SmoothingOrder::Two {
+        if self.setup.rod.scheme.forces.nodal()
+            || self.setup.rod.scheme.order == SmoothingOrder::Two
+        {
             g.nodal.rebuild(&g.shapes, pts.len());
         } else {
             g.nodal = NodalOperator::default();
         }
-        self.profile.lap(Phase::Operator, &mut watch);
-        self.profile.operators += 1;
-        self.geometry = Some(g);
-        self.rebuilds += 1;
+        self.pipe.profile.lap(Phase::Operator, &mut watch);
+        self.pipe.profile.operators += 1;
+        self.pipe.geometry = Some(g);
+        self.state.rebuilds += 1;
         Ok(())
     }
 
@@ -181,19 +193,19 @@ impl Mlpg3d {
     /// it is), and the images farther than their `r_J + d_k` are then
     /// dropped: the rows are the same.
     pub(super) fn supports_with_images(&self) -> Result<(Supports, Mirror)> {
-        let n = self.pos.len();
-        let at = &self.supports_at;
-        if self.plane.is_empty() {
-            let sup = Supports::compute_grouped(at, &self.group, SupportParams::default())?;
+        let n = self.state.pos.len();
+        let at = &self.state.supports_at;
+        if self.setup.plane.is_empty() {
+            let sup = Supports::compute_grouped(at, &self.setup.group, SupportParams::default())?;
             return Ok((sup, Mirror::default()));
         }
-        let mut layer = 6.0 * self.reach;
+        let mut layer = 6.0 * self.setup.reach;
         let (mut sup, m, dk) = loop {
-            let m = Mirror::choose(at, &self.plane, layer);
+            let m = Mirror::choose(at, &self.setup.plane, layer);
             let (mut pts, mut group) = (Vec::new(), Vec::new());
             m.extend(at, &mut pts, mirror::vector);
-            if !self.group.is_empty() {
-                m.extend(&self.group, &mut group, mirror::same);
+            if !self.setup.group.is_empty() {
+                m.extend(&self.setup.group, &mut group, mirror::same);
             }
             let mut sup = Supports::compute_rows(&pts, &group, n, SupportParams::default())?;
             // A node's radius covers what its images' do (their namers are
@@ -211,7 +223,7 @@ impl Mlpg3d {
                 return Err(Error::NonFinite {
                     field: "support radius",
                     particle: sup.radius.iter().position(|r| !r.is_finite()).unwrap_or(0),
-                    time: self.clock.time,
+                    time: self.state.clock.time,
                 });
             }
             if widest + dk < layer {
@@ -277,14 +289,14 @@ impl Mlpg3d {
     pub(super) fn named_pairs(&self, x: &[[f64; 3]], b: &[[f64; 3]]) -> NamedPairs {
         let sup = self.supports();
         let limit = 0.5 * (1.0 + sup.params.factor);
-        let rebuild = self.setup.rebuild_strain;
+        let rebuild = self.setup.rod.rebuild_strain;
         let (within, beyond) = (
             limit * limit * (1.0 - PRE_TEST_MARGIN),
             (1.0 + PRE_TEST_MARGIN) / (limit * limit),
         );
         let still = rebuild * rebuild * (1.0 - PRE_TEST_MARGIN);
         let dot = |a: [f64; 3]| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        let pairs = (0..self.pos.len())
+        let pairs = (0..self.state.pos.len())
             .into_par_iter()
             .map(|i| {
                 let lo = sup.named.offsets[i];

@@ -134,12 +134,28 @@ use shift::{Freedom, carry, exchange, shifts};
 use spheres::{nanson, radial};
 use util::{at_time, extended, kinetic, kinetic1, material_of, norm, pin};
 
-/// A 3-D MLPG run of a rod striking a rigid smooth anvil.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+/// A 3-D MLPG run of a rod striking a rigid smooth anvil, or of several
+/// bodies: its setup, its state and its pipeline, apart.
+#[derive(Debug, Clone)]
 pub struct Mlpg3d {
-    setup: RodSetup,
+    /// What the run is built from, and never changes.
+    setup: Setup3d,
+    /// What the run changes: all that is saved.
+    state: State3d,
+    /// The workspace of the step: rebuilt, never saved.
+    pipe: Pipeline3d,
+}
+
+/// What a 3-D run is built from, from its scene, and never changes: the
+/// rod's setup with its typed scheme, the bodies and their materials, the
+/// lattice, the nodal masses and the quantities that follow from them.
+/// Not saved: a restored run is built from its scene.
+#[derive(Debug, Clone)]
+struct Setup3d {
+    /// The rod and the solver's choices.
+    rod: RodSetup,
+    /// The rod's material.
     material: Material,
-    material_state: MaterialState,
     /// The reference lattice (positions at impact, volumes, surfaces, sets):
     /// the rod's nodes first, then those of each further body; the sets
     /// are the rod's.
@@ -153,35 +169,31 @@ pub struct Mlpg3d {
     /// Contact reach between the nodes of different bodies
     /// ([`contact`]): the smallest radial spacing of the bodies (m).
     reach: f64,
-    /// The place at impact of the material each node is on: the lattice
-    /// position, carried along when the node shifts (the reference map of
-    /// the Nanson normals).
-    reference: Vec<[f64; 3]>,
-    /// `reference` at the last build of the operator (the test spheres'
-    /// Nanson normals are built from it, so a restored run rebuilds them
-    /// as they were).
-    built_reference: Vec<[f64; 3]>,
-    /// `contact` at the last build of the operator (the test sphere of a
-    /// face node held on the anvil is cut by the anvil's plane, of a free one
-    /// by its Nanson plane, so a restored run rebuilds them as they were).
-    built_contact: Vec<bool>,
-    /// `rho` at the last build of the operator (conforming gradients weigh
-    /// the constraint by the nodal volumes `m / ρ` of the build, so a
-    /// restored run rebuilds them as they were).
-    built_rho: Vec<f64>,
-    /// The multipliers the conforming correction started from at the last
-    /// build (those of the build before; empty: from zero), so a restored
-    /// run rebuilds its gradients as they were ([`conform`]'s warm start).
-    built_multipliers: Vec<[f64; 3]>,
-    /// The anvil's reaction on each node held on it at the last step's
-    /// forces, `−F_z ≥ 0` (N; zero on a free node): a release is timed by
-    /// the zero of the node's net axial force between that step and the
-    /// next ([`Mlpg3d::last_release`]).
-    reaction: Vec<f64>,
-    // Node fields (structure of arrays).
+    /// The nodal masses (kg).
+    mass: Vec<f64>,
+    /// The symmetry planes each node lies on (bits `X`, `Y` of
+    /// `src/approx/mirror.rs`) in the quarter model; empty for the whole
+    /// body.
+    plane: Vec<u8>,
+    /// The nodes held still (a clamped rim, [`Body::clamped_rim`]); empty
+    /// when none is.
+    held: Vec<bool>,
+    /// The smallest distance between named nodes at the start (m).
+    d_min0: f64,
+    /// Damping time `c = 2 ζ / ω_max` of the viscous stress (s).
+    damping_time: f64,
+}
+
+/// What a 3-D run changes, and all that it saves (format 2 of
+/// `src/state_format.rs`): the node fields (structure of arrays), the
+/// record of the last build, the clock, the energy book, the material
+/// state and the run's tallies.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct State3d {
+    // Node fields.
     pos: Vec<[f64; 3]>,
     vel: Vec<[f64; 3]>,
-    mass: Vec<f64>,
     rho: Vec<f64>,
     dev: Vec<Full>,
     pressure: Vec<f64>,
@@ -190,24 +202,40 @@ pub struct Mlpg3d {
     /// Viscous stress of the damping, from the last rate of deformation.
     visc: Vec<Full>,
     contact: Vec<bool>,
-    /// The symmetry planes each node lies on (bits `X`,
-    /// `Y` of `src/approx/mirror.rs`) in the quarter model; empty for the whole body.
-    plane: Vec<u8>,
-    /// The nodes held still (a clamped rim, [`Body::clamped_rim`]); empty
-    /// when none is.
-    held: Vec<bool>,
+    /// The anvil's reaction on each node held on it at the last step's
+    /// forces, `−F_z ≥ 0` (N; zero on a free node): a release is timed by
+    /// the zero of the node's net axial force between that step and the
+    /// next ([`Mlpg3d::last_release`]).
+    reaction: Vec<f64>,
+    /// The place at impact of the material each node is on: the lattice
+    /// position, carried along when the node shifts (the reference map of
+    /// the Nanson normals).
+    reference: Vec<[f64; 3]>,
+    /// The state of the material models at each node (the ceramic's
+    /// damage variables).
+    material_state: MaterialState,
+    // The record of the last build, so that a restored run rebuilds its
+    // geometry as it was.
     /// Positions the supports were computed from.
     supports_at: Vec<[f64; 3]>,
     /// Positions the operator was last built at.
     built_at: Vec<[f64; 3]>,
-    #[serde(skip)]
-    geometry: Option<Geometry>,
+    /// `reference` at the last build of the operator (the test spheres'
+    /// Nanson normals are built from it).
+    built_reference: Vec<[f64; 3]>,
+    /// `contact` at the last build of the operator (the test sphere of a
+    /// face node held on the anvil is cut by the anvil's plane, of a free one
+    /// by its Nanson plane).
+    built_contact: Vec<bool>,
+    /// `rho` at the last build of the operator (conforming gradients weigh
+    /// the constraint by the nodal volumes `m / ρ` of the build).
+    built_rho: Vec<f64>,
+    /// The multipliers the conforming correction started from at the last
+    /// build (those of the build before; empty: from zero) ([`conform`]'s
+    /// warm start).
+    built_multipliers: Vec<[f64; 3]>,
     // Bookkeeping.
     clock: Clock,
-    /// Damping time `c = 2 ζ / ω_max` of the viscous stress (s).
-    damping_time: f64,
-    d_min0: f64,
-    min_spacing: f64,
     /// The impact's kinetic energy, the internal energy and the losses to
     /// the damping ([`LOST_DAMPING`]), the anvil or the contact between
     /// bodies ([`LOST_CONTACT`]) and the smoothing ([`LOST_SMOOTHING`]).
@@ -216,6 +244,9 @@ pub struct Mlpg3d {
     /// The part of the smoothing's loss that node shifting booked: the
     /// kinetic energy its carry of the velocities changed.
     shift_dissipation: f64,
+    /// Smallest distance between named nodes so far, relative to `d_min0`.
+    min_spacing: f64,
+    /// Builds of the geometry so far.
     rebuilds: u64,
     at_rest: bool,
     /// The quiet end (saved as the time since which the run has been
@@ -223,15 +254,29 @@ pub struct Mlpg3d {
     quiet_since: QuietEnd,
     /// Time of the last release of a node from the anvil.
     last_release: f64,
-    /// Wall time per phase of this process's steps (not saved).
-    #[serde(skip)]
-    profile: PhaseTimes,
+}
+
+/// The workspace of a 3-D step: the geometry of the last build, the step's
+/// buffers, the phase profile and the compiled copy of the hot loops.
+/// Rebuilt, never saved.
+#[derive(Debug, Clone, Default)]
+struct Pipeline3d {
+    /// The supports, shapes, test spheres and operator of the last build
+    /// (`None`: rebuilt at the next step, as after a restore).
+    geometry: Option<Geometry>,
     /// The buffers of the step.
-    #[serde(skip)]
     scratch: Scratch,
-    /// The compiled copy of the hot loops (not saved: the best one).
-    #[serde(skip)]
+    /// Wall time per phase of this process's steps.
+    profile: PhaseTimes,
+    /// The compiled copy of the hot loops (the best one by default).
     isa: Isa,
+}
+
+/// The run's state is all it saves.
+impl serde::Serialize for Mlpg3d {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        self.state.serialize(s)
+    }
 }
 
 impl Mlpg3d {
@@ -339,61 +384,62 @@ impl Mlpg3d {
             .map(|(i, s)| anvil && i < n0 && s.has(Surfaces::FACE))
             .collect();
         let mut s = Mlpg3d {
-            material,
-            material_state: MaterialState::default(),
-            vel,
-            mass,
-            built_rho: rho.clone(),
-            built_multipliers: Vec::new(),
-            rho,
-            dev: vec![[0.0; 6]; n],
-            pressure: vec![0.0; n],
-            eps_p: vec![0.0; n],
-            temp,
-            visc: vec![[0.0; 6]; n],
-            built_contact: contact.clone(),
-            reaction: vec![0.0; n],
-            contact,
-            plane,
-            held,
-            supports_at: pos.clone(),
-            built_at: pos.clone(),
-            reference: pos.clone(),
-            built_reference: pos.clone(),
-            pos,
-            lattice,
-            others,
-            group,
-            anvil,
-            reach,
-            geometry: None,
-            clock: Clock::default(),
-            damping_time: 0.0,
-            d_min0: 0.0,
-            min_spacing: 1.0,
-            energy: EnergyBook::new(initial_energy),
-            plastic_work: 0.0,
-            shift_dissipation: 0.0,
-            rebuilds: 0,
-            at_rest: false,
-            quiet_since: QuietEnd::default(),
-            last_release: 0.0,
-            profile: PhaseTimes::default(),
-            scratch: Scratch::default(),
-            isa: Isa::best(),
-            setup,
+            setup: Setup3d {
+                rod: setup,
+                material,
+                lattice,
+                others,
+                group,
+                anvil,
+                reach,
+                mass,
+                plane,
+                held,
+                d_min0: 0.0,
+                damping_time: 0.0,
+            },
+            state: State3d {
+                vel,
+                built_rho: rho.clone(),
+                built_multipliers: Vec::new(),
+                rho,
+                dev: vec![[0.0; 6]; n],
+                pressure: vec![0.0; n],
+                eps_p: vec![0.0; n],
+                temp,
+                visc: vec![[0.0; 6]; n],
+                built_contact: contact.clone(),
+                reaction: vec![0.0; n],
+                contact,
+                material_state: MaterialState::default(),
+                supports_at: pos.clone(),
+                built_at: pos.clone(),
+                reference: pos.clone(),
+                built_reference: pos.clone(),
+                pos,
+                clock: Clock::default(),
+                energy: EnergyBook::new(initial_energy),
+                plastic_work: 0.0,
+                shift_dissipation: 0.0,
+                min_spacing: 1.0,
+                rebuilds: 0,
+                at_rest: false,
+                quiet_since: QuietEnd::default(),
+                last_release: 0.0,
+            },
+            pipe: Pipeline3d::default(),
         };
         s.build_geometry(true)?;
-        s.d_min0 = s.nearest_distance();
+        s.setup.d_min0 = s.nearest_distance();
         let cp = s.wave_speed();
         check_derived("wave speed", cp, " m/s")?;
-        s.damping_time = 2.0 * setup.damping * s.d_min0 / (setup.omega_factor() * cp);
+        s.setup.damping_time = 2.0 * setup.damping * s.setup.d_min0 / (setup.omega_factor() * cp);
         // The bound of every later step: the wave speed plus the nodes'
         // own speed, so that no body crosses a spacing (and past a contact)
         // in the first step.
-        let fastest = s.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max);
-        s.clock = Clock::start(s.stable_dt(cp + fastest, s.d_min0));
-        check_derived("time step", s.clock.dt, " s")?;
+        let fastest = s.state.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max);
+        s.state.clock = Clock::start(s.stable_dt(cp + fastest, s.setup.d_min0));
+        check_derived("time step", s.state.clock.dt, " s")?;
         Ok(s)
     }
 
@@ -401,53 +447,54 @@ impl Mlpg3d {
     /// node distance `d`, times the safety factor, shortened for the
     /// damping: `(2 / ω_max)(√(1 + ζ²) − ζ)`.
     fn stable_dt(&self, c: f64, d: f64) -> f64 {
-        let z = self.setup.damping;
-        let kappa = self.setup.omega_factor();
-        stable_step_with(kappa, c, d, self.setup.safety) * ((1.0 + z * z).sqrt() - z)
+        let z = self.setup.rod.damping;
+        let kappa = self.setup.rod.omega_factor();
+        stable_step_with(kappa, c, d, self.setup.rod.safety) * ((1.0 + z * z).sqrt() - z)
     }
 
     /// Longitudinal elastic wave speed of the reference state (m/s), the
     /// fastest of the bodies'.
     pub fn wave_speed(&self) -> f64 {
         let speed = |m: &Material| {
-            let rho = m.eos.reference_density().unwrap_or(self.rho[0]);
+            let rho = m.eos.reference_density().unwrap_or(self.state.rho[0]);
             (m.longitudinal_modulus(rho, 0.0) / rho).sqrt()
         };
-        self.others
+        self.setup
+            .others
             .iter()
             .map(|b| speed(&b.material))
-            .fold(speed(&self.material), f64::max)
+            .fold(speed(&self.setup.material), f64::max)
     }
 
     /// Whether a body's material has a damage model (no pass over the
     /// nodes: the step asks every time).
     fn damaging(&self) -> bool {
-        std::iter::once(&self.material)
-            .chain(self.others.iter().map(|b| &b.material))
+        std::iter::once(&self.setup.material)
+            .chain(self.setup.others.iter().map(|b| &b.material))
             .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)))
     }
 
     fn energy_error_with(&self, kinetic: f64) -> f64 {
-        self.energy.error(kinetic)
+        self.state.energy.error(kinetic)
     }
 
     /// One step (see the module docs).
     pub fn step(&mut self) -> Result<()> {
-        if self.geometry.is_none() {
-            let fresh = self.supports_at == self.built_at;
+        if self.pipe.geometry.is_none() {
+            let fresh = self.state.supports_at == self.state.built_at;
             self.build_geometry(fresh)?;
-            self.rebuilds -= 1;
+            self.state.rebuilds -= 1;
         }
         let n = self.particles();
-        let watch = self.profile.stopwatch();
-        self.material_state.fit(n);
-        let mut scratch = std::mem::take(&mut self.scratch);
+        let watch = self.pipe.profile.stopwatch();
+        self.state.material_state.fit(n);
+        let mut scratch = std::mem::take(&mut self.pipe.scratch);
         scratch.fit(n);
-        if self.setup.scheme.shifting > 0.0 {
+        if self.setup.rod.scheme.shifting > 0.0 {
             scratch.fit_shift(n);
         }
         let result = self.step_with(&mut scratch, watch);
-        self.scratch = scratch;
+        self.pipe.scratch = scratch;
         result
     }
 }

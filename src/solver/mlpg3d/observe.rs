@@ -8,39 +8,39 @@ use crate::solver::shared::SolidNodes;
 impl Mlpg3d {
     /// Number of nodes.
     pub fn particles(&self) -> usize {
-        self.pos.len()
+        self.state.pos.len()
     }
 
-    crate::solver::shared::clock_getters!(dt);
+    crate::solver::shared::clock_getters!(state.clock; dt);
 
     /// Builds of the operator so far (the first included).
     pub fn rebuilds(&self) -> u64 {
-        self.rebuilds
+        self.state.rebuilds
     }
 
     /// The reference lattice.
     pub fn lattice(&self) -> &NodeLattice {
-        &self.lattice
+        &self.setup.lattice
     }
 
     /// Node positions (m).
     pub fn positions(&self) -> &[[f64; 3]] {
-        &self.pos
+        &self.state.pos
     }
 
     /// Node velocities (m/s).
     pub fn velocities(&self) -> &[[f64; 3]] {
-        &self.vel
+        &self.state.vel
     }
 
     /// Node masses (kg).
     pub fn masses(&self) -> &[f64] {
-        &self.mass
+        &self.setup.mass
     }
 
     /// Whether each node is pressed on the anvil.
     pub fn in_contact(&self) -> &[bool] {
-        &self.contact
+        &self.state.contact
     }
 
     /// Time of the last release of a node from the anvil (s): where the
@@ -48,35 +48,35 @@ impl Mlpg3d {
     /// (pushed by the anvil) and the step it lets go (pulled away), crosses
     /// zero; the node leaves the anvil in that step.
     pub fn last_release(&self) -> f64 {
-        self.last_release
+        self.state.last_release
     }
 
     /// Whether the end condition holds: the rod is at rest or has left the
     /// anvil, or `end_time` has been reached.
     pub fn finished(&self) -> bool {
-        self.at_rest || self.clock.time >= self.setup.end_time
+        self.state.at_rest || self.state.clock.time >= self.setup.rod.end_time
     }
 
     /// Smallest distance between named neighbours relative to the initial
     /// smallest, over the run so far.
     pub fn min_spacing_ratio(&self) -> f64 {
-        self.min_spacing
+        self.state.min_spacing
     }
 
     /// The energies: kinetic, internal (stress work), plastic work, damping
     /// and contact dissipation, and the relative energy error; the whole
     /// body's in the quarter model (four times the quarter's).
     pub fn energies(&self) -> Energies {
-        let kinetic = kinetic(&self.vel, &self.mass);
+        let kinetic = kinetic(&self.state.vel, &self.setup.mass);
         let k = self.multiplicity();
         Energies {
-            initial: k * self.energy.initial,
+            initial: k * self.state.energy.initial,
             kinetic: k * kinetic,
-            internal: k * self.energy.internal,
-            plastic_work: k * self.plastic_work,
-            damping: k * self.energy.lost[LOST_DAMPING],
-            contact: k * self.energy.lost[LOST_CONTACT],
-            smoothing: k * self.energy.lost[LOST_SMOOTHING],
+            internal: k * self.state.energy.internal,
+            plastic_work: k * self.state.plastic_work,
+            damping: k * self.state.energy.lost[LOST_DAMPING],
+            contact: k * self.state.energy.lost[LOST_CONTACT],
+            smoothing: k * self.state.energy.lost[LOST_SMOOTHING],
             error: self.energy_error_with(kinetic),
         }
     }
@@ -86,26 +86,30 @@ impl Mlpg3d {
     /// quarter model): the kinetic energy that carrying the moved nodes'
     /// velocities changed.
     pub fn shift_dissipation(&self) -> f64 {
-        self.multiplicity() * self.shift_dissipation
+        self.multiplicity() * self.state.shift_dissipation
     }
 
     /// How many copies of the modelled part make the body: 4 in the quarter
     /// model, else 1.
     pub fn multiplicity(&self) -> f64 {
-        if self.plane.is_empty() { 1.0 } else { 4.0 }
+        if self.setup.plane.is_empty() {
+            1.0
+        } else {
+            4.0
+        }
     }
 
     /// The symmetry planes each node lies on in the quarter model (bits
     /// `X`, `Y` of `src/approx/mirror.rs`); empty for the whole body.
     pub fn planes(&self) -> &[u8] {
-        &self.plane
+        &self.setup.plane
     }
 
     /// Runs the hot loops in the compiled copy `isa` from now on (by
     /// default the best this processor runs); every copy gives the same
     /// bits.
     pub fn set_isa(&mut self, isa: Isa) {
-        self.isa = isa;
+        self.pipe.isa = isa;
     }
 
     /// The heap bytes the run holds, by part (capacities, not lengths):
@@ -116,34 +120,34 @@ impl Mlpg3d {
         fn b<T>(v: &Vec<T>) -> usize {
             v.capacity() * std::mem::size_of::<T>()
         }
-        let l = &self.lattice;
-        let fields = b(&self.pos)
-            + b(&self.vel)
-            + b(&self.mass)
-            + b(&self.rho)
-            + b(&self.dev)
-            + b(&self.pressure)
-            + b(&self.eps_p)
-            + b(&self.temp)
-            + b(&self.visc)
-            + b(&self.contact)
-            + b(&self.supports_at)
-            + b(&self.built_at)
-            + b(&self.reference)
-            + b(&self.built_reference)
-            + b(&self.built_contact)
-            + b(&self.built_rho)
-            + b(&self.built_multipliers)
-            + b(&self.reaction)
+        let l = &self.setup.lattice;
+        let fields = b(&self.state.pos)
+            + b(&self.state.vel)
+            + b(&self.setup.mass)
+            + b(&self.state.rho)
+            + b(&self.state.dev)
+            + b(&self.state.pressure)
+            + b(&self.state.eps_p)
+            + b(&self.state.temp)
+            + b(&self.state.visc)
+            + b(&self.state.contact)
+            + b(&self.state.supports_at)
+            + b(&self.state.built_at)
+            + b(&self.state.reference)
+            + b(&self.state.built_reference)
+            + b(&self.state.built_contact)
+            + b(&self.state.built_rho)
+            + b(&self.state.built_multipliers)
+            + b(&self.state.reaction)
             + b(&l.position)
             + b(&l.volume)
             + b(&l.surfaces)
             + b(&l.sets.face)
             + b(&l.sets.mantle)
             + self.particles() * std::mem::size_of::<crate::material::PointState>();
-        let scratch = self.scratch.bytes();
+        let scratch = self.pipe.scratch.bytes();
         let (mut supports, mut shapes, mut spheres, mut op) = (0, 0, 0, 0);
-        if let Some(g) = &self.geometry {
+        if let Some(g) = &self.pipe.geometry {
             if let Some(s) = &g.supports {
                 supports =
                     b(&s.radius) + b(&s.named.offsets) + b(&s.named.indices) + b(&s.named_distance);
@@ -167,34 +171,35 @@ impl Mlpg3d {
     /// Wall time per phase of the steps taken in this process (a restored
     /// run starts from zero), and the counts of the builds.
     pub fn profile(&self) -> &PhaseTimes {
-        &self.profile
+        &self.pipe.profile
     }
 
     /// Turns on or off the counting of each phase's serial time in
     /// [`Mlpg3d::profile`] ([`PhaseTimes::count_serial`]).
     pub fn count_serial(&mut self, on: bool) {
-        self.profile.count_serial(on);
+        self.pipe.profile.count_serial(on);
     }
 
     /// The rod observables of the current state.
     pub fn rod(&self) -> RodObservables {
         RodObservables::of::<3>(
-            &self.lattice.sets,
-            &self.pos,
-            &self.vel,
-            self.setup.cylinder.radius,
+            &self.setup.lattice.sets,
+            &self.state.pos,
+            &self.state.vel,
+            self.setup.rod.cylinder.radius,
         )
     }
 
     /// The distances from the axis of the face's outer ring (the nodes on
     /// both the face and the mantle), in node order.
     fn ring_radii(&self) -> impl Iterator<Item = f64> + '_ {
-        self.lattice
+        self.setup
+            .lattice
             .sets
             .face
             .iter()
-            .filter(|&&i| self.lattice.surfaces[i].has(Surfaces::MANTLE))
-            .map(|&i| radius(&self.pos[i]))
+            .filter(|&&i| self.setup.lattice.surfaces[i].has(Surfaces::MANTLE))
+            .map(|&i| radius(&self.state.pos[i]))
     }
 
     /// `(max − min) / mean` of the distance from the axis of the face's
@@ -222,29 +227,34 @@ impl Mlpg3d {
 
     /// Height of the centre of the impact face above the anvil (m).
     pub fn face_lift(&self) -> f64 {
-        self.pos[0][2]
+        self.state.pos[0][2]
     }
 
     /// Largest effective plastic strain.
     pub fn max_plastic_strain(&self) -> f64 {
-        self.eps_p.iter().copied().fold(0.0, f64::max)
+        self.state.eps_p.iter().copied().fold(0.0, f64::max)
     }
 
     /// Highest temperature (K).
     pub fn max_temperature(&self) -> f64 {
-        self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        self.state
+            .temp
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Whether the rod has stopped or left the anvil.
     pub fn at_rest(&self) -> bool {
-        self.at_rest
+        self.state.at_rest
     }
 
     /// The node stresses `σ = S − p I` (Pa), `[xx, yy, zz, xy, yz, zx]`.
     pub fn stress(&self) -> Vec<Full> {
-        self.dev
+        self.state
+            .dev
             .iter()
-            .zip(&self.pressure)
+            .zip(&self.state.pressure)
             .map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3], d[4], d[5]])
             .collect()
     }
@@ -252,38 +262,43 @@ impl Mlpg3d {
     /// Density (kg/m³), pressure (Pa), plastic strain and temperature (K)
     /// of every node.
     pub fn scalars(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
-        (&self.rho, &self.pressure, &self.eps_p, &self.temp)
+        (
+            &self.state.rho,
+            &self.state.pressure,
+            &self.state.eps_p,
+            &self.state.temp,
+        )
     }
 
     /// The setup of this run.
     pub fn setup(&self) -> &RodSetup {
-        &self.setup
+        &self.setup.rod
     }
 
     /// The material of the rod.
     pub fn material(&self) -> &Material {
-        &self.material
+        &self.setup.material
     }
 
     /// The bodies after the rod (none for a Taylor run).
     pub fn others(&self) -> &[Body] {
-        &self.others
+        &self.setup.others
     }
 
     /// The body of each node (0: the rod); empty for a run of one body.
     pub fn group(&self) -> &[u8] {
-        &self.group
+        &self.setup.group
     }
 
     /// The material state of each node (its damage variables; empty before
     /// the first step).
     pub fn material_points(&self) -> &[crate::material::PointState] {
-        self.material_state.points()
+        self.state.material_state.points()
     }
 
     /// The contact reach between the bodies (m; [`contact`]).
     pub fn contact_reach(&self) -> f64 {
-        self.reach
+        self.setup.reach
     }
 }
 
@@ -330,7 +345,7 @@ impl Mlpg3d {
             e.smoothing,
             e.contact,
             e.error,
-            if self.at_rest { 1.0 } else { 0.0 },
+            if self.state.at_rest { 1.0 } else { 0.0 },
             self.mushroom_radius_spread(),
             e.damping,
             e.plastic_work,
@@ -343,13 +358,13 @@ impl Mlpg3d {
     /// interleaved per node.
     pub fn field(&self, name: &str) -> Option<Vec<f64>> {
         SolidNodes {
-            pos: &self.pos,
-            vel: &self.vel,
-            rho: &self.rho,
-            pressure: &self.pressure,
-            eps_p: &self.eps_p,
-            temp: &self.temp,
-            contact: &self.contact,
+            pos: &self.state.pos,
+            vel: &self.state.vel,
+            rho: &self.state.rho,
+            pressure: &self.state.pressure,
+            eps_p: &self.state.eps_p,
+            temp: &self.state.temp,
+            contact: &self.state.contact,
         }
         .field(name, || self.stress().into_iter().flatten().collect())
     }
@@ -362,10 +377,13 @@ impl crate::model::Model for Mlpg3d {
     }
     /// 64 records per elastic transit of the rod.
     fn record_interval(&self) -> f64 {
-        self.setup.cylinder.length / self.wave_speed() / 64.0
+        self.setup.rod.cylinder.length / self.wave_speed() / 64.0
     }
     fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
-        Some(crate::rod::profile(&self.lattice.sets.mantle, &self.pos))
+        Some(crate::rod::profile(
+            &self.setup.lattice.sets.mantle,
+            &self.state.pos,
+        ))
     }
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.min_spacing_ratio())
@@ -374,8 +392,7 @@ impl crate::model::Model for Mlpg3d {
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        *self = crate::model::read_saved(saved)?;
-        Ok(())
+        Self::load_state(self, saved)
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)

@@ -53,10 +53,18 @@ pub enum Outcome {
 }
 
 /// A penetration run: the two-body MLPG run and what its observables need.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+/// It saves its run's state alone (its setup follows from its scene).
+#[derive(Debug, Clone)]
 pub struct Penetration {
     setup: PenetrationSetup,
     run: Mlpg3d,
+}
+
+/// The run's state is all it saves.
+impl serde::Serialize for Penetration {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        self.run.serialize(s)
+    }
 }
 
 impl Penetration {
@@ -432,14 +440,10 @@ impl crate::model::Model for Penetration {
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        *self = crate::model::read_saved(saved)?;
-        Ok(())
+        self.run.load_state(saved)
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         let fresh: &Penetration = crate::model::same_solver(fresh)?;
-        if self.setup != fresh.setup {
-            return Err("its setup does not follow from its parameters".into());
-        }
         self.run.check_restored(&fresh.run)
     }
     fn set_isa(&mut self, isa: crate::isa::Isa) {

@@ -3,44 +3,70 @@
 
 use super::*;
 
+/// The fields of the setup ([`Setup3d`]), which a saved state does not
+/// hold, and what each is.
+const SETUP_KEYS: &[(&str, &str)] = &[
+    ("setup", "the rod's setup"),
+    ("material", "its material"),
+    ("lattice", "its lattice"),
+    ("others", "its bodies"),
+    ("group", "its bodies' nodes"),
+    ("anvil", "its anvil"),
+    ("reach", "its contact reach"),
+    ("mass", "its masses"),
+    ("plane", "its symmetry planes"),
+    ("held", "its held nodes"),
+    ("d_min0", "its first spacing"),
+    ("damping_time", "its damping time"),
+];
+
 impl Mlpg3d {
+    /// Reads a saved state (of [`State3d`]) into this run, a new run of its
+    /// scene, unchecked ([`Mlpg3d::check_restored`]); the geometry is
+    /// rebuilt at the next step from the state's record of the last build.
+    /// A state that holds a part of the setup is refused, naming it.
+    pub(crate) fn load_state(
+        &mut self,
+        saved: crate::model::SavedSolver<'_>,
+    ) -> std::result::Result<(), String> {
+        if let crate::model::SavedSolver::Json(value) = &saved {
+            crate::solver::shared::refuse_setup(value, SETUP_KEYS)?;
+        }
+        self.state = crate::model::read_saved(saved)?;
+        self.pipe.geometry = None;
+        Ok(())
+    }
+
     /// Checks a restored run against `fresh`, a new run of the same
-    /// parameters: what follows from them (setup, material, lattice, masses,
-    /// first step, damping time, impact energy) must be the same bits, and
-    /// every node field must have one finite value per node.
+    /// parameters: what the state holds that follows from them (the first
+    /// step, the impact energy) must be the same bits, and every node field
+    /// must have one finite value per node of the setup.
     pub(crate) fn check_restored(&self, fresh: &Mlpg3d) -> std::result::Result<(), String> {
         use crate::solver::shared::json;
-        let fixed = |s: &Mlpg3d| {
-            json(&(
-                &s.setup,
-                &s.material,
-                (&s.others, &s.group, s.anvil, s.reach, &s.plane, &s.held),
-                &s.lattice,
-                &s.mass,
-                s.clock.dt0,
-                s.d_min0,
-                s.damping_time,
-                s.energy.initial,
-            ))
-        };
+        // The setup is the scene's (a restored run is built from it); what
+        // the state holds that follows from the parameters must be its bits.
+        let fixed = |s: &Mlpg3d| json(&(s.state.clock.dt0, s.state.energy.initial));
         if fixed(self) != fixed(fresh) {
             return Err("its lattice, masses or material do not follow from its parameters".into());
         }
         let n = fresh.particles();
         let vectors = [
-            ("positions", &self.pos),
-            ("velocities", &self.vel),
-            ("support positions", &self.supports_at),
-            ("build positions", &self.built_at),
-            ("reference places", &self.reference),
-            ("reference places at the build", &self.built_reference),
+            ("positions", &self.state.pos),
+            ("velocities", &self.state.vel),
+            ("support positions", &self.state.supports_at),
+            ("build positions", &self.state.built_at),
+            ("reference places", &self.state.reference),
+            ("reference places at the build", &self.state.built_reference),
         ];
         for (what, f) in vectors {
             if f.len() != n || !f.iter().flatten().all(|x| x.is_finite()) {
                 return Err(format!("its {what} are not {n} finite vectors"));
             }
         }
-        let tensors = [("deviators", &self.dev), ("viscous stresses", &self.visc)];
+        let tensors = [
+            ("deviators", &self.state.dev),
+            ("viscous stresses", &self.state.visc),
+        ];
         for (what, f) in tensors {
             if f.len() != n || !f.iter().flatten().all(|x| x.is_finite()) {
                 return Err(format!("its {what} are not {n} finite tensors"));
@@ -48,19 +74,24 @@ impl Mlpg3d {
         }
         // Each with the least physical value.
         let scalars = [
-            ("densities", &self.rho, f64::MIN_POSITIVE),
-            ("densities at the build", &self.built_rho, f64::MIN_POSITIVE),
-            ("pressures", &self.pressure, f64::NEG_INFINITY),
-            ("plastic strains", &self.eps_p, 0.0),
-            ("temperatures", &self.temp, f64::MIN_POSITIVE),
+            ("densities", &self.state.rho, f64::MIN_POSITIVE),
+            (
+                "densities at the build",
+                &self.state.built_rho,
+                f64::MIN_POSITIVE,
+            ),
+            ("pressures", &self.state.pressure, f64::NEG_INFINITY),
+            ("plastic strains", &self.state.eps_p, 0.0),
+            ("temperatures", &self.state.temp, f64::MIN_POSITIVE),
         ];
         for (what, f, least) in scalars {
             if f.len() != n || !f.iter().all(|&x| x.is_finite() && x >= least) {
                 return Err(format!("its {what} are not {n} finite, physical values"));
             }
         }
-        if !(self.built_multipliers.is_empty() || self.built_multipliers.len() == n)
+        if !(self.state.built_multipliers.is_empty() || self.state.built_multipliers.len() == n)
             || !self
+                .state
                 .built_multipliers
                 .iter()
                 .flatten()
@@ -70,15 +101,16 @@ impl Mlpg3d {
                 "its multipliers of the conforming correction are not none or {n} finite vectors"
             ));
         }
-        if self.contact.len() != n || self.built_contact.len() != n {
+        if self.state.contact.len() != n || self.state.built_contact.len() != n {
             return Err(format!("its contact flags are not {n}"));
         }
         // The anvil holds only the nodes on it, and pushes.
-        if self.reaction.len() != n
+        if self.state.reaction.len() != n
             || !self
+                .state
                 .reaction
                 .iter()
-                .zip(&self.contact)
+                .zip(&self.state.contact)
                 .all(|(&r, &c)| r.is_finite() && r >= 0.0 && (c || r == 0.0))
         {
             return Err(format!(
@@ -87,8 +119,8 @@ impl Mlpg3d {
         }
         // The quarter model's nodes stay on their side of the planes, those
         // on a plane on it, with no velocity across it.
-        for (i, &on) in self.plane.iter().enumerate() {
-            let (x, v) = (self.pos[i], self.vel[i]);
+        for (i, &on) in self.setup.plane.iter().enumerate() {
+            let (x, v) = (self.state.pos[i], self.state.vel[i]);
             let off = |bit: u8, d: usize| {
                 if on & bit != 0 {
                     x[d] != 0.0 || v[d] != 0.0
@@ -100,44 +132,45 @@ impl Mlpg3d {
                 return Err(format!("its node {i} is off its side of a symmetry plane"));
             }
         }
-        if self.damaging() && self.clock.steps > 0 && !self.material_state.has_damage() {
+        if self.damaging() && self.state.clock.steps > 0 && !self.state.material_state.has_damage()
+        {
             return Err("its damage variables are missing".into());
         }
-        self.material_state.check_len(n)?;
+        self.state.material_state.check_len(n)?;
         crate::solver::shared::check_restored_clock(
-            self.clock.time,
-            self.clock.dt,
-            self.clock.dt0,
-            self.clock.steps,
+            self.state.clock.time,
+            self.state.clock.dt,
+            self.state.clock.dt0,
+            self.state.clock.steps,
             &[
-                self.min_spacing,
-                self.energy.internal,
-                self.plastic_work,
-                self.energy.lost[LOST_DAMPING],
-                self.energy.lost[LOST_CONTACT],
-                self.energy.lost[LOST_SMOOTHING],
-                self.shift_dissipation,
-                self.quiet_since.since().unwrap_or(0.0),
-                self.last_release,
+                self.state.min_spacing,
+                self.state.energy.internal,
+                self.state.plastic_work,
+                self.state.energy.lost[LOST_DAMPING],
+                self.state.energy.lost[LOST_CONTACT],
+                self.state.energy.lost[LOST_SMOOTHING],
+                self.state.shift_dissipation,
+                self.state.quiet_since.since().unwrap_or(0.0),
+                self.state.last_release,
             ],
         )?;
         // Finite is not enough: a position of 1e300 overflows the search
         // of the supports, a velocity of 1e300 the energies.
         let bounds = crate::solver::shared::RestoreBounds::new(
-            &fresh.pos,
-            fresh.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max) + fresh.wave_speed(),
-            self.clock.time,
+            &fresh.state.pos,
+            fresh.state.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max) + fresh.wave_speed(),
+            self.state.clock.time,
         );
-        bounds.speeds("velocities", &self.vel)?;
+        bounds.speeds("velocities", &self.state.vel)?;
         for (what, f) in [
-            ("positions", &self.pos),
-            ("support positions", &self.supports_at),
-            ("build positions", &self.built_at),
-            ("reference places", &self.reference),
-            ("reference places at the build", &self.built_reference),
+            ("positions", &self.state.pos),
+            ("support positions", &self.state.supports_at),
+            ("build positions", &self.state.built_at),
+            ("reference places", &self.state.reference),
+            ("reference places at the build", &self.state.built_reference),
         ] {
             bounds.places(what, f)?;
         }
-        self.material_state.check_cracks(bounds.extent)
+        self.state.material_state.check_cracks(bounds.extent)
     }
 }

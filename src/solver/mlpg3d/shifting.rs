@@ -28,34 +28,39 @@ impl Mlpg3d {
     /// changes is booked with the smoothing. Fails with the compression
     /// limit of the equation of state at a moved node.
     pub(super) fn shift(&mut self, scratch: &mut Scratch) -> Result<()> {
-        let g = self.geometry.as_ref().expect("built before the step");
+        let g = self.pipe.geometry.as_ref().expect("built before the step");
         let frame = ShiftFrame {
             geometry: g,
-            spacing: self.d_min0,
-            anvil: self.anvil,
-            nodal: self.setup.scheme.forces.nodal(),
-            surfaces: &self.lattice.surfaces,
-            contact: &self.contact,
-            plane: &self.plane,
-            held: &self.held,
-            mass: &self.mass,
-            points: self.material_state.points(),
-            materials: (&self.material, &self.others, &self.group),
-            time: self.clock.time,
+            spacing: self.setup.d_min0,
+            anvil: self.setup.anvil,
+            nodal: self.setup.rod.scheme.forces.nodal(),
+            surfaces: &self.setup.lattice.surfaces,
+            contact: &self.state.contact,
+            plane: &self.setup.plane,
+            held: &self.setup.held,
+            mass: &self.setup.mass,
+            points: self.state.material_state.points(),
+            materials: (&self.setup.material, &self.setup.others, &self.setup.group),
+            time: self.state.clock.time,
         };
         let (buffers, ext) = (&mut scratch.shifting, &mut scratch.images);
         let images = &g.mirror;
-        let reference = extended(images, &self.reference, &mut ext.built, mirror::vector);
+        let reference = extended(
+            images,
+            &self.state.reference,
+            &mut ext.built,
+            mirror::vector,
+        );
         freedoms(&frame, reference, &mut buffers.free);
-        let pos = extended(images, &self.pos, &mut ext.pos, mirror::vector);
-        let (spacing, step_scale) = (frame.spacing, self.setup.step_scale());
+        let pos = extended(images, &self.state.pos, &mut ext.pos, mirror::vector);
+        let (spacing, step_scale) = (frame.spacing, self.setup.rod.step_scale());
         shifts(
             pos,
             &g.shapes,
             &buffers.free,
             spacing,
             SHIFT_RANGE * spacing,
-            self.setup.scheme.shifting * step_scale,
+            self.setup.rod.scheme.shifting * step_scale,
             SHIFT_CAP * spacing * step_scale,
             &mut buffers.shift,
         );
@@ -75,19 +80,19 @@ impl Mlpg3d {
             return Ok(());
         }
         let mut fields = ShiftedFields {
-            pos: &mut self.pos,
-            vel: &mut self.vel,
-            dev: &mut self.dev,
-            pressure: &mut self.pressure,
-            rho: &mut self.rho,
-            eps_p: &mut self.eps_p,
-            temp: &mut self.temp,
-            reference: &mut self.reference,
+            pos: &mut self.state.pos,
+            vel: &mut self.state.vel,
+            dev: &mut self.state.dev,
+            pressure: &mut self.state.pressure,
+            rho: &mut self.state.rho,
+            eps_p: &mut self.state.eps_p,
+            temp: &mut self.state.temp,
+            reference: &mut self.state.reference,
         };
         pack(&fields, &mut buffers.carried);
         let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
         carry(&g.shapes, carried, &buffers.shift, &mut buffers.carried_out);
-        let conservative = self.setup.conservative_carry;
+        let conservative = self.setup.rod.conservative_carry;
         let mut ke = [0.0; 2];
         if conservative {
             ke[0] = kinetic(fields.vel, frame.mass);
@@ -97,8 +102,8 @@ impl Mlpg3d {
         if conservative {
             ke[1] = kinetic(fields.vel, frame.mass);
         }
-        self.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
-        self.shift_dissipation += ke[0] - ke[1];
+        self.state.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
+        self.state.shift_dissipation += ke[0] - ke[1];
         Ok(())
     }
 }

@@ -15,15 +15,20 @@ impl Mlpg3d {
         sup: &Supports,
         shapes: &NodalShapes,
     ) -> Vec<TestSphere> {
-        let n = self.pos.len();
+        let n = self.state.pos.len();
         // F⁻¹ = ∂X/∂x at every node.
         let mut finv = vec![[[0.0; 3]; 3]; n];
         let mut buf = Vec::new();
-        let reference_ext = extended(mirror, &self.built_reference, &mut buf, mirror::vector);
+        let reference_ext = extended(
+            mirror,
+            &self.state.built_reference,
+            &mut buf,
+            mirror::vector,
+        );
         shapes.velocity_gradients(reference_ext, &mut finv);
-        let surf = &self.lattice.surfaces;
-        let contact = &self.built_contact;
-        let reference = &self.built_reference;
+        let surf = &self.setup.lattice.surfaces;
+        let contact = &self.state.built_contact;
+        let reference = &self.state.built_reference;
         // Current outward normals of the boundary planes through each node:
         // (mantle, face or top), zero when absent.
         let normals: Vec<[[f64; 3]; 2]> = (0..n)

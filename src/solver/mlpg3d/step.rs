@@ -12,141 +12,145 @@ impl Mlpg3d {
     /// The step with its buffers (reused from step to step: the step
     /// allocates nothing once they have their size).
     pub(super) fn step_with(&mut self, scratch: &mut Scratch, mut watch: Stopwatch) -> Result<()> {
-        let dt = self.clock.dt;
-        let nodal = self.setup.scheme.forces.nodal();
+        let dt = self.state.clock.dt;
+        let nodal = self.setup.rod.scheme.forces.nodal();
         // 1. Forces from σ^n and the viscous stress.
-        let g = self.geometry.as_ref().expect("built above");
+        let g = self.pipe.geometry.as_ref().expect("built above");
         total_stress(
-            &self.dev,
-            &self.pressure,
-            &self.visc,
+            &self.state.dev,
+            &self.state.pressure,
+            &self.state.visc,
             &mut scratch.forces.total,
         );
         forces(
             g,
             nodal,
-            (&self.mass, &self.rho),
+            (&self.setup.mass, &self.state.rho),
             &mut scratch.forces,
             &mut scratch.images.total,
         );
-        self.profile.lap(Phase::Force, &mut watch);
+        self.pipe.profile.lap(Phase::Force, &mut watch);
         // 2-3. Velocities, contact, positions.
         let damaging = self.damaging();
-        if !self.group.is_empty() || damaging {
-            scratch.contact.before.clone_from(&self.vel);
+        if !self.setup.group.is_empty() || damaging {
+            scratch.contact.before.clone_from(&self.state.vel);
         }
         let frame = Frame {
             dt,
-            now: self.clock.time,
+            now: self.state.clock.time,
             nodal,
-            spacing: self.d_min0,
-            reach: self.reach,
+            spacing: self.setup.d_min0,
+            reach: self.setup.reach,
             geometry: g,
-            mass: &self.mass,
-            rho: &self.rho,
-            group: &self.group,
-            plane: &self.plane,
-            held: &self.held,
+            mass: &self.setup.mass,
+            rho: &self.state.rho,
+            group: &self.setup.group,
+            plane: &self.setup.plane,
+            held: &self.setup.held,
         };
         motion::kick(
             &frame,
             &scratch.forces.force,
-            &mut self.vel,
-            &mut self.contact,
-            &mut self.reaction,
+            &mut self.state.vel,
+            &mut self.state.contact,
+            &mut self.state.reaction,
             &mut scratch.kicks,
         );
-        self.profile.lap(Phase::Kick, &mut watch);
+        self.pipe.profile.lap(Phase::Kick, &mut watch);
         // Velocity smoothing toward the MLS approximation at the node.
-        let alpha = self.setup.scheme.smoothing * self.setup.step_scale();
+        let alpha = self.setup.rod.scheme.smoothing * self.setup.rod.step_scale();
         if alpha > 0.0 {
-            self.energy.lost[LOST_SMOOTHING] += motion::smooth(
+            self.state.energy.lost[LOST_SMOOTHING] += motion::smooth(
                 &frame,
-                (alpha, self.setup.scheme.order.power()),
-                &mut self.vel,
-                &self.contact,
+                (alpha, self.setup.rod.scheme.order.power()),
+                &mut self.state.vel,
+                &self.state.contact,
                 &mut scratch.smoothing,
                 &mut scratch.images.vel,
             );
         }
-        self.profile.lap(Phase::Smoothing, &mut watch);
+        self.pipe.profile.lap(Phase::Smoothing, &mut watch);
         // Contact between the bodies, then between pulverized nodes closer
         // than half a spacing.
         motion::collide(
             &frame,
-            &self.pos,
-            damaging.then(|| self.material_state.points()),
-            &mut self.vel,
+            &self.state.pos,
+            damaging.then(|| self.state.material_state.points()),
+            &mut self.state.vel,
             &mut scratch.contact,
             &mut scratch.images,
-            &mut self.energy.lost[LOST_CONTACT],
+            &mut self.state.energy.lost[LOST_CONTACT],
         );
-        motion::clamp(&frame, &mut self.vel, &mut self.energy.lost[LOST_CONTACT]);
+        motion::clamp(
+            &frame,
+            &mut self.state.vel,
+            &mut self.state.energy.lost[LOST_CONTACT],
+        );
         motion::drift(
             &frame,
-            self.anvil,
-            &mut self.vel,
-            &mut self.pos,
-            &mut self.contact,
+            self.setup.anvil,
+            &mut self.state.vel,
+            &mut self.state.pos,
+            &mut self.state.contact,
             &scratch.kicks,
             &mut scratch.moves,
         );
-        self.clock.time += dt;
-        self.clock.steps += 1;
+        self.state.clock.time += dt;
+        self.state.clock.steps += 1;
         motion::settle(
             &scratch.moves,
-            &mut self.energy.lost[LOST_CONTACT],
-            &mut self.last_release,
-            self.clock.time,
+            &mut self.state.energy.lost[LOST_CONTACT],
+            &mut self.state.last_release,
+            self.state.clock.time,
         )?;
-        motion::check_planes(&self.pos, &self.plane, self.clock.time)?;
-        self.profile.lap(Phase::Move, &mut watch);
-        if self.setup.scheme.shifting > 0.0 {
+        motion::check_planes(&self.state.pos, &self.setup.plane, self.state.clock.time)?;
+        self.pipe.profile.lap(Phase::Move, &mut watch);
+        if self.setup.rod.scheme.shifting > 0.0 {
             self.shift(scratch)?;
         }
-        self.profile.lap(Phase::Shift, &mut watch);
+        self.pipe.profile.lap(Phase::Shift, &mut watch);
         // 4. The geometry follows the body.
         let d_min = self.follow(scratch, &mut watch)?;
         // 5. Velocity gradients and the material.
-        let g = self.geometry.as_ref().expect("built above");
+        let g = self.pipe.geometry.as_ref().expect("built above");
         let vel_ext = extended(
             &g.mirror,
-            &self.vel,
+            &self.state.vel,
             &mut scratch.images.vel,
             mirror::vector,
         );
         g.shapes.velocity_gradients(vel_ext, &mut scratch.grad);
-        self.profile.lap(Phase::Gradients, &mut watch);
+        self.pipe.profile.lap(Phase::Gradients, &mut watch);
         update::update_material(
             &MaterialInputs {
                 dt,
-                damping_time: self.damping_time,
-                rod: &self.material,
-                others: &self.others,
-                group: &self.group,
-                mass: &self.mass,
-                vel: &self.vel,
+                damping_time: self.setup.damping_time,
+                rod: &self.setup.material,
+                others: &self.setup.others,
+                group: &self.setup.group,
+                mass: &self.setup.mass,
+                vel: &self.state.vel,
                 grad: &scratch.grad,
             },
             MaterialFields {
-                dev: &mut self.dev,
-                pressure: &mut self.pressure,
-                eps_p: &mut self.eps_p,
-                temp: &mut self.temp,
-                rho: &mut self.rho,
-                visc: &mut self.visc,
-                states: self.material_state.points_mut(),
+                dev: &mut self.state.dev,
+                pressure: &mut self.state.pressure,
+                eps_p: &mut self.state.eps_p,
+                temp: &mut self.state.temp,
+                rho: &mut self.state.rho,
+                visc: &mut self.state.visc,
+                states: self.state.material_state.points_mut(),
             },
             &mut scratch.results,
         );
-        let t = update::sum(&scratch.results, self.clock.time)?;
-        self.profile.lap(Phase::Material, &mut watch);
-        self.energy.internal += t.internal;
-        self.plastic_work += t.plastic;
-        self.energy.lost[LOST_DAMPING] += t.damping;
+        let t = update::sum(&scratch.results, self.state.clock.time)?;
+        self.pipe.profile.lap(Phase::Material, &mut watch);
+        self.state.energy.internal += t.internal;
+        self.state.plastic_work += t.plastic;
+        self.state.energy.lost[LOST_DAMPING] += t.damping;
         // 6. Checks and the next step.
         self.end_step(&t, d_min)?;
-        self.profile.lap(Phase::Checks, &mut watch);
+        self.pipe.profile.lap(Phase::Checks, &mut watch);
         Ok(())
     }
 
@@ -156,31 +160,36 @@ impl Mlpg3d {
     /// which books its own phases). Returns the smallest distance between
     /// named nodes.
     fn follow(&mut self, scratch: &mut Scratch, watch: &mut Stopwatch) -> Result<f64> {
-        let images = &self.geometry.as_ref().expect("built above").mirror;
-        let x = extended(images, &self.pos, &mut scratch.images.pos, mirror::vector);
+        let images = &self.pipe.geometry.as_ref().expect("built above").mirror;
+        let x = extended(
+            images,
+            &self.state.pos,
+            &mut scratch.images.pos,
+            mirror::vector,
+        );
         let b = extended(
             images,
-            &self.built_at,
+            &self.state.built_at,
             &mut scratch.images.built,
             mirror::vector,
         );
         let pairs = self.named_pairs(x, b);
-        self.profile.lap(Phase::Pairs, watch);
+        self.pipe.profile.lap(Phase::Pairs, watch);
         let d_min = pairs.nearest;
-        let ratio = d_min / self.d_min0;
-        self.min_spacing = self.min_spacing.min(ratio);
-        check_spacing(ratio, self.clock.time, "")?;
+        let ratio = d_min / self.setup.d_min0;
+        self.state.min_spacing = self.state.min_spacing.min(ratio);
+        check_spacing(ratio, self.state.clock.time, "")?;
         let supports = pairs.recompute;
         if supports || pairs.strained {
             if supports {
-                self.supports_at.clone_from(&self.pos);
+                self.state.supports_at.clone_from(&self.state.pos);
             }
-            self.built_at.clone_from(&self.pos);
-            self.built_reference.clone_from(&self.reference);
-            self.built_contact.clone_from(&self.contact);
-            self.built_rho.clone_from(&self.rho);
+            self.state.built_at.clone_from(&self.state.pos);
+            self.state.built_reference.clone_from(&self.state.reference);
+            self.state.built_contact.clone_from(&self.state.contact);
+            self.state.built_rho.clone_from(&self.state.rho);
             self.build_geometry(supports)?;
-            *watch = self.profile.stopwatch();
+            *watch = self.pipe.profile.stopwatch();
         }
         Ok(d_min)
     }
@@ -191,6 +200,7 @@ impl Mlpg3d {
     /// [`crate::solver::shared::QUIET_TRANSITS`] transits ([`QuietEnd`]).
     fn end_step(&mut self, t: &Tally, d_min: f64) -> Result<()> {
         if let Some(i) = self
+            .state
             .pos
             .par_iter()
             .position_first(|x| !x.iter().all(|v| v.is_finite()))
@@ -198,7 +208,7 @@ impl Mlpg3d {
             return Err(Error::NonFinite {
                 field: "position",
                 particle: i,
-                time: self.clock.time,
+                time: self.state.clock.time,
             });
         }
         let e = self.energy_error_with(t.kinetic);
@@ -206,26 +216,26 @@ impl Mlpg3d {
             return Err(Error::EnergyDrift {
                 error: e,
                 bound: ENERGY_ERROR_BOUND,
-                time: self.clock.time,
+                time: self.state.clock.time,
             });
         }
-        self.clock.dt = self.stable_dt(t.worst_speed, d_min);
-        self.clock.check_step(self.clock.dt)?;
-        let touching = self.contact.par_iter().any(|&c| c);
-        if self.anvil && -t.momentum / t.mass <= 0.0 && !touching {
-            self.at_rest = true;
+        self.state.clock.dt = self.stable_dt(t.worst_speed, d_min);
+        self.state.clock.check_step(self.state.clock.dt)?;
+        let touching = self.state.contact.par_iter().any(|&c| c);
+        if self.setup.anvil && -t.momentum / t.mass <= 0.0 && !touching {
+            self.state.at_rest = true;
         }
         // A run of several bodies (no anvil) ends at its end time.
-        if self.anvil
-            && self.quiet_since.at_rest(
-                self.clock.time,
+        if self.setup.anvil
+            && self.state.quiet_since.at_rest(
+                self.state.clock.time,
                 t.kinetic,
-                self.energy.initial,
-                self.setup.cylinder.length,
+                self.state.energy.initial,
+                self.setup.rod.cylinder.length,
                 self.wave_speed(),
             )
         {
-            self.at_rest = true;
+            self.state.at_rest = true;
         }
         Ok(())
     }

@@ -65,7 +65,7 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             let mut uniform = crate::test_rng::rng(99);
             let mut noise = || amplitude * (uniform() - 0.5);
             for i in 0..n {
-                let x = run.pos[i];
+                let x = run.state.pos[i];
                 let mut v = if amplitude == 0.0 {
                     // Smooth: a gradient in every direction.
                     [
@@ -76,21 +76,22 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
                 } else {
                     [noise(), noise(), -300.0 + SHEAR * x[0] + noise()]
                 };
-                if let Some(&on) = run.plane.get(i) {
+                if let Some(&on) = run.setup.plane.get(i) {
                     pin(&mut v, on);
                 }
-                run.vel[i] = v;
+                run.state.vel[i] = v;
             }
             if amplitude == 0.0 {
                 // The run's energy balance starts from this field.
-                run.energy.initial = kinetic(&run.vel, &run.mass);
+                run.state.energy.initial = kinetic(&run.state.vel, &run.setup.mass);
             }
             run.step().unwrap();
             // Three interior nodes, each pushed toward a neighbour.
-            let spacing = run.d_min0;
+            let spacing = run.setup.d_min0;
             let interior: Vec<usize> = (0..n)
                 .filter(|&i| {
-                    run.lattice.surfaces[i].interior() && run.plane.get(i).is_none_or(|&p| p == 0)
+                    run.setup.lattice.surfaces[i].interior()
+                        && run.setup.plane.get(i).is_none_or(|&p| p == 0)
                 })
                 .collect();
             assert!(interior.len() >= 6, "{} interior nodes", interior.len());
@@ -98,18 +99,19 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
                 let j = (0..n)
                     .filter(|&j| j != i)
                     .min_by(|&a, &b| {
-                        distance(&run.pos[a], &run.pos[i])
-                            .total_cmp(&distance(&run.pos[b], &run.pos[i]))
+                        distance(&run.state.pos[a], &run.state.pos[i])
+                            .total_cmp(&distance(&run.state.pos[b], &run.state.pos[i]))
                     })
                     .unwrap();
-                let (xi, xj) = (run.pos[i], run.pos[j]);
+                let (xi, xj) = (run.state.pos[i], run.state.pos[j]);
                 let r = distance(&xi, &xj);
-                run.pos[i] = std::array::from_fn(|k| xj[k] + (xi[k] - xj[k]) * 0.2 * spacing / r);
+                run.state.pos[i] =
+                    std::array::from_fn(|k| xj[k] + (xi[k] - xj[k]) * 0.2 * spacing / r);
             }
             let momentum = |run: &Mlpg3d| -> ([f64; 3], f64) {
                 let mut p = [0.0; 3];
                 let mut scale = 0.0;
-                for (v, m) in run.vel.iter().zip(&run.mass) {
+                for (v, m) in run.state.vel.iter().zip(&run.setup.mass) {
                     for k in 0..3 {
                         p[k] += m * v[k];
                         scale += m * v[k].abs();
@@ -119,28 +121,28 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             };
             let (p0, scale) = momentum(&run);
             let (ke0, booked0) = (
-                kinetic(&run.vel, &run.mass),
-                run.energy.lost[LOST_SMOOTHING],
+                kinetic(&run.state.vel, &run.setup.mass),
+                run.state.energy.lost[LOST_SMOOTHING],
             );
-            let pos0 = run.pos.clone();
-            let mut scratch = std::mem::take(&mut run.scratch);
+            let pos0 = run.state.pos.clone();
+            let mut scratch = std::mem::take(&mut run.pipe.scratch);
             scratch.fit(n);
             scratch.fit_shift(n);
             run.shift(&mut scratch).unwrap();
-            let moved = (0..n).filter(|&i| run.pos[i] != pos0[i]).count();
+            let moved = (0..n).filter(|&i| run.state.pos[i] != pos0[i]).count();
             assert!(moved >= 3, "{moved} nodes moved");
             let (p1, _) = momentum(&run);
             let axes = if quarter { 2..3 } else { 0..3 };
             drift[usize::from(!conservative)] =
                 axes.map(|k| (p1[k] - p0[k]).abs()).fold(0.0, f64::max) / scale;
-            let ke1 = kinetic(&run.vel, &run.mass);
-            let booked = run.energy.lost[LOST_SMOOTHING] - booked0;
+            let ke1 = kinetic(&run.state.vel, &run.setup.mass);
+            let booked = run.state.energy.lost[LOST_SMOOTHING] - booked0;
             assert!(
                 (ke1 + booked - ke0).abs() < 1e-13 * ke0,
                 "quarter {quarter}: {ke0} J before, {ke1} J after, {booked} J booked"
             );
             assert_eq!(
-                run.shift_dissipation, booked,
+                run.state.shift_dissipation, booked,
                 "the shift's own tally is what it booked"
             );
             if conservative && amplitude == 0.0 {
@@ -153,14 +155,14 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
                 // Σ m_i |G|² |d_i| (R_i + |d_i|) over the moved nodes; a
                 // shift that destroyed energy at first order (m v·Δv)
                 // would book 10^4 times more.
-                let g = run.geometry.as_ref().unwrap();
+                let g = run.pipe.geometry.as_ref().unwrap();
                 let radius = &g.supports.as_ref().unwrap().radius;
                 let bound: f64 = (0..n)
-                    .filter(|&i| run.pos[i] != pos0[i])
+                    .filter(|&i| run.state.pos[i] != pos0[i])
                     .map(|i| {
-                        let d = distance(&run.pos[i], &pos0[i]);
+                        let d = distance(&run.state.pos[i], &pos0[i]);
                         // |G|² = 3.0625 SHEAR² (Frobenius) for the smooth field.
-                        run.mass[i] * 3.0625 * SHEAR * SHEAR * d * (radius[i] + d)
+                        run.setup.mass[i] * 3.0625 * SHEAR * SHEAR * d * (radius[i] + d)
                     })
                     .sum();
                 eprintln!(
@@ -288,10 +290,10 @@ fn the_operator_of_a_deformed_rod_is_the_plain_one() {
         s.step().unwrap();
     }
     assert!(s.rebuilds() > 2);
-    let g = s.geometry.as_ref().unwrap();
+    let g = s.pipe.geometry.as_ref().unwrap();
     let sup = g.supports.as_ref().unwrap();
     let plain = TractionOperator::build_plain(
-        &s.built_at,
+        &s.state.built_at,
         sup,
         &g.spheres,
         &SphereRule::of(DEFAULT_RULE),
@@ -312,25 +314,29 @@ fn the_operator_of_a_deformed_rod_is_the_plain_one() {
 fn a_run_restored_after_a_release_rebuilds_the_spheres_of_the_last_build() {
     let (material, cyl) = (plastic_steel(), small_rod());
     let mut s = Mlpg3d::new(RodSetup::new(cyl, 3, 300.0, 1e-3), material).unwrap();
-    while s.contact == s.built_contact {
+    while s.state.contact == s.state.built_contact {
         assert!(s.steps() < 2000, "no node left the anvil");
         s.step().unwrap();
     }
     let changed = (0..s.particles())
-        .filter(|&i| s.contact[i] != s.built_contact[i])
+        .filter(|&i| s.state.contact[i] != s.state.built_contact[i])
         .count();
     assert!(changed > 0);
-    let json = serde_json::to_string(&s).unwrap();
-    let mut back: Mlpg3d = serde_json::from_str(&json).unwrap();
-    back.check_restored(&s).unwrap();
+    let json = serde_json::to_value(&s).unwrap();
+    let fresh = Mlpg3d::new(RodSetup::new(cyl, 3, 300.0, 1e-3), material).unwrap();
+    let mut back = fresh.clone();
+    back.load_state(crate::model::SavedSolver::Json(json))
+        .unwrap();
+    back.check_restored(&fresh).unwrap();
     for _ in 0..20 {
         s.step().unwrap();
         back.step().unwrap();
     }
     let bits = |m: &Mlpg3d| -> Vec<u64> {
-        m.pos
+        m.state
+            .pos
             .iter()
-            .chain(&m.vel)
+            .chain(&m.state.vel)
             .flatten()
             .map(|x| x.to_bits())
             .collect()
@@ -361,9 +367,9 @@ fn operator_sizes() {
     let s = crate::scene::taylor3d::Taylor3dParams::of(&scene)
         .build()
         .unwrap();
-    let g = s.geometry.as_ref().unwrap();
+    let g = s.pipe.geometry.as_ref().unwrap();
     let sup = g.supports.as_ref().unwrap();
-    let pts = &s.built_at;
+    let pts = &s.state.built_at;
     let n = pts.len() as f64;
     let reach = g.spheres.iter().map(|t| t.radius).fold(0.0, f64::max);
     let list = candidates_first(pts, pts.len(), sup, reach);

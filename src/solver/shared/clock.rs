@@ -43,26 +43,27 @@ impl Clock {
     }
 }
 
-/// Inside `impl` of a solver with a [`Clock`] field `clock`: its getters
-/// `time()` (s) and `steps()`, and with `dt` also `dt()` (s).
+/// Inside `impl` of a solver with a [`Clock`] at the field path given
+/// (`clock`, `state.clock`): its getters `time()` (s) and `steps()`, and
+/// after `; dt` also `dt()` (s).
 macro_rules! clock_getters {
-    () => {
+    ($($f:ident).+) => {
         /// Simulated time (s).
         pub fn time(&self) -> f64 {
-            self.clock.time
+            self.$($f).+.time
         }
 
         /// Steps taken.
         pub fn steps(&self) -> u64 {
-            self.clock.steps
+            self.$($f).+.steps
         }
     };
-    (dt) => {
-        $crate::solver::shared::clock_getters!();
+    ($($f:ident).+ ; dt) => {
+        $crate::solver::shared::clock_getters!($($f).+);
 
         /// Current time step (s).
         pub fn dt(&self) -> f64 {
-            self.clock.dt
+            self.$($f).+.dt
         }
     };
 }

@@ -101,3 +101,16 @@ pub(crate) fn first_non_finite(fields: &[(&'static str, &[f64])]) -> Option<(&'s
         .iter()
         .find_map(|(name, v)| v.iter().position(|x| !x.is_finite()).map(|i| (*name, i)))
 }
+
+/// Refuses a saved state (as JSON) that holds one of the `keys` of its
+/// solver's setup (each with what it is): a saved run holds only what the
+/// run changes, and its setup follows from its parameters.
+pub(crate) fn refuse_setup(saved: &serde_json::Value, keys: &[(&str, &str)]) -> Result<(), String> {
+    match keys.iter().find(|(key, _)| saved.get(key).is_some()) {
+        Some((key, what)) => Err(format!(
+            "it holds {what} (`{key}`), which follows from its parameters: a saved run holds \
+             only what the run changes"
+        )),
+        None => Ok(()),
+    }
+}

@@ -221,7 +221,7 @@ impl PlateImpact {
         self.clock.time >= self.end_time
     }
 
-    crate::solver::shared::clock_getters!();
+    crate::solver::shared::clock_getters!(clock);
 
     /// The end time (s), infinite if none was set.
     pub fn end_time(&self) -> f64 {
