@@ -12,8 +12,9 @@
 //! | Format | Written by | What changed |
 //! | --- | --- | --- |
 //! | 1 | up to 2026-11-29 (no `format` key) | — |
-//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; the 3-D runs save their state alone (node fields, the record of the last build, clock, energy, material state, tallies), not their setup |
+//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; the Taylor and 3-D runs save their state alone (node fields, the 3-D record of the last build, clock, energy, material state, tallies), not their setup |
 
+use crate::solver::shared::digest_json;
 use serde_json::{Map, Value};
 
 /// The format this build writes.
@@ -48,8 +49,9 @@ pub(crate) fn upgrade(saved: &mut Value) -> Result<(), String> {
 /// Format 1 to 2: each solver's clock (`time`, `steps`, `dt`, `dt0`) and
 /// energy book (the energy at the start, the internal energy and the
 /// losses, in the order of the solver's balance) gathered under `clock`
-/// and `energy`; the 3-D runs' setup dropped (a restored run is built from
-/// its scene; a penetration run saves its run's state alone); the plate
+/// and `energy`; the setup of the Taylor and 3-D runs dropped (a restored
+/// run is built from its scene; a penetration run saves its run's state
+/// alone) and its digest kept; the plate
 /// impact's cell energies renamed `specific_energy`; and every field that a
 /// state of format 1 may lack (it was read with a default) put in with that
 /// default.
@@ -72,6 +74,18 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
                     ("material_state", Value::Null),
                     ("quiet_since", Value::Null),
                 ],
+            );
+            // The setup follows from the scene: its digest stays.
+            let keys = [
+                "p", "material", "nr", "nz", "h", "r0", "mass", "mantle", "top", "face",
+            ];
+            let mut setup = Map::new();
+            for key in keys {
+                setup.insert(key.to_string(), take(state, key)?);
+            }
+            state.insert(
+                "setup_digest".into(),
+                Value::from(digest_json(&Value::Object(setup))),
             );
             clock(state)?;
             energy(
@@ -183,7 +197,9 @@ const MLPG_SETUP: &[&str] = &[
 ];
 
 /// The 3-D solver's state of format 1 in format 2: the setup dropped (it
-/// follows from the scene), the clock and the energy book gathered.
+/// follows from the scene) and its digest kept, taken as format 2 takes
+/// it (the rod's setup under `rod`, its scheme typed); the clock and the
+/// energy book gathered.
 fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
     let empty = || Value::Array(Vec::new());
     defaults(
@@ -197,11 +213,32 @@ fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
             ("built_multipliers", empty()),
             ("reaction", empty()),
             ("shift_dissipation", Value::from(0.0)),
+            ("others", empty()),
+            ("group", empty()),
+            ("anvil", Value::Bool(true)),
+            ("reach", Value::from(0.0)),
+            ("plane", empty()),
+            ("held", empty()),
         ],
     );
-    for key in MLPG_SETUP {
-        state.remove(*key);
+    if let Some(others) = state.get_mut("others").and_then(Value::as_array_mut) {
+        for body in others.iter_mut().filter_map(Value::as_object_mut) {
+            defaults(body, &[("clamped_rim", Value::Bool(false))]);
+        }
     }
+    let mut setup = Map::new();
+    for key in MLPG_SETUP {
+        let value = take(state, key)?;
+        setup.insert(if *key == "setup" { "rod" } else { key }.to_string(), value);
+    }
+    match setup.get_mut("rod").and_then(Value::as_object_mut) {
+        Some(rod) => typed_scheme(rod)?,
+        None => return Err("its setup is not an object".into()),
+    }
+    state.insert(
+        "setup_digest".into(),
+        Value::from(digest_json(&Value::Object(setup))),
+    );
     clock(state)?;
     energy(
         state,
@@ -213,6 +250,49 @@ fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
             "smoothing_dissipation",
         ],
     )
+}
+
+/// The rod's setup of format 1 as format 2 has it: the weak form, the
+/// conforming flag, the smoothing's order and coefficient, the shifting
+/// and the lattice under one typed `scheme`.
+fn typed_scheme(rod: &mut Map<String, Value>) -> Result<(), String> {
+    defaults(
+        rod,
+        &[
+            ("base", Value::from(0.0)),
+            ("quarter", Value::Bool(false)),
+            ("conservative_carry", Value::Bool(false)),
+            ("weak_form", Value::from("Sphere")),
+        ],
+    );
+    let weak_form = take(rod, "weak_form")?;
+    let conforming = rod.remove("conforming").unwrap_or(Value::Bool(false));
+    let forces = match (weak_form.as_str(), conforming.as_bool()) {
+        (Some("Sphere"), _) => "Sphere",
+        (Some("Nodal"), Some(true)) => "Conforming",
+        (Some("Nodal"), _) => "Nodal",
+        _ => return Err(format!("its weak form {weak_form} is not Sphere or Nodal")),
+    };
+    let order = match rod.remove("smoothing_order").and_then(|v| v.as_u64()) {
+        Some(2) => "Two",
+        // A state saved before the order was saved smooths to order 1.
+        _ => "One",
+    };
+    let lattice = match rod.remove("staggered").and_then(|v| v.as_bool()) {
+        Some(true) => "Staggered",
+        _ => "Aligned",
+    };
+    let mut scheme = Map::new();
+    scheme.insert("forces".into(), Value::from(forces));
+    scheme.insert("order".into(), Value::from(order));
+    scheme.insert("smoothing".into(), take(rod, "smoothing")?);
+    scheme.insert(
+        "shifting".into(),
+        rod.remove("shifting").unwrap_or(Value::from(0.0)),
+    );
+    scheme.insert("lattice".into(), Value::from(lattice));
+    rod.insert("scheme".into(), Value::Object(scheme));
+    Ok(())
 }
 
 #[cfg(test)]

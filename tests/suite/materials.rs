@@ -95,7 +95,7 @@ fn mie_gruneisen_compression_limit_is_a_named_error() {
     let mut state = serde_json::to_value(&s).unwrap();
     let k = 2 * 5 + 2;
     state["rho"][k] = (1.5 * p.density).into();
-    let mut s: TaylorSolver = serde_json::from_value(state).unwrap();
+    Model::load_state(&mut s, SavedSolver::Json(state)).unwrap();
     let err = s.step().unwrap_err();
     assert_eq!(err.name(), "CompressionLimit", "{err}");
     assert!(err.to_string().contains("Mie-Grüneisen"), "{err}");

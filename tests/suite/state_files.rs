@@ -128,3 +128,22 @@ fn record_states() {
         std::fs::write(dir.join(case.file), sim.serialize_state()).unwrap();
     }
 }
+
+/// A state of format 1 whose setup was edited (a mass, the rod's weak
+/// form) is refused: the digest of its setup, which the reader keeps when
+/// it drops the setup, is not the scene's.
+#[test]
+fn a_first_format_state_with_an_edited_setup_is_refused() {
+    let read = |file: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(folder("v1").join(file)).unwrap()).unwrap()
+    };
+    let mut taylor = read("taylor.json");
+    taylor["solver"]["Taylor"]["mass"][0] = serde_json::json!(1.0);
+    let mut taylor3d = read("taylor3d.json");
+    taylor3d["solver"]["Taylor3d"]["setup"]["weak_form"] = serde_json::json!("Sphere");
+    for (what, state) in [("a mass", taylor), ("the weak form", taylor3d)] {
+        let e = Simulation::deserialize_state(&serde_json::to_vec(&state).unwrap()).unwrap_err();
+        assert_eq!(e.name(), "InvalidState", "{what}: {e}");
+        assert!(e.to_string().contains("digest of its setup"), "{what}: {e}");
+    }
+}

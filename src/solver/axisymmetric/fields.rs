@@ -8,7 +8,7 @@ use crate::solver::shared::SolidNodes;
 
 impl TaylorSolver {
     fn kinetic_energy(&self) -> f64 {
-        kinetic(&self.vel, &self.mass)
+        kinetic(&self.state.vel, &self.setup.mass)
     }
 
     fn energy_error(&self) -> f64 {
@@ -18,13 +18,13 @@ impl TaylorSolver {
     /// The energy error with the kinetic energy given (the update pass sums
     /// it in chunks).
     pub(super) fn energy_error_with(&self, kinetic: f64) -> f64 {
-        self.energy.error(kinetic)
+        self.state.energy.error(kinetic)
     }
 
     /// The centre-of-mass axial velocity toward the anvil.
     pub fn centre_of_mass_speed(&self) -> f64 {
         let (mut mv, mut m) = (0.0, 0.0);
-        for (v, mi) in self.vel.iter().zip(&self.mass) {
+        for (v, mi) in self.state.vel.iter().zip(&self.setup.mass) {
             mv -= mi * v[1];
             m += mi;
         }
@@ -34,9 +34,9 @@ impl TaylorSolver {
     /// The rod's particle sets: the face row, the mantle column from the
     /// face up, and the tail on the axis.
     pub fn rod_sets(&self) -> RodSets {
-        let (nr, nz) = (self.nr, self.nz);
+        let (nr, nz) = (self.setup.nr, self.setup.nz);
         RodSets {
-            face: self.face.particles.clone(),
+            face: self.setup.face.particles.clone(),
             mantle: (0..nz).map(|k| k * nr + nr - 1).collect(),
             tail: (nz - 1) * nr,
         }
@@ -58,22 +58,29 @@ impl TaylorSolver {
     /// [`TaylorSolver::observables`].
     pub fn observable(&self, k: usize) -> Option<f64> {
         Some(match TAYLOR_OBSERVABLES.get(k)?.name {
-            "rod_length" => rod::rod_length(&self.pos),
-            "mushroom_radius" => rod::mushroom_radius(&self.face.particles, &self.pos),
+            "rod_length" => rod::rod_length(&self.state.pos),
+            "mushroom_radius" => rod::mushroom_radius(&self.setup.face.particles, &self.state.pos),
             "undeformed_length" => {
-                rod::undeformed_length(&self.mantle.particles, &self.pos, self.r0)
+                rod::undeformed_length(&self.setup.mantle.particles, &self.state.pos, self.setup.r0)
             }
-            "tail_velocity" => rod::tail_velocity((self.nz - 1) * self.nr, &self.vel),
-            "face_lift" => self.pos[0][1],
-            "max_plastic_strain" => self.eps_p.iter().copied().fold(0.0, f64::max),
-            "max_temperature" => self.temp.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            "tail_velocity" => {
+                rod::tail_velocity((self.setup.nz - 1) * self.setup.nr, &self.state.vel)
+            }
+            "face_lift" => self.state.pos[0][1],
+            "max_plastic_strain" => self.state.eps_p.iter().copied().fold(0.0, f64::max),
+            "max_temperature" => self
+                .state
+                .temp
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max),
             "kinetic_energy" => self.kinetic_energy(),
-            "internal_energy" => self.energy.internal,
-            "smoothing_dissipation" => self.energy.lost[LOST_SMOOTHING],
-            "contact_dissipation" => self.energy.lost[LOST_CONTACT],
+            "internal_energy" => self.state.energy.internal,
+            "smoothing_dissipation" => self.state.energy.lost[LOST_SMOOTHING],
+            "contact_dissipation" => self.state.energy.lost[LOST_CONTACT],
             "energy_error" => self.energy_error(),
             "at_rest" => {
-                if self.at_rest {
+                if self.state.at_rest {
                     1.0
                 } else {
                     0.0
@@ -87,18 +94,19 @@ impl TaylorSolver {
     /// interleaved per particle.
     pub fn field(&self, name: &str) -> Option<Vec<f64>> {
         SolidNodes {
-            pos: &self.pos,
-            vel: &self.vel,
-            rho: &self.rho,
-            pressure: &self.pressure,
-            eps_p: &self.eps_p,
-            temp: &self.temp,
-            contact: &self.contact,
+            pos: &self.state.pos,
+            vel: &self.state.vel,
+            rho: &self.state.rho,
+            pressure: &self.state.pressure,
+            eps_p: &self.state.eps_p,
+            temp: &self.state.temp,
+            contact: &self.state.contact,
         }
         .field(name, || {
-            self.dev
+            self.state
+                .dev
                 .iter()
-                .zip(&self.pressure)
+                .zip(&self.state.pressure)
                 .flat_map(|(d, p)| [d[0] - p, d[1] - p, d[2] - p, d[3]])
                 .collect()
         })

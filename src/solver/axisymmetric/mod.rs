@@ -91,23 +91,56 @@ pub const SURFACE_BAND: f64 = 1.0;
 /// [`SPACING_COLLAPSE_BOUND`](crate::solver::shared::SPACING_COLLAPSE_BOUND).
 pub const AXIS_LEAVE: f64 = 0.1;
 
-/// State of a Taylor impact run.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+/// A Taylor impact run: its setup, its state and its pipeline, apart.
+#[derive(Debug, Clone)]
 pub struct TaylorSolver {
+    /// What the run is built from, and never changes.
+    setup: SetupAxi,
+    /// What the run changes: all that is saved.
+    state: StateAxi,
+    /// The workspace of the step: rebuilt, never saved.
+    pipe: PipelineAxi,
+}
+
+/// What a Taylor run is built from, from its scene, and never changes: the
+/// parameters, the material, the lattice and its masses, the surfaces.
+/// Not saved: a restored run is built from its scene, and the state it
+/// loads carries the digest of the setup that made it (serialized for
+/// that digest only).
+#[derive(Debug, Clone, serde::Serialize)]
+struct SetupAxi {
+    /// The parameters (the scheme's knobs among them).
     p: TaylorParams,
+    /// The rod's material.
     material: Material,
-    /// Per-particle state of the material's models: its damage variables
-    /// are saved (none for a material without damage), its caches rebuilt
-    /// after a restore ([`MaterialState`]'s saved form).
-    material_state: MaterialState,
+    /// Particles across the radius and along the length.
     nr: usize,
     nz: usize,
+    /// The smoothing length (m).
     h: f64,
+    /// The rod's radius at impact (m).
     r0: f64,
-    // Particle fields (structure of arrays).
+    /// The particles' masses (kg).
+    mass: Vec<f64>,
+    /// The particles of the mantle, the top and the face.
+    mantle: Surface,
+    top: Surface,
+    face: Surface,
+}
+
+/// What a Taylor run changes, and all that it saves (format 2 of
+/// `src/state_format.rs`): the particle fields (structure of arrays), the
+/// clock, the energy book, the material state and the run's tallies.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StateAxi {
+    /// The digest of the setup of the run that made this state
+    /// (`setup_digest` of `src/solver/shared/restore.rs`): a state loads
+    /// only into a run of the same setup.
+    setup_digest: u64,
+    // Particle fields.
     pos: Vec<[f64; 2]>,
     vel: Vec<[f64; 2]>,
-    mass: Vec<f64>,
     rho: Vec<f64>,
     dev: Vec<Stress>,
     pressure: Vec<f64>,
@@ -120,9 +153,10 @@ pub struct TaylorSolver {
     /// the first of each lattice row at the start; shifting may move a
     /// crowded one off it.
     on_axis: Vec<bool>,
-    mantle: Surface,
-    top: Surface,
-    face: Surface,
+    /// Per-particle state of the material's models: its damage variables
+    /// (none for a material without damage); its caches are rebuilt after a
+    /// restore ([`MaterialState`]'s saved form).
+    material_state: MaterialState,
     // Bookkeeping.
     clock: Clock,
     /// The impact's kinetic energy, the internal energy, and the losses to
@@ -130,17 +164,27 @@ pub struct TaylorSolver {
     energy: EnergyBook<2>,
     at_rest: bool,
     /// The rest detector: the time since which the kinetic energy has
-    /// stayed at or below [`QUIET_FRACTION`](crate::solver::shared::QUIET_FRACTION) of
-    /// the impact energy (`None` while it is above).
+    /// stayed at or below [`QUIET_FRACTION`](crate::solver::shared::QUIET_FRACTION)
+    /// of the impact energy (`None` while it is above).
     quiet_since: QuietEnd,
     /// Smallest spacing seen between neighbours, relative to the initial one.
     min_spacing: f64,
-    #[serde(skip)]
+}
+
+/// The workspace of a Taylor step: its buffers and the compiled copy of the
+/// hot loops (a restored run uses the best its processor has). Rebuilt,
+/// never saved.
+#[derive(Debug, Clone, Default)]
+struct PipelineAxi {
     ws: Workspace,
-    /// The compiled copy of the hot loops this run uses (not saved: a
-    /// restored run uses the best its processor has).
-    #[serde(skip)]
     isa: Isa,
+}
+
+/// The run's state is all it saves.
+impl serde::Serialize for TaylorSolver {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        self.state.serialize(s)
+    }
 }
 
 /// Neighbour-list skin, in units of h: the candidate lists hold every pair
@@ -173,58 +217,63 @@ fn wave_and_flow_speed(modulus: f64, rho: f64, v: [f64; 2]) -> f64 {
 impl TaylorSolver {
     /// Number of particles.
     pub fn particles(&self) -> usize {
-        self.pos.len()
+        self.state.pos.len()
     }
 
     /// Particles across the radius and along the axis.
     pub fn lattice(&self) -> (usize, usize) {
-        (self.nr, self.nz)
+        (self.setup.nr, self.setup.nz)
     }
 
     /// Smoothing length.
     pub fn smoothing_length(&self) -> f64 {
-        self.h
+        self.setup.h
     }
 
-    crate::solver::shared::clock_getters!(clock; dt);
+    crate::solver::shared::clock_getters!(state.clock; dt);
 
     /// Whether the end condition holds: the rod is at rest, or `end_time` has
     /// been reached.
     pub fn finished(&self) -> bool {
-        self.at_rest || self.clock.time >= self.p.end_time
+        self.state.at_rest || self.state.clock.time >= self.setup.p.end_time
     }
 
     /// Smallest distance between neighbouring particles relative to the
     /// initial spacing, over the run so far.
     pub fn min_spacing_ratio(&self) -> f64 {
-        self.min_spacing
+        self.state.min_spacing
     }
 
     /// Runs the hot loops in the copy `isa` from now on (the same bits in
     /// every copy).
     pub fn set_isa(&mut self, isa: Isa) {
-        self.isa = isa;
+        self.pipe.isa = isa;
     }
 
     /// Longitudinal elastic wave speed sqrt((K + 4 mu / 3) / rho0).
     pub fn wave_speed(&self) -> f64 {
-        (self.material.longitudinal_modulus(self.p.density, 0.0) / self.p.density).sqrt()
+        (self
+            .setup
+            .material
+            .longitudinal_modulus(self.setup.p.density, 0.0)
+            / self.setup.p.density)
+            .sqrt()
     }
 
     fn stable_dt(&self) -> f64 {
-        let m = &self.material;
+        let m = &self.setup.material;
         let worst = (0..self.particles())
             .map(|i| {
-                let (rho, p) = (self.rho[i], self.pressure[i]);
-                wave_and_flow_speed(m.longitudinal_modulus(rho, p), rho, self.vel[i])
+                let (rho, p) = (self.state.rho[i], self.state.pressure[i]);
+                wave_and_flow_speed(m.longitudinal_modulus(rho, p), rho, self.state.vel[i])
             })
             .fold(0.0, f64::max);
-        COURANT * self.h / worst
+        COURANT * self.setup.h / worst
     }
 
     /// Initial particle spacing.
     fn spacing(&self) -> f64 {
-        self.r0 / (self.nr - 1) as f64
+        self.setup.r0 / (self.setup.nr - 1) as f64
     }
 }
 
@@ -238,10 +287,13 @@ impl crate::model::Model for TaylorSolver {
     }
     /// 64 records per elastic transit of the rod.
     fn record_interval(&self) -> f64 {
-        self.p.initial_length / self.wave_speed() / 64.0
+        self.setup.p.initial_length / self.wave_speed() / 64.0
     }
     fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
-        Some(crate::rod::profile(&self.rod_sets().mantle, &self.pos))
+        Some(crate::rod::profile(
+            &self.rod_sets().mantle,
+            &self.state.pos,
+        ))
     }
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.min_spacing_ratio())
@@ -253,8 +305,7 @@ impl crate::model::Model for TaylorSolver {
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        *self = crate::model::read_saved(saved)?;
-        Ok(())
+        Self::load_state(self, saved)
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {
         self.check_restored(crate::model::same_solver(fresh)?)

@@ -28,28 +28,31 @@ impl TaylorSolver {
     /// so above a part of the face that has left the anvil there is none:
     /// that part is a free surface.
     fn anvil_image(&self, i: usize, reach: f64) -> bool {
-        let [r, z] = self.pos[i];
-        if i < self.nr || self.contact[i] || z < self.anvil_gap() || z >= reach {
+        let [r, z] = self.state.pos[i];
+        if i < self.setup.nr || self.state.contact[i] || z < self.anvil_gap() || z >= reach {
             return false;
         }
-        let nearest = (0..self.nr)
+        let nearest = (0..self.setup.nr)
             .min_by(|&a, &b| {
-                let (da, db) = ((self.pos[a][0] - r).abs(), (self.pos[b][0] - r).abs());
+                let (da, db) = (
+                    (self.state.pos[a][0] - r).abs(),
+                    (self.state.pos[b][0] - r).abs(),
+                );
                 da.total_cmp(&db)
             })
             .expect("a face row");
-        self.contact[nearest]
+        self.state.contact[nearest]
     }
 
     /// Rebuilds the mirror images and the candidate neighbour lists, with a
     /// skin of [`SKIN`] h, from the current positions.
     pub(super) fn rebuild_neighbours(&self, ws: &mut Workspace) {
         let n = self.particles();
-        let nr = self.nr;
-        let reach = (SUPPORT + SKIN) * self.h;
+        let nr = self.setup.nr;
+        let reach = (SUPPORT + SKIN) * self.setup.h;
         ws.lists.images.clear();
         for i in 0..n {
-            let axis = !self.on_axis[i] && self.pos[i][0] < reach;
+            let axis = !self.state.on_axis[i] && self.state.pos[i][0] < reach;
             let anvil = self.anvil_image(i, reach);
             let source = i as u32;
             for (yes, mirror) in [
@@ -64,7 +67,7 @@ impl TaylorSolver {
         }
         let m = n + ws.lists.images.len();
         ws.fields.pos.resize(m, [0.0; 2]);
-        ws.fields.pos[..n].copy_from_slice(&self.pos);
+        ws.fields.pos[..n].copy_from_slice(&self.state.pos);
         fill_images(&mut ws.fields.pos, n, &ws.lists.images);
         ws.lists.stride = padded_rows(
             &ws.fields.pos,
@@ -77,9 +80,11 @@ impl TaylorSolver {
         );
         let stride = ws.lists.stride;
         ws.lists.built_at.clear();
-        ws.lists.built_at.extend_from_slice(&self.pos);
+        ws.lists.built_at.extend_from_slice(&self.state.pos);
         ws.lists.face_contact.clear();
-        ws.lists.face_contact.extend_from_slice(&self.contact[..nr]);
+        ws.lists
+            .face_contact
+            .extend_from_slice(&self.state.contact[..nr]);
         ws.lists.axis_count = self.axis_count();
         // Whole batches of W rows.
         let rows = n.next_multiple_of(W) * stride;
@@ -91,7 +96,7 @@ impl TaylorSolver {
         ws.fields.sbc.resize(m, [0.0; 4]);
         ws.fields.vel.resize(m, [0.0; 2]);
         ws.fields.vel_s.resize(m, [0.0; 2]);
-        if MsphScheme::of(&self.p).order == SmoothingOrder::BiLaplacian {
+        if MsphScheme::of(&self.setup.p).order == SmoothingOrder::BiLaplacian {
             ws.fields.lap.resize(m, [0.0; 2]);
             ws.fields.lap_rho.resize(m, [0.0]);
         }
@@ -114,7 +119,7 @@ impl TaylorSolver {
     /// images).
     pub(super) fn needs_rebuild(&self, ws: &Workspace) -> bool {
         if ws.lists.built_at.len() != self.particles()
-            || ws.lists.face_contact[..] != self.contact[..self.nr]
+            || ws.lists.face_contact[..] != self.state.contact[..self.setup.nr]
             || ws.lists.axis_count != self.axis_count()
         {
             return true;
@@ -122,20 +127,24 @@ impl TaylorSolver {
         let gap = self.anvil_gap();
         if ws.lists.images.iter().any(|im| {
             let i = im.source as usize;
-            im.mirror == Mirror::Anvil && (self.contact[i] || self.pos[i][1] < gap)
+            im.mirror == Mirror::Anvil && (self.state.contact[i] || self.state.pos[i][1] < gap)
         }) {
             return true;
         }
-        let limit = 0.5 * SKIN * self.h;
+        let limit = 0.5 * SKIN * self.setup.h;
         let limit2 = limit * limit;
-        self.pos.iter().zip(&ws.lists.built_at).any(|(x, x0)| {
-            let (a, b) = (x[0] - x0[0], x[1] - x0[1]);
-            a * a + b * b > limit2
-        })
+        self.state
+            .pos
+            .iter()
+            .zip(&ws.lists.built_at)
+            .any(|(x, x0)| {
+                let (a, b) = (x[0] - x0[0], x[1] - x0[1]);
+                a * a + b * b > limit2
+            })
     }
 
     /// Number of particles on the axis (particles only ever leave it).
     fn axis_count(&self) -> usize {
-        self.on_axis.iter().filter(|&&a| a).count()
+        self.state.on_axis.iter().filter(|&&a| a).count()
     }
 }

@@ -1,12 +1,10 @@
 //! The setup of a Taylor run: its parameters ([`TaylorParams`], which the
-//! solver keeps and saves with its state; their table, defaults and ranges
-//! are the `taylor` scene's), and the rod on its (R, Z) lattice at the
-//! instant of impact, of the material they describe.
+//! solver keeps in its setup, not in its saved state; their table, defaults
+//! and ranges are the `taylor` scene's), and the rod on its (R, Z) lattice
+//! at the instant of impact, of the material they describe.
 
-use super::TaylorSolver;
-use super::workspace::Workspace;
+use super::{PipelineAxi, SetupAxi, StateAxi, TaylorSolver};
 use crate::error::{Error, Result};
-use crate::isa::Isa;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Material, MaterialState};
 use crate::solver::axisymmetric::boundary::Surface;
@@ -117,38 +115,43 @@ impl TaylorSolver {
         let contact = (0..n).map(|i| i < nr).collect();
         let total_mass: f64 = mass.iter().sum();
         let mut s = TaylorSolver {
-            material,
-            material_state: MaterialState::default(),
-            nr,
-            nz,
-            h,
-            r0,
-            vel,
-            rho: vec![p.density; n],
-            dev: vec![[0.0; 4]; n],
-            pressure: vec![0.0; n],
-            eps_p: vec![0.0; n],
-            temp: vec![p.initial_temperature; n],
-            stress_bc: vec![[0.0; 4]; n],
-            contact,
-            on_axis: (0..n).map(|i| i.is_multiple_of(nr)).collect(),
-            mantle,
-            top,
-            face,
-            pos,
-            mass,
-            clock: Clock::default(),
-            energy: EnergyBook::new(0.5 * total_mass * p.impact_speed * p.impact_speed),
-            at_rest: false,
-            quiet_since: QuietEnd::default(),
-            min_spacing: 1.0,
-            ws: Workspace::default(),
-            isa: Isa::best(),
-            p,
+            state: StateAxi {
+                setup_digest: 0,
+                vel,
+                rho: vec![p.density; n],
+                dev: vec![[0.0; 4]; n],
+                pressure: vec![0.0; n],
+                eps_p: vec![0.0; n],
+                temp: vec![p.initial_temperature; n],
+                stress_bc: vec![[0.0; 4]; n],
+                contact,
+                on_axis: (0..n).map(|i| i.is_multiple_of(nr)).collect(),
+                material_state: MaterialState::default(),
+                pos,
+                clock: Clock::default(),
+                energy: EnergyBook::new(0.5 * total_mass * p.impact_speed * p.impact_speed),
+                at_rest: false,
+                quiet_since: QuietEnd::default(),
+                min_spacing: 1.0,
+            },
+            setup: SetupAxi {
+                material,
+                nr,
+                nz,
+                h,
+                r0,
+                mass,
+                mantle,
+                top,
+                face,
+                p,
+            },
+            pipe: PipelineAxi::default(),
         };
         check_derived("wave speed", s.wave_speed(), " m/s")?;
-        s.clock = Clock::start(s.stable_dt());
-        check_derived("time step", s.clock.dt, " s")?;
+        s.state.clock = Clock::start(s.stable_dt());
+        check_derived("time step", s.state.clock.dt, " s")?;
+        s.state.setup_digest = crate::solver::shared::setup_digest(&s.setup);
         Ok(s)
     }
 }

@@ -21,10 +21,11 @@ impl TaylorSolver {
     /// along R on the anvil, none on both.
     fn freedoms(&self, normals: &[(usize, [f64; 2])]) -> Vec<Freedom> {
         let mut free: Vec<Freedom> = self
+            .state
             .contact
             .iter()
             .enumerate()
-            .map(|(i, &touch)| match (self.on_axis[i], touch) {
+            .map(|(i, &touch)| match (self.state.on_axis[i], touch) {
                 (true, true) => Freedom::Fixed,
                 (true, false) => Freedom::Across([1.0, 0.0]),
                 (false, true) => Freedom::Across([0.0, 1.0]),
@@ -36,20 +37,27 @@ impl TaylorSolver {
         // only, so that the outline stays while crowded surface particles
         // spread along it. The face row and the corners stay. The normals
         // are those of [`Self::surface_normals`] (mantle, then top).
-        let m = self.mantle.particles.len();
-        for (s, normals) in [(&self.mantle, &normals[..m]), (&self.top, &normals[m..])] {
+        let m = self.setup.mantle.particles.len();
+        for (s, normals) in [
+            (&self.setup.mantle, &normals[..m]),
+            (&self.setup.top, &normals[m..]),
+        ] {
             let last = s.particles.len() - 1;
             for (k, &i) in s.particles.iter().enumerate() {
                 let n = normals[k].1;
-                free[i] =
-                    if k == 0 || k == last || self.contact[i] || self.on_axis[i] || n == [0.0; 2] {
-                        Freedom::Fixed
-                    } else {
-                        Freedom::Across(n)
-                    };
+                free[i] = if k == 0
+                    || k == last
+                    || self.state.contact[i]
+                    || self.state.on_axis[i]
+                    || n == [0.0; 2]
+                {
+                    Freedom::Fixed
+                } else {
+                    Freedom::Across(n)
+                };
             }
         }
-        for &i in &self.face.particles {
+        for &i in &self.setup.face.particles {
             free[i] = Freedom::Fixed;
         }
         free
@@ -59,14 +67,19 @@ impl TaylorSolver {
     /// outward normals, as the traction-free condition takes them.
     fn surface_normals(&self) -> Vec<(usize, [f64; 2])> {
         let mut out = Vec::with_capacity(
-            self.mantle.particles.len() + self.top.particles.len() + self.face.particles.len(),
+            self.setup.mantle.particles.len()
+                + self.setup.top.particles.len()
+                + self.setup.face.particles.len(),
         );
-        for (k, &i) in self.mantle.particles.iter().enumerate() {
-            out.push((i, self.mantle.normal(k, &self.pos)));
+        for (k, &i) in self.setup.mantle.particles.iter().enumerate() {
+            out.push((i, self.setup.mantle.normal(k, &self.state.pos)));
         }
-        for (s, on_axis) in [(&self.top, TOP_ON_AXIS), (&self.face, FACE_ON_AXIS)] {
+        for (s, on_axis) in [
+            (&self.setup.top, TOP_ON_AXIS),
+            (&self.setup.face, FACE_ON_AXIS),
+        ] {
             for (k, &i) in s.particles.iter().enumerate() {
-                out.push((i, normal_from_axis(s, k, &self.pos, on_axis)));
+                out.push((i, normal_from_axis(s, k, &self.state.pos, on_axis)));
             }
         }
         out
@@ -95,7 +108,7 @@ impl TaylorSolver {
                 return Ok(false);
             }
         }
-        ws.fields.pos[..n].copy_from_slice(&self.pos);
+        ws.fields.pos[..n].copy_from_slice(&self.state.pos);
         fill_images(&mut ws.fields.pos, n, &ws.lists.images);
         let c = Candidates {
             pos: &ws.fields.pos,
@@ -110,7 +123,7 @@ impl TaylorSolver {
             &outward,
             spacing,
             SHIFT_RANGE * spacing,
-            self.p.shifting,
+            self.setup.p.shifting,
             SHIFT_CAP * spacing,
         );
         self.leave_axis(&free, spacing, &mut d);
@@ -119,7 +132,7 @@ impl TaylorSolver {
         }
         let mut f: Vec<[f64; 9]> = (0..n)
             .map(|i| {
-                let (v, s) = (self.vel[i], self.dev[i]);
+                let (v, s) = (self.state.vel[i], self.state.dev[i]);
                 [
                     v[0],
                     v[1],
@@ -127,51 +140,50 @@ impl TaylorSolver {
                     s[1],
                     s[2],
                     s[3],
-                    self.rho[i],
-                    self.eps_p[i],
-                    self.temp[i],
+                    self.state.rho[i],
+                    self.state.eps_p[i],
+                    self.state.temp[i],
                 ]
             })
             .collect();
-        carry(c, n, self.h, &mut f, &d);
+        carry(c, n, self.setup.h, &mut f, &d);
         let mut ke = [0.0; 2];
         for (i, (fi, di)) in f.iter().zip(&d).enumerate() {
             if *di == [0.0; 2] {
                 continue;
             }
-            ke[0] += kinetic1(self.vel[i], self.mass[i]);
-            self.vel[i] = [fi[0], fi[1]];
-            ke[1] += kinetic1(self.vel[i], self.mass[i]);
+            ke[0] += kinetic1(self.state.vel[i], self.setup.mass[i]);
+            self.state.vel[i] = [fi[0], fi[1]];
+            ke[1] += kinetic1(self.state.vel[i], self.setup.mass[i]);
             // Each component was limited to its neighbours' range on its
             // own, which leaves a trace: the deviator (RR, ZZ, TT, RZ) is
             // made trace-free again (the mean normal stress stays −P).
             let m = (fi[2] + fi[3] + fi[4]) / 3.0;
-            self.dev[i] = [fi[2] - m, fi[3] - m, fi[4] - m, fi[5]];
-            self.rho[i] = fi[6];
-            self.eps_p[i] = fi[7].max(0.0);
-            self.temp[i] = fi[8];
-            let p = self
-                .material
-                .pressure(fi[6], fi[8])
-                .map_err(|l| Error::CompressionLimit {
+            self.state.dev[i] = [fi[2] - m, fi[3] - m, fi[4] - m, fi[5]];
+            self.state.rho[i] = fi[6];
+            self.state.eps_p[i] = fi[7].max(0.0);
+            self.state.temp[i] = fi[8];
+            let p = self.setup.material.pressure(fi[6], fi[8]).map_err(|l| {
+                Error::CompressionLimit {
                     particle: i,
-                    time: self.clock.time,
+                    time: self.state.clock.time,
                     compression: l.compression,
                     limit: l.limit,
-                })?;
-            self.pressure[i] = p;
-            let s = self.dev[i];
-            self.stress_bc[i] = [s[0] - p, s[1] - p, s[2] - p, s[3]];
-            if self.contact[i] {
-                self.stress_bc[i][3] = 0.0;
+                }
+            })?;
+            self.state.pressure[i] = p;
+            let s = self.state.dev[i];
+            self.state.stress_bc[i] = [s[0] - p, s[1] - p, s[2] - p, s[3]];
+            if self.state.contact[i] {
+                self.state.stress_bc[i][3] = 0.0;
             }
-            self.pos[i] = [self.pos[i][0] + di[0], self.pos[i][1] + di[1]];
+            self.state.pos[i] = [self.state.pos[i][0] + di[0], self.state.pos[i][1] + di[1]];
         }
-        self.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
+        self.state.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
         // A surface particle that slid carries the stress of its new place:
         // the traction-free condition again, on the new normals.
         let slid = |s: &Surface| s.particles.iter().any(|&i| d[i] != [0.0; 2]);
-        if slid(&self.mantle) || slid(&self.top) {
+        if slid(&self.setup.mantle) || slid(&self.setup.top) {
             self.apply_surface_stress_bc();
         }
         Ok(true)
@@ -182,10 +194,10 @@ impl TaylorSolver {
     /// is a ring with its own mirror image.
     fn leave_axis(&mut self, free: &[Freedom], spacing: f64, d: &mut [[f64; 2]]) {
         let column: Vec<usize> = (0..self.particles())
-            .step_by(self.nr)
-            .filter(|&i| self.on_axis[i])
+            .step_by(self.setup.nr)
+            .filter(|&i| self.state.on_axis[i])
             .collect();
-        let z: Vec<f64> = column.iter().map(|&i| self.pos[i][1]).collect();
+        let z: Vec<f64> = column.iter().map(|&i| self.state.pos[i][1]).collect();
         let may: Vec<bool> = column
             .iter()
             .map(|&i| free[i] == Freedom::Across([1.0, 0.0]))
@@ -193,7 +205,7 @@ impl TaylorSolver {
         for (&i, leaves) in column.iter().zip(leaving(&z, &may, AXIS_CROWD * spacing)) {
             if leaves {
                 d[i] = [AXIS_LEAVE * spacing, d[i][1]];
-                self.on_axis[i] = false;
+                self.state.on_axis[i] = false;
             }
         }
     }

@@ -23,7 +23,7 @@ use crate::solver::shared::{ENERGY_ERROR_BOUND, above, check_spacing};
 impl TaylorSolver {
     /// Advances one step.
     pub fn step(&mut self) -> Result<()> {
-        let mut ws = std::mem::take(&mut self.ws);
+        let mut ws = std::mem::take(&mut self.pipe.ws);
         // The whole step runs on one worker of the thread pool, which leads
         // a team of the others through its parallel passes
         // (src/solver/axisymmetric/team.rs). The neighbour rebuild comes first, with its
@@ -38,21 +38,24 @@ impl TaylorSolver {
             }
             // New lists may bring new mirror images, and pairs with them.
             let margin = if rebuilt { None } else { ws.shift_margin };
-            if self.p.shifting > 0.0 && self.shift(&mut ws, margin)? && self.needs_rebuild(&ws) {
+            if self.setup.p.shifting > 0.0
+                && self.shift(&mut ws, margin)?
+                && self.needs_rebuild(&ws)
+            {
                 self.rebuild_neighbours(&mut ws);
             }
             Team::lead(|team| self.step_in(&mut ws, team))
         });
-        self.ws = ws;
+        self.pipe.ws = ws;
         result
     }
 
     fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
         let n = self.particles();
-        let dt = self.clock.dt;
-        let scheme = MsphScheme::of(&self.p);
+        let dt = self.state.clock.dt;
+        let scheme = MsphScheme::of(&self.setup.p);
         ws.rate.resize(n, [0.0; 4]);
-        self.material_state.fit(n);
+        self.state.material_state.fit(n);
         ws.scratch.fit();
         let stride = ws.lists.stride.max(1);
         let images = &ws.lists.images;
@@ -61,13 +64,13 @@ impl TaylorSolver {
         // them, so that those particles see a symmetric neighbourhood (the
         // anvil is rigid and smooth): the velocity component and the shear
         // stress odd across the plane, the rest even.
-        f.pos[..n].copy_from_slice(&self.pos);
+        f.pos[..n].copy_from_slice(&self.state.pos);
         fill_images(&mut f.pos, n, images);
-        for ((v, m), r) in f.vol.iter_mut().zip(&self.mass).zip(&self.rho) {
+        for ((v, m), r) in f.vol.iter_mut().zip(&self.setup.mass).zip(&self.state.rho) {
             *v = m / r;
         }
         fill_images(&mut f.vol, n, images);
-        f.sbc[..n].copy_from_slice(&self.stress_bc);
+        f.sbc[..n].copy_from_slice(&self.state.stress_bc);
         fill_images(&mut f.sbc, n, images);
 
         // 1-2. The pair pass and the momentum equation.
@@ -78,10 +81,10 @@ impl TaylorSolver {
             nbr: &ws.lists.nbr,
             nbr_len: &ws.lists.nbr_len,
             stride,
-            vel: &self.vel,
-            rho: &self.rho,
-            on_axis: &self.on_axis,
-            h: self.h,
+            vel: &self.state.vel,
+            rho: &self.state.rho,
+            on_axis: &self.state.on_axis,
+            h: self.setup.h,
             dt,
         };
         let r = &mut ws.rows;
@@ -97,29 +100,29 @@ impl TaylorSolver {
         };
         pair_pass(
             team,
-            self.isa,
+            self.pipe.isa,
             &inputs,
             out,
             &ws.scratch,
-            &self.mass,
-            &self.contact,
+            &self.setup.mass,
+            &self.state.contact,
         );
         let a = BatchTally::total(&ws.sums.batches);
         if let Some((particle, condition)) = a.singular {
             return Err(Error::SingularMomentMatrix {
                 method: crate::error::MomentMethod::Msph,
                 particle,
-                time: self.clock.time,
+                time: self.state.clock.time,
                 condition,
             });
         }
         let d0 = self.spacing();
         let ratio = a.min_d2.sqrt() / d0;
-        self.min_spacing = self.min_spacing.min(ratio);
+        self.state.min_spacing = self.state.min_spacing.min(ratio);
         check_spacing(
             ratio,
-            self.clock.time,
-            if self.p.shifting == 0.0 {
+            self.state.clock.time,
+            if self.setup.p.shifting == 0.0 {
                 "; at large strain, use scheme = large_strain, the default (it sets \
                  smoothing_order = 2, smoothing_ratio = 2 and shifting = 0.1; README, \
                  \"Particle shifting\")"
@@ -127,11 +130,11 @@ impl TaylorSolver {
                 ""
             },
         )?;
-        self.energy.lost[LOST_CONTACT] += a.held;
+        self.state.energy.lost[LOST_CONTACT] += a.held;
 
         let p = Pass {
             team,
-            isa: self.isa,
+            isa: self.pipe.isa,
             rows: Rows {
                 act: &r.act,
                 wr: &r.wr,
@@ -144,8 +147,8 @@ impl TaylorSolver {
             images,
             alpha: scheme.smoothing,
             order2: scheme.order == SmoothingOrder::BiLaplacian,
-            mass: &self.mass,
-            on_axis: &self.on_axis,
+            mass: &self.setup.mass,
+            on_axis: &self.state.on_axis,
             pos: &f.pos,
             dt,
         };
@@ -158,13 +161,13 @@ impl TaylorSolver {
         }
         let ke = smooth_velocity(
             p,
-            &self.contact,
+            &self.state.contact,
             &f.vel,
             &f.lap,
             &mut f.vel_s[..n],
             &mut ws.sums.smoothing,
         );
-        self.energy.lost[LOST_SMOOTHING] += ke.before - ke.after;
+        self.state.energy.lost[LOST_SMOOTHING] += ke.before - ke.after;
 
         // 4. Velocity gradients and continuity.
         fill_images(&mut f.vel_s, n, images);
@@ -172,7 +175,7 @@ impl TaylorSolver {
             grads: Chunks::new(&mut ws.grads, MIN_LEN),
             rho_out: Chunks::new(&mut f.rho[..n], MIN_LEN),
         };
-        continuity(p, &f.vel_s, &self.rho, out);
+        continuity(p, &f.vel_s, &self.state.rho, out);
         fill_images(&mut f.rho, n, images);
         // With order 2 the density is smoothed by the same bi-Laplacian as
         // the velocity: first L ρ, then the Shepard mean of L ρ in the loop.
@@ -186,20 +189,20 @@ impl TaylorSolver {
             grads: &ws.grads,
             rho_raw: &f.rho,
             lap_rho: &f.lap_rho,
-            material: self.material,
-            h: self.h,
+            material: self.setup.material,
+            h: self.setup.h,
         };
         let out = UpdateChunks {
-            dev: Chunks::new(&mut self.dev, MIN_LEN),
-            pressure: Chunks::new(&mut self.pressure, MIN_LEN),
-            eps_p: Chunks::new(&mut self.eps_p, MIN_LEN),
-            temp: Chunks::new(&mut self.temp, MIN_LEN),
-            rho: Chunks::new(&mut self.rho, MIN_LEN),
-            models: Chunks::new(self.material_state.points_mut(), MIN_LEN),
-            pos: Chunks::new(&mut self.pos, MIN_LEN),
-            vel: Chunks::new(&mut self.vel, MIN_LEN),
-            contact: Chunks::new(&mut self.contact, MIN_LEN),
-            stress_bc: Chunks::new(&mut self.stress_bc, MIN_LEN),
+            dev: Chunks::new(&mut self.state.dev, MIN_LEN),
+            pressure: Chunks::new(&mut self.state.pressure, MIN_LEN),
+            eps_p: Chunks::new(&mut self.state.eps_p, MIN_LEN),
+            temp: Chunks::new(&mut self.state.temp, MIN_LEN),
+            rho: Chunks::new(&mut self.state.rho, MIN_LEN),
+            models: Chunks::new(self.state.material_state.points_mut(), MIN_LEN),
+            pos: Chunks::new(&mut self.state.pos, MIN_LEN),
+            vel: Chunks::new(&mut self.state.vel, MIN_LEN),
+            contact: Chunks::new(&mut self.state.contact, MIN_LEN),
+            stress_bc: Chunks::new(&mut self.state.stress_bc, MIN_LEN),
             tally: Chunks::new(&mut ws.sums.tallies, 1),
             work: Chunks::new(&mut ws.rate[..], MIN_LEN),
         };
@@ -212,23 +215,23 @@ impl TaylorSolver {
     /// the clock, the stops, the stress boundary conditions (and the work
     /// they take), the next time step and the rest test.
     fn end_step(&mut self, ws: &mut Workspace, t: &Tally, dt: f64) -> Result<()> {
-        self.energy.internal += t.internal;
-        self.energy.lost[LOST_CONTACT] += t.contact_lost;
+        self.state.energy.internal += t.internal;
+        self.state.energy.lost[LOST_CONTACT] += t.contact_lost;
         ws.shift_margin = Some(2.0 * dt * t.fastest2.sqrt());
-        self.clock.time += dt;
-        self.clock.steps += 1;
+        self.state.clock.time += dt;
+        self.state.clock.steps += 1;
         if let Some(b) = t.through {
             return Err(Error::ThroughBoundary {
                 particle: b.particle,
                 boundary: b.boundary,
-                time: self.clock.time,
+                time: self.state.clock.time,
                 position: b.position,
             });
         }
         if let Some(c) = t.compression {
             return Err(Error::CompressionLimit {
                 particle: c.particle,
-                time: self.clock.time,
+                time: self.state.clock.time,
                 compression: c.compression,
                 limit: c.limit,
             });
@@ -237,50 +240,50 @@ impl TaylorSolver {
             return Err(Error::NonFinite {
                 field,
                 particle,
-                time: self.clock.time,
+                time: self.state.clock.time,
             });
         }
         // The boundary conditions on the new stress, and the work they take
         // from the new half of the step's stress power.
         ws.raw_bc.clear();
-        ws.raw_bc.extend_from_slice(&self.stress_bc);
+        ws.raw_bc.extend_from_slice(&self.state.stress_bc);
         self.apply_surface_stress_bc();
         let mut booked = 0.0;
-        for ((bc, raw), w) in self.stress_bc.iter().zip(&ws.raw_bc).zip(&ws.rate) {
+        for ((bc, raw), w) in self.state.stress_bc.iter().zip(&ws.raw_bc).zip(&ws.rate) {
             for c in 0..4 {
                 booked += (bc[c] - raw[c]) * w[c];
             }
         }
-        self.energy.internal += booked;
+        self.state.energy.internal += booked;
 
         let e = self.energy_error_with(t.kinetic);
         if above(e, ENERGY_ERROR_BOUND) {
             return Err(Error::EnergyDrift {
                 error: e,
                 bound: ENERGY_ERROR_BOUND,
-                time: self.clock.time,
+                time: self.state.clock.time,
             });
         }
-        self.clock.dt = COURANT * self.h / t.worst_speed;
-        self.clock.check_step(self.clock.dt)?;
+        self.state.clock.dt = COURANT * self.setup.h / t.worst_speed;
+        self.state.clock.check_step(self.state.clock.dt)?;
         // The rod is at rest once its momentum toward the anvil is spent: the
         // centre of mass no longer moves toward the anvil.
         if -t.momentum / t.mass <= 0.0 && !t.touching {
-            self.at_rest = true;
+            self.state.at_rest = true;
         }
         // Or once it is quiet: a flange pressed flat on the anvil never
         // leaves it, and the rod rings elastically on it for ever. Its impact
         // energy is spent once the kinetic energy has stayed below
         // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
-        let (length, speed) = (self.p.initial_length, self.wave_speed());
-        if self.quiet_since.at_rest(
-            self.clock.time,
+        let (length, speed) = (self.setup.p.initial_length, self.wave_speed());
+        if self.state.quiet_since.at_rest(
+            self.state.clock.time,
             t.kinetic,
-            self.energy.initial,
+            self.state.energy.initial,
             length,
             speed,
         ) {
-            self.at_rest = true;
+            self.state.at_rest = true;
         }
         Ok(())
     }

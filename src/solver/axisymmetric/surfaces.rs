@@ -28,33 +28,33 @@ impl TaylorSolver {
     /// stress `dev - p I` (which the update pass writes for every particle).
     pub(super) fn apply_surface_stress_bc(&mut self) {
         let n = self.particles();
-        let (nr, nz) = (self.nr, self.nz);
-        for (k, &i) in self.mantle.particles.iter().enumerate() {
-            let s = &self.stress_bc[i];
-            self.stress_bc[i] = if k == nz - 1 || (k == 0 && !self.contact[i]) {
+        let (nr, nz) = (self.setup.nr, self.setup.nz);
+        for (k, &i) in self.setup.mantle.particles.iter().enumerate() {
+            let s = &self.state.stress_bc[i];
+            self.state.stress_bc[i] = if k == nz - 1 || (k == 0 && !self.state.contact[i]) {
                 corner_free(s)
             } else {
-                traction_free(s, self.mantle.normal(k, &self.pos))
+                traction_free(s, self.setup.mantle.normal(k, &self.state.pos))
             };
         }
-        for (k, &i) in self.top.particles.iter().enumerate().take(nr - 1) {
-            let n = normal_from_axis(&self.top, k, &self.pos, TOP_ON_AXIS);
-            self.stress_bc[i] = traction_free(&self.stress_bc[i], n);
+        for (k, &i) in self.setup.top.particles.iter().enumerate().take(nr - 1) {
+            let n = normal_from_axis(&self.setup.top, k, &self.state.pos, TOP_ON_AXIS);
+            self.state.stress_bc[i] = traction_free(&self.state.stress_bc[i], n);
         }
-        for (k, &i) in self.face.particles.iter().enumerate().take(nr - 1) {
-            if self.contact[i] {
+        for (k, &i) in self.setup.face.particles.iter().enumerate().take(nr - 1) {
+            if self.state.contact[i] {
                 // Smooth anvil: no shear traction.
-                self.stress_bc[i][3] = 0.0;
+                self.state.stress_bc[i][3] = 0.0;
             } else {
-                let n = normal_from_axis(&self.face, k, &self.pos, FACE_ON_AXIS);
-                self.stress_bc[i] = traction_free(&self.stress_bc[i], n);
+                let n = normal_from_axis(&self.setup.face, k, &self.state.pos, FACE_ON_AXIS);
+                self.state.stress_bc[i] = traction_free(&self.state.stress_bc[i], n);
             }
         }
         // Particles that started elsewhere but touch the anvil (a folded
         // mantle) carry no shear there either.
         for i in 0..n {
-            if self.contact[i] && i >= self.nr {
-                self.stress_bc[i][3] = 0.0;
+            if self.state.contact[i] && i >= self.setup.nr {
+                self.state.stress_bc[i][3] = 0.0;
             }
         }
     }

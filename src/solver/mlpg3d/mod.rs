@@ -149,8 +149,10 @@ pub struct Mlpg3d {
 /// What a 3-D run is built from, from its scene, and never changes: the
 /// rod's setup with its typed scheme, the bodies and their materials, the
 /// lattice, the nodal masses and the quantities that follow from them.
-/// Not saved: a restored run is built from its scene.
-#[derive(Debug, Clone)]
+/// Not saved: a restored run is built from its scene, and the state it
+/// loads carries the digest of the setup that made it (serialized for
+/// that digest only).
+#[derive(Debug, Clone, serde::Serialize)]
 struct Setup3d {
     /// The rod and the solver's choices.
     rod: RodSetup,
@@ -191,6 +193,10 @@ struct Setup3d {
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct State3d {
+    /// The digest of the setup of the run that made this state
+    /// (`setup_digest` of `src/solver/shared/restore.rs`): a state loads
+    /// only into a run of the same setup.
+    setup_digest: u64,
     // Node fields.
     pos: Vec<[f64; 3]>,
     vel: Vec<[f64; 3]>,
@@ -399,6 +405,7 @@ impl Mlpg3d {
                 damping_time: 0.0,
             },
             state: State3d {
+                setup_digest: 0,
                 vel,
                 built_rho: rho.clone(),
                 built_multipliers: Vec::new(),
@@ -440,6 +447,7 @@ impl Mlpg3d {
         let fastest = s.state.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max);
         s.state.clock = Clock::start(s.stable_dt(cp + fastest, s.setup.d_min0));
         check_derived("time step", s.state.clock.dt, " s")?;
+        s.state.setup_digest = crate::solver::shared::setup_digest(&s.setup);
         Ok(s)
     }
 

@@ -43,8 +43,12 @@ impl Mlpg3d {
     /// must have one finite value per node of the setup.
     pub(crate) fn check_restored(&self, fresh: &Mlpg3d) -> std::result::Result<(), String> {
         use crate::solver::shared::json;
-        // The setup is the scene's (a restored run is built from it); what
-        // the state holds that follows from the parameters must be its bits.
+        // The setup is the scene's (a restored run is built from it), and
+        // the state must be one that a run of this setup made.
+        if self.state.setup_digest != fresh.state.setup_digest {
+            return Err(crate::solver::shared::NOT_ITS_SETUP.into());
+        }
+        // What the state holds that follows from the parameters: its bits.
         let fixed = |s: &Mlpg3d| json(&(s.state.clock.dt0, s.state.energy.initial));
         if fixed(self) != fixed(fresh) {
             return Err("its lattice, masses or material do not follow from its parameters".into());

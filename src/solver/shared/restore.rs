@@ -114,3 +114,26 @@ pub(crate) fn refuse_setup(saved: &serde_json::Value, keys: &[(&str, &str)]) -> 
         None => Ok(()),
     }
 }
+
+/// Why a state made by a run of another setup is refused.
+pub(crate) const NOT_ITS_SETUP: &str = "it was saved by a run of other parameters or another \
+     material than its scene's (the digest of its setup differs)";
+
+/// The digest of a solver's setup: FNV-1a over the text of its JSON tree
+/// (keys sorted, each number in its shortest exact form), which a saved
+/// state carries so that it is loaded only into a run of the same setup.
+/// `src/state_format.rs` takes the digest of a format-1 state's setup the
+/// same way ([`digest_json`]).
+pub(crate) fn setup_digest<T: serde::Serialize>(setup: &T) -> u64 {
+    digest_json(&serde_json::to_value(setup).expect("a setup holds finite numbers"))
+}
+
+/// FNV-1a (64 bits) over the text of `value`.
+pub(crate) fn digest_json(value: &serde_json::Value) -> u64 {
+    value
+        .to_string()
+        .bytes()
+        .fold(0xcbf2_9ce4_8422_2325, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+}
