@@ -12,7 +12,7 @@
 //! | Format | Written by | What changed |
 //! | --- | --- | --- |
 //! | 1 | up to 2026-11-29 (no `format` key) | — |
-//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; the Taylor and 3-D runs save their state alone (node fields, the 3-D record of the last build, clock, energy, material state, tallies), not their setup |
+//! | 2 | from 2026-11-29 | the clock and the energy book of every solver in one place each; every solver saves its state alone (node fields, the 3-D record of the last build, clock, energy, material state, tallies) with the digest of its setup, not the setup |
 
 use crate::solver::shared::digest_json;
 use serde_json::{Map, Value};
@@ -51,8 +51,9 @@ pub(crate) fn upgrade(saved: &mut Value) -> Result<(), String> {
 /// losses, in the order of the solver's balance) gathered under `clock`
 /// and `energy`; the setup of the Taylor and 3-D runs dropped (a restored
 /// run is built from its scene; a penetration run saves its run's state
-/// alone) and its digest kept; the plate
-/// impact's cell energies renamed `specific_energy`; and every field that a
+/// alone) and its digest kept, and so the plate impact's and the Noh
+/// run's; the plate impact's cell energies renamed `specific_energy` and
+/// its cell states `cells`; and every field that a
 /// state of format 1 may lack (it was read with a default) put in with that
 /// default.
 fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
@@ -96,13 +97,42 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
             )
         }
         "Noh" => {
+            // The setup follows from the scene: its digest stays.
+            let mut setup = Map::new();
+            for key in ["p", "gas", "h", "mass"] {
+                setup.insert(key.to_string(), take(state, key)?);
+            }
+            state.insert(
+                "setup_digest".into(),
+                Value::from(digest_json(&Value::Object(setup))),
+            );
             clock(state)?;
             energy(state, "initial_energy", None, &[])
         }
         "Plate_impact" => {
-            // The cells' specific energies make room for the book.
-            let cells = take(state, "energy")?;
-            state.insert("specific_energy".into(), cells);
+            // The cells' specific energies make room for the book, their
+            // states for the state; the setup follows from the scene, its
+            // digest stays.
+            let energies = take(state, "energy")?;
+            state.insert("specific_energy".into(), energies);
+            let cells = take(state, "state")?;
+            state.insert("cells".into(), cells);
+            let mut setup = Map::new();
+            for key in [
+                "layers",
+                "flyer_cells",
+                "impact_speed",
+                "mass",
+                "length0",
+                "density0",
+                "end_time",
+            ] {
+                setup.insert(key.to_string(), take(state, key)?);
+            }
+            state.insert(
+                "setup_digest".into(),
+                Value::from(digest_json(&Value::Object(setup))),
+            );
             clock(state)?;
             energy(state, "initial_kinetic", None, &["contact_loss"])
         }

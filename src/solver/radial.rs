@@ -94,15 +94,34 @@ pub const MAX_VOLUME_STRAIN: f64 = 0.02;
 /// Exact post-shock density of the cylindrical Noh problem with gamma = 5/3.
 pub const POST_SHOCK_DENSITY: f64 = 16.0;
 
-/// State of a Noh run.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+/// A Noh run: its setup and its state, apart (it has no workspace).
+#[derive(Debug, Clone)]
 pub struct NohSolver {
+    /// What the run is built from, and never changes.
+    setup: SetupNoh,
+    /// What the run changes: all that is saved.
+    state: StateNoh,
+}
+
+/// What a Noh run is built from, from its scene, and never changes: the
+/// parameters, the gas, the smoothing length and the masses. Not saved.
+#[derive(Debug, Clone, serde::Serialize)]
+struct SetupNoh {
     p: NohParams,
     gas: IdealGas,
     h: f64,
+    mass: Vec<f64>,
+}
+
+/// What a Noh run changes, and all that it saves (format 2 of
+/// `src/state_format.rs`).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StateNoh {
+    /// The digest of the setup of the run that made this state.
+    setup_digest: u64,
     r: Vec<f64>,
     v: Vec<f64>,
-    mass: Vec<f64>,
     rho: Vec<f64>,
     e: Vec<f64>,
     pres: Vec<f64>,
@@ -116,6 +135,13 @@ pub struct NohSolver {
     /// The impact's kinetic energy; the internal energy is summed from the
     /// particles when asked.
     energy: EnergyBook<0>,
+}
+
+/// The run's state is all it saves.
+impl serde::Serialize for NohSolver {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        self.state.serialize(s)
+    }
 }
 
 impl NohSolver {
@@ -135,29 +161,35 @@ impl NohSolver {
         let v: Vec<f64> = (0..n).map(|k| if k == 0 { 0.0 } else { -1.0 }).collect();
         let initial_energy = mass.iter().zip(&v).map(|(m, v)| 0.5 * m * v * v).sum();
         let mut s = NohSolver {
-            gas: IdealGas { gamma: p.gamma },
-            h: p.smoothing_ratio * d,
-            rho: vec![1.0; n],
-            e: vec![0.0; n],
-            pres: vec![0.0; n],
-            q: vec![0.0; n],
-            signal: vec![0.0; n],
-            div: vec![0.0; n],
-            r,
-            v,
-            mass,
-            clock: Clock::default(),
-            energy: EnergyBook::new(initial_energy),
-            p,
+            setup: SetupNoh {
+                gas: IdealGas { gamma: p.gamma },
+                h: p.smoothing_ratio * d,
+                mass,
+                p,
+            },
+            state: StateNoh {
+                setup_digest: 0,
+                rho: vec![1.0; n],
+                e: vec![0.0; n],
+                pres: vec![0.0; n],
+                q: vec![0.0; n],
+                signal: vec![0.0; n],
+                div: vec![0.0; n],
+                r,
+                v,
+                clock: Clock::default(),
+                energy: EnergyBook::new(initial_energy),
+            },
         };
-        s.clock = Clock::start(s.stable_dt());
-        check_derived("time step", s.clock.dt, "")?;
+        s.state.clock = Clock::start(s.stable_dt());
+        check_derived("time step", s.state.clock.dt, "")?;
+        s.state.setup_digest = crate::solver::shared::setup_digest(&s.setup);
         Ok(s)
     }
 
     /// Number of particles.
     pub fn particles(&self) -> usize {
-        self.r.len()
+        self.state.r.len()
     }
 
     /// Checks a restored state against `fresh`, a new run of the same
@@ -166,33 +198,26 @@ impl NohSolver {
     /// one finite value per particle.
     pub(crate) fn check_restored(&self, fresh: &NohSolver) -> std::result::Result<(), String> {
         use crate::solver::shared::json;
-        if json(&(
-            &self.p,
-            &self.gas,
-            self.h,
-            &self.mass,
-            self.clock.dt0,
-            self.energy.initial,
-        )) != json(&(
-            &fresh.p,
-            &fresh.gas,
-            fresh.h,
-            &fresh.mass,
-            fresh.clock.dt0,
-            fresh.energy.initial,
-        )) {
-            return Err("its lattice, masses or gas do not follow from its parameters".into());
+        // The setup is the scene's (a restored run is built from it), and
+        // the state one that a run of it made.
+        if self.state.setup_digest != fresh.state.setup_digest {
+            return Err(crate::solver::shared::NOT_ITS_SETUP.into());
+        }
+        if json(&(self.state.clock.dt0, self.state.energy.initial))
+            != json(&(fresh.state.clock.dt0, fresh.state.energy.initial))
+        {
+            return Err("its first step or impact energy do not follow from its parameters".into());
         }
         let n = fresh.particles();
         let fields = [
-            ("radii", &self.r),
-            ("velocities", &self.v),
-            ("densities", &self.rho),
-            ("specific energies", &self.e),
-            ("pressures", &self.pres),
-            ("viscous pressures", &self.q),
-            ("signal speeds", &self.signal),
-            ("divergences", &self.div),
+            ("radii", &self.state.r),
+            ("velocities", &self.state.v),
+            ("densities", &self.state.rho),
+            ("specific energies", &self.state.e),
+            ("pressures", &self.state.pres),
+            ("viscous pressures", &self.state.q),
+            ("signal speeds", &self.state.signal),
+            ("divergences", &self.state.div),
         ];
         for (what, f) in fields {
             if f.len() != n {
@@ -202,52 +227,56 @@ impl NohSolver {
                 return Err(format!("its {what} are not all finite"));
             }
         }
-        if !self.rho.iter().all(|&x| x > 0.0) {
+        if !self.state.rho.iter().all(|&x| x > 0.0) {
             return Err("its densities are not all positive".into());
         }
         // Each step ends by taking the next one from the fields, so a
         // restored step is at most the stable one of its fields.
-        let stable = self.clock.dt > 0.0 && self.clock.dt <= self.stable_dt() * (1.0 + 1e-9);
-        if !(self.clock.time.is_finite() && self.clock.time >= 0.0 && stable) {
+        let stable =
+            self.state.clock.dt > 0.0 && self.state.clock.dt <= self.stable_dt() * (1.0 + 1e-9);
+        if !(self.state.clock.time.is_finite() && self.state.clock.time >= 0.0 && stable) {
             return Err(format!(
                 "its clock (t = {}, dt = {}) is not valid",
-                self.clock.time, self.clock.dt
+                self.state.clock.time, self.state.clock.dt
             ));
         }
-        if (self.clock.steps == 0) != (self.clock.time == 0.0) {
+        if (self.state.clock.steps == 0) != (self.state.clock.time == 0.0) {
             return Err(format!(
                 "its step count {} does not match its time {}",
-                self.clock.steps, self.clock.time
+                self.state.clock.steps, self.state.clock.time
             ));
         }
         Ok(())
     }
 
-    crate::solver::shared::clock_getters!(clock);
+    crate::solver::shared::clock_getters!(state.clock);
 
     /// Whether `end_time` has been reached.
     pub fn finished(&self) -> bool {
-        self.clock.time >= self.p.end_time
+        self.state.clock.time >= self.setup.p.end_time
     }
 
     fn stable_dt(&self) -> f64 {
         let worst = (0..self.particles())
             .map(|i| {
-                self.signal[i].max(self.gas.sound_speed(self.rho[i], self.pres[i]))
-                    + self.v[i].abs()
+                self.state.signal[i].max(
+                    self.setup
+                        .gas
+                        .sound_speed(self.state.rho[i], self.state.pres[i]),
+                ) + self.state.v[i].abs()
             })
             .fold(0.0, f64::max);
-        let max_div = self.div.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        (COURANT * self.h / worst).min(MAX_VOLUME_STRAIN / max_div)
+        let max_div = self.state.div.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        (COURANT * self.setup.h / worst).min(MAX_VOLUME_STRAIN / max_div)
     }
 
     /// Positions of the real particles followed by their mirror images
     /// across the axis, and for each entry the real particle it copies.
     fn with_mirror(&self) -> (Vec<f64>, Vec<usize>) {
-        let mut r = self.r.clone();
+        let mut r = self.state.r.clone();
         let mut src: Vec<usize> = (0..r.len()).collect();
-        for (k, &rk) in self.r.iter().enumerate().skip(1) {
-            if rk < 2.0 * self.h {
+        for (k, &rk) in self.state.r.iter().enumerate().skip(1) {
+            if rk < 2.0 * self.setup.h {
                 r.push(-rk);
                 src.push(k);
             }
@@ -260,7 +289,7 @@ impl NohSolver {
         let n = self.particles();
         let mut w = vec![0.0; nl.indices.len()];
         let rows = rows_mut(&mut w, &nl.offsets);
-        let h = self.h;
+        let h = self.setup.h;
         let status: Vec<std::result::Result<(), crate::approx::msph::Degenerate>> = rows
             .into_par_iter()
             .take(n)
@@ -274,15 +303,19 @@ impl NohSolver {
                 Ok(())
             })
             .collect();
-        first_degenerate(status, self.clock.time)?;
+        first_degenerate(status, self.state.clock.time)?;
         Ok(w)
     }
 
     /// Advances one step (the last one is shortened to land on `end_time`).
     pub fn step(&mut self) -> Result<()> {
         let n = self.particles();
-        let dt = self.clock.dt.min(self.p.end_time - self.clock.time);
-        let alpha = self.p.smoothing_coefficient;
+        let dt = self
+            .state
+            .clock
+            .dt
+            .min(self.setup.p.end_time - self.state.clock.time);
+        let alpha = self.setup.p.smoothing_coefficient;
         let (r, src) = self.with_mirror();
         let mirrored = |f: &[f64], sign: f64| -> Vec<[f64; 1]> {
             src.iter()
@@ -290,9 +323,12 @@ impl NohSolver {
                 .map(|(k, &i)| [if k < n { f[i] } else { sign * f[i] }])
                 .collect()
         };
-        let vol: Vec<f64> = src.iter().map(|&i| self.mass[i] / self.rho[i]).collect();
+        let vol: Vec<f64> = src
+            .iter()
+            .map(|&i| self.setup.mass[i] / self.state.rho[i])
+            .collect();
         let pts: Vec<[f64; 2]> = r.iter().map(|&x| [x, 0.0]).collect();
-        let nl = cell_list(&pts, 2.0 * self.h);
+        let nl = cell_list(&pts, 2.0 * self.setup.h);
         let w = self.pair_weights(&nl, &r, &vol)?;
         let deriv = |f: &[[f64; 1]], i: usize| -> f64 {
             let (a, b) = (nl.offsets[i], nl.offsets[i + 1]);
@@ -303,7 +339,13 @@ impl NohSolver {
                 .sum()
         };
         // Momentum (4.2) with the radial viscous stress.
-        let pq: Vec<f64> = self.pres.iter().zip(&self.q).map(|(p, q)| p + q).collect();
+        let pq: Vec<f64> = self
+            .state
+            .pres
+            .iter()
+            .zip(&self.state.q)
+            .map(|(p, q)| p + q)
+            .collect();
         let pq = mirrored(&pq, 1.0);
         let v_half: Vec<f64> = (0..n)
             .into_par_iter()
@@ -311,7 +353,7 @@ impl NohSolver {
                 if i == 0 {
                     0.0
                 } else {
-                    self.v[i] - dt * deriv(&pq, i) / self.rho[i]
+                    self.state.v[i] - dt * deriv(&pq, i) / self.state.rho[i]
                 }
             })
             .collect();
@@ -321,9 +363,9 @@ impl NohSolver {
         // M_i = sum_k m_k W_ik, which is eq. (3.23) for equal masses. The
         // kinetic energy it removes becomes heat, shared in proportion to each
         // particle's part of the pairwise dissipation.
-        let m_ext = mirrored(&self.mass, 1.0);
+        let m_ext = mirrored(&self.setup.mass, 1.0);
         let vh_m = mirrored(&v_half, -1.0);
-        let kern = |i: usize, j: usize| kernel1(r[i] - r[j], self.h).w;
+        let kern = |i: usize, j: usize| kernel1(r[i] - r[j], self.setup.h).w;
         let big_m: Vec<f64> = (0..n)
             .map(|i| nl.of(i).iter().map(|&j| m_ext[j][0] * kern(i, j)).sum())
             .collect();
@@ -333,24 +375,24 @@ impl NohSolver {
             .map(|i| {
                 let (mut dp, mut d) = (0.0, 0.0);
                 for &j in nl.of(i) {
-                    let c =
-                        self.mass[i] * m_ext[j][0] * kern(i, j) / (0.5 * (big_m[i] + big_m_of(j)));
+                    let c = self.setup.mass[i] * m_ext[j][0] * kern(i, j)
+                        / (0.5 * (big_m[i] + big_m_of(j)));
                     let diff = vh_m[j][0] - v_half[i];
                     dp += c * diff;
                     d += c * diff * diff;
                 }
-                (alpha * dp / self.mass[i], 0.5 * alpha * d)
+                (alpha * dp / self.setup.mass[i], 0.5 * alpha * d)
             })
             .unzip();
         let mut vs: Vec<f64> = (0..n).map(|i| v_half[i] + dv[i]).collect();
         vs[0] = 0.0;
         let lost: f64 = (0..n)
-            .map(|i| 0.5 * self.mass[i] * (v_half[i] * v_half[i] - vs[i] * vs[i]))
+            .map(|i| 0.5 * self.setup.mass[i] * (v_half[i] * v_half[i] - vs[i] * vs[i]))
             .sum();
         let total: f64 = dissip.iter().sum();
         if lost > 0.0 && total > 0.0 {
             for i in 0..n {
-                self.e[i] += lost * dissip[i] / total / self.mass[i];
+                self.state.e[i] += lost * dissip[i] / total / self.setup.mass[i];
             }
         }
         // Continuity (4.1) and energy (4.3).
@@ -361,57 +403,64 @@ impl NohSolver {
                 if i == 0 {
                     2.0 * dvdr[0]
                 } else {
-                    dvdr[i] + vs[i] / self.r[i]
+                    dvdr[i] + vs[i] / self.state.r[i]
                 }
             })
             .collect();
         // Density of each shell from its mass and its Lagrangian volume
         // (exact mass conservation in 1-D; see the module notes).
-        let rn: Vec<f64> = (0..n).map(|i| self.r[i] + dt * vs[i]).collect();
+        let rn: Vec<f64> = (0..n).map(|i| self.state.r[i] + dt * vs[i]).collect();
         let rho_new: Vec<f64> = shell_bounds(&rn)
             .iter()
-            .zip(&self.mass)
+            .zip(&self.setup.mass)
             .map(|((lo, hi), m)| m / (std::f64::consts::PI * (hi * hi - lo * lo)))
             .collect();
-        let (h, cq, cl) = (self.h, self.p.viscosity_quadratic, self.p.viscosity_linear);
+        let (h, cq, cl) = (
+            self.setup.h,
+            self.setup.p.viscosity_quadratic,
+            self.setup.p.viscosity_linear,
+        );
         for i in 0..n {
             let rho = rho_new[i];
-            let rho_mid = 0.5 * (self.rho[i] + rho);
-            let c = self.gas.sound_speed(self.rho[i], self.pres[i]);
+            let rho_mid = 0.5 * (self.state.rho[i] + rho);
+            let c = self
+                .setup
+                .gas
+                .sound_speed(self.state.rho[i], self.state.pres[i]);
             let g = div[i].min(0.0);
-            self.q[i] = rho * (cq * h * h * g * g - cl * h * c * g);
-            self.signal[i] = c + cl * c + cq * h * g.abs();
-            self.div[i] = div[i];
-            self.e[i] -= dt * (self.pres[i] + self.q[i]) * div[i] / rho_mid;
-            self.rho[i] = rho;
-            self.pres[i] = self.gas.pressure(rho, self.e[i]);
-            self.r[i] += dt * vs[i];
+            self.state.q[i] = rho * (cq * h * h * g * g - cl * h * c * g);
+            self.state.signal[i] = c + cl * c + cq * h * g.abs();
+            self.state.div[i] = div[i];
+            self.state.e[i] -= dt * (self.state.pres[i] + self.state.q[i]) * div[i] / rho_mid;
+            self.state.rho[i] = rho;
+            self.state.pres[i] = self.setup.gas.pressure(rho, self.state.e[i]);
+            self.state.r[i] += dt * vs[i];
         }
-        self.v = vs;
-        self.clock.time += dt;
-        self.clock.steps += 1;
+        self.state.v = vs;
+        self.state.clock.time += dt;
+        self.state.clock.steps += 1;
         if let Some((field, i)) = first_non_finite(&[
-            ("radius", &self.r),
-            ("velocity", &self.v),
-            ("density", &self.rho),
-            ("specific energy", &self.e),
+            ("radius", &self.state.r),
+            ("velocity", &self.state.v),
+            ("density", &self.state.rho),
+            ("specific energy", &self.state.e),
         ]) {
             return Err(Error::NonFinite {
                 field,
                 particle: i,
-                time: self.clock.time,
+                time: self.state.clock.time,
             });
         }
-        if let Some(i) = (1..n).find(|&i| self.r[i] <= 0.0) {
+        if let Some(i) = (1..n).find(|&i| self.state.r[i] <= 0.0) {
             return Err(Error::ThroughBoundary {
                 particle: i,
                 boundary: "axis",
-                time: self.clock.time,
-                position: self.r[i],
+                time: self.state.clock.time,
+                position: self.state.r[i],
             });
         }
-        self.clock.dt = self.stable_dt();
-        self.clock.check_step(self.clock.dt)?;
+        self.state.clock.dt = self.stable_dt();
+        self.state.clock.check_step(self.state.clock.dt)?;
         Ok(())
     }
 
@@ -426,22 +475,22 @@ impl NohSolver {
 
     /// Current values of [`NOH_OBSERVABLES`], in that order.
     pub fn observables(&self) -> Vec<f64> {
-        let t = self.clock.time;
+        let t = self.state.clock.time;
         let n = self.particles();
         // Shock: outermost particle whose density reaches the mean of the exact
         // pre- and post-shock values, interpolated to the crossing.
         let thresh = |r: f64| 0.5 * (POST_SHOCK_DENSITY + 1.0 + t / r.max(1e-12));
         let mut shock = 0.0;
         for i in (1..n).rev() {
-            if self.rho[i] >= thresh(self.r[i]) {
-                shock = self.r[i];
+            if self.state.rho[i] >= thresh(self.state.r[i]) {
+                shock = self.state.r[i];
                 if i + 1 < n {
                     let (a, b) = (
-                        self.rho[i] - thresh(self.r[i]),
-                        self.rho[i + 1] - thresh(self.r[i + 1]),
+                        self.state.rho[i] - thresh(self.state.r[i]),
+                        self.state.rho[i + 1] - thresh(self.state.r[i + 1]),
                     );
                     let f = a / (a - b);
-                    shock = self.r[i] + f * (self.r[i + 1] - self.r[i]);
+                    shock = self.state.r[i] + f * (self.state.r[i + 1] - self.state.r[i]);
                 }
                 break;
             }
@@ -449,7 +498,7 @@ impl NohSolver {
         let mean_over = |lo: f64, hi: f64, f: &dyn Fn(usize) -> f64| -> f64 {
             let (mut s, mut c) = (0.0, 0usize);
             for i in 0..n {
-                if self.r[i] >= lo && self.r[i] <= hi {
+                if self.state.r[i] >= lo && self.state.r[i] <= hi {
                     s += f(i);
                     c += 1;
                 }
@@ -459,30 +508,41 @@ impl NohSolver {
             }
             // No particle in the window (a very coarse run): the value of the
             // particle nearest to its centre.
-            let mid = 0.5 * (lo + hi.min(self.r[n - 1]));
+            let mid = 0.5 * (lo + hi.min(self.state.r[n - 1]));
             let nearest = (0..n)
-                .min_by(|&a, &b| (self.r[a] - mid).abs().total_cmp(&(self.r[b] - mid).abs()))
+                .min_by(|&a, &b| {
+                    (self.state.r[a] - mid)
+                        .abs()
+                        .total_cmp(&(self.state.r[b] - mid).abs())
+                })
                 .unwrap_or(0);
             f(nearest)
         };
         let (post_lo, post_hi) = POST_SHOCK_WINDOW;
         let (pre_lo, pre_hi) = PRE_SHOCK_WINDOW;
-        let post = mean_over(post_lo, post_hi, &|i| self.rho[i]);
+        let post = mean_over(post_lo, post_hi, &|i| self.state.rho[i]);
         let pre = mean_over(pre_lo, pre_hi, &|i| {
-            let ex = 1.0 + t / self.r[i];
-            (self.rho[i] - ex).abs() / ex
+            let ex = 1.0 + t / self.state.r[i];
+            (self.state.rho[i] - ex).abs() / ex
         });
         let l1 = mean_over(0.05, f64::INFINITY, &|i| {
-            let ex = Self::exact_density(self.r[i], t);
-            (self.rho[i] - ex).abs() / ex
+            let ex = Self::exact_density(self.state.r[i], t);
+            (self.state.rho[i] - ex).abs() / ex
         });
         let ke: f64 = self
+            .setup
             .mass
             .iter()
-            .zip(&self.v)
+            .zip(&self.state.v)
             .map(|(m, v)| 0.5 * m * v * v)
             .sum();
-        let ie: f64 = self.mass.iter().zip(&self.e).map(|(m, e)| m * e).sum();
+        let ie: f64 = self
+            .setup
+            .mass
+            .iter()
+            .zip(&self.state.e)
+            .map(|(m, e)| m * e)
+            .sum();
         let values = vec![
             shock,
             post,
@@ -490,7 +550,7 @@ impl NohSolver {
             l1,
             ke,
             ie,
-            self.energy.error_given(ke, ie),
+            self.state.energy.error_given(ke, ie),
         ];
         debug_assert_eq!(values.len(), NOH_OBSERVABLES.len());
         values
@@ -500,11 +560,11 @@ impl NohSolver {
     /// interleaved per particle.
     pub fn field(&self, name: &str) -> Option<Vec<f64>> {
         Some(match name {
-            "position" => self.r.iter().flat_map(|&r| [r, 0.0]).collect(),
-            "density" => self.rho.clone(),
-            "velocity" => self.v.clone(),
-            "pressure" => self.pres.clone(),
-            "specific_energy" => self.e.clone(),
+            "position" => self.state.r.iter().flat_map(|&r| [r, 0.0]).collect(),
+            "density" => self.state.rho.clone(),
+            "velocity" => self.state.v.clone(),
+            "pressure" => self.state.pres.clone(),
+            "specific_energy" => self.state.e.clone(),
             _ => return None,
         })
     }
@@ -546,13 +606,24 @@ impl crate::model::Model for NohSolver {
     }
     /// 600 records over the run.
     fn record_interval(&self) -> f64 {
-        self.p.end_time / 600.0
+        self.setup.p.end_time / 600.0
     }
     fn load_state(
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        *self = crate::model::read_saved(saved)?;
+        if let crate::model::SavedSolver::Json(value) = &saved {
+            crate::solver::shared::refuse_setup(
+                value,
+                &[
+                    ("p", "its parameters"),
+                    ("gas", "its gas"),
+                    ("h", "its smoothing length"),
+                    ("mass", "its masses"),
+                ],
+            )?;
+        }
+        self.state = crate::model::read_saved(saved)?;
         Ok(())
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {

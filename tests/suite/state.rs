@@ -154,7 +154,7 @@ fn forged_noh_states_are_refused() {
     solver(&mut s, "Noh")["rho"][5] = json!(0.0);
     assert!(refused(&s).contains("densities"));
     let mut s = base.clone();
-    solver(&mut s, "Noh")["mass"][5] = json!(2.0);
+    solver(&mut s, "Noh")["mass"] = json!([2.0]);
     assert!(refused(&s).contains("masses"));
     let mut s = base;
     s["scene"]["params"]["Noh"]["end_time"] = json!(5e-324);

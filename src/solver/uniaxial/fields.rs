@@ -63,24 +63,24 @@ pub const PLATE_IMPACT_FIELDS: &[FieldSpec] = &[
 impl PlateImpact {
     /// Cells (the material points).
     pub fn particles(&self) -> usize {
-        self.state.len()
+        self.state.cells.len()
     }
 
     /// The observables of [`crate::observe::PLATE_IMPACT_OBSERVABLES`], in
     /// order.
     pub fn observables(&self) -> Vec<f64> {
-        let target = self.layers[1];
+        let target = self.setup.layers[1];
         let rho0 = target.density().unwrap_or(f64::NAN);
         let (c_l, c_b) = target.sound_speeds().unwrap_or((f64::NAN, f64::NAN));
-        let r = self.reading;
+        let r = self.state.reading;
         let precursor = r.precursor.unwrap_or(0.0);
         let pullback = r.peak - r.pullback_minimum;
-        let spall_strength = if self.spall.is_some() {
+        let spall_strength = if self.state.spall.is_some() {
             0.5 * rho0 * c_b * pullback
         } else {
             0.0
         };
-        let max_damage = match &self.layers[1] {
+        let max_damage = match &self.setup.layers[1] {
             Layer::Ceramic(m) => self
                 .target_ceramic()
                 .iter()
@@ -96,7 +96,7 @@ impl PlateImpact {
             r.peak,
             pullback,
             spall_strength,
-            self.spall.map_or(0.0, |s| s.0),
+            self.state.spall.map_or(0.0, |s| s.0),
             max_damage,
             kinetic,
             internal,
@@ -108,8 +108,8 @@ impl PlateImpact {
     /// The values of the field `name` ([`PLATE_IMPACT_FIELDS`]), one per
     /// cell, or `None` for another name.
     pub fn field(&self, name: &str) -> Option<Vec<f64>> {
-        let cells = 0..self.state.len();
-        let ceramic = |c: usize| match (&self.state[c], self.layer(c)) {
+        let cells = 0..self.state.cells.len();
+        let ceramic = |c: usize| match (&self.state.cells[c], self.layer(c)) {
             (CellState::Ceramic(p), Layer::Ceramic(m)) => Some((p, m)),
             _ => None,
         };
@@ -117,24 +117,26 @@ impl PlateImpact {
             "position" => cells
                 .map(|c| {
                     let (a, b) = self.nodes(c);
-                    0.5 * (self.x[a] + self.x[b])
+                    0.5 * (self.state.x[a] + self.state.x[b])
                 })
                 .collect(),
             "velocity" => cells
                 .map(|c| {
                     let (a, b) = self.nodes(c);
-                    0.5 * (self.v[a] + self.v[b])
+                    0.5 * (self.state.v[a] + self.state.v[b])
                 })
                 .collect(),
             "density" => cells
                 .map(|c| {
                     let (a, b) = self.nodes(c);
-                    self.density0[c] * self.length0[c] / (self.x[b] - self.x[a])
+                    self.setup.density0[c] * self.setup.length0[c]
+                        / (self.state.x[b] - self.state.x[a])
                 })
                 .collect(),
-            "stress" => self.stress.clone(),
+            "stress" => self.state.stress.clone(),
             "pressure" => self
                 .state
+                .cells
                 .iter()
                 .map(|s| match s {
                     CellState::Ceramic(p) => p.pressure,
@@ -143,6 +145,7 @@ impl PlateImpact {
                 .collect(),
             "plastic_strain" => self
                 .state
+                .cells
                 .iter()
                 .map(|s| match s {
                     CellState::Ceramic(p) => p.plastic_strain,

@@ -36,28 +36,52 @@ use layer::CellState;
 pub use layer::Layer;
 pub use reading::FreeSurfaceReading;
 
-/// A flyer plate striking a target plate in uniaxial strain.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+/// A flyer plate striking a target plate in uniaxial strain: its setup, its
+/// state and what it keeps for its caller, apart.
+#[derive(Debug, Clone)]
 pub struct PlateImpact {
+    /// What the run is built from, and never changes.
+    setup: SetupPlate,
+    /// What the run changes: all that is saved.
+    state: StatePlate,
+    /// What the run keeps for its caller: rebuilt, never saved.
+    pipe: PipelinePlate,
+}
+
+/// What a plate-impact run is built from, from its scene, and never
+/// changes: the two plates, the cells' masses, lengths and densities at the
+/// start, and the end time. Not saved.
+#[derive(Debug, Clone, serde::Serialize)]
+struct SetupPlate {
     layers: [Layer; 2],
     /// Flyer cells first; the flyer's last node and the target's first
     /// node are the contact pair.
     flyer_cells: usize,
     impact_speed: f64,
-    x: Vec<f64>,
-    v: Vec<f64>,
     mass: Vec<f64>,
-    /// Per cell: initial length, initial density, state, total stress
-    /// (tension positive, viscosity included), specific internal energy.
+    /// Per cell: initial length and initial density.
     length0: Vec<f64>,
     density0: Vec<f64>,
-    state: Vec<CellState>,
-    stress: Vec<f64>,
-    specific_energy: Vec<f64>,
-    clock: Clock,
     /// Where [`PlateImpact::finished`] holds (s); infinite unless set by
     /// [`PlateImpact::until`].
     end_time: f64,
+}
+
+/// What a plate-impact run changes, and all that it saves (format 2 of
+/// `src/state_format.rs`).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StatePlate {
+    /// The digest of the setup of the run that made this state.
+    setup_digest: u64,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    /// Per cell: the material's state, the total stress (tension positive,
+    /// viscosity included), the specific internal energy.
+    cells: Vec<CellState>,
+    stress: Vec<f64>,
+    specific_energy: Vec<f64>,
+    clock: Clock,
     /// The impact's kinetic energy and the loss at the contact
     /// ([`LOST_CONTACT`]); the internal energy is summed from the cells.
     energy: EnergyBook<1>,
@@ -65,14 +89,24 @@ pub struct PlateImpact {
     /// The depth below the target's impact face of the first target cell
     /// that failed in tension, and when (m, s).
     spall: Option<(f64, f64)>,
+}
+
+/// What a plate-impact run keeps for its caller. Not saved.
+#[derive(Debug, Clone, Default)]
+struct PipelinePlate {
     /// Every step's `(t, u)` of the free surface since the run was made
-    /// (not part of the saved state; not kept by a scene's run, whose
-    /// histories record the observables: [`PlateImpact::without_history`]).
-    #[serde(skip)]
+    /// (not kept by a scene's run, whose histories record the observables:
+    /// [`PlateImpact::without_history`]; a restored run keeps none).
     free_surface: Vec<(f64, f64)>,
-    /// Whether `free_surface` is kept (a restored run keeps none).
-    #[serde(skip)]
+    /// Whether `free_surface` is kept.
     keep_history: bool,
+}
+
+/// The run's state is all it saves.
+impl serde::Serialize for PlateImpact {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        self.state.serialize(s)
+    }
 }
 
 impl PlateImpact {
@@ -119,24 +153,31 @@ impl PlateImpact {
             });
         }
         let mut sim = PlateImpact {
-            layers: [flyer, target],
-            flyer_cells: counts[0],
-            impact_speed,
-            x: Vec::new(),
-            v: Vec::new(),
-            mass: Vec::new(),
-            length0: Vec::new(),
-            density0: Vec::new(),
-            state: Vec::new(),
-            stress: Vec::new(),
-            specific_energy: Vec::new(),
-            clock: Clock::default(),
-            end_time: f64::INFINITY,
-            energy: EnergyBook::new(0.0),
-            reading: FreeSurfaceReading::default(),
-            spall: None,
-            free_surface: Vec::new(),
-            keep_history: true,
+            setup: SetupPlate {
+                layers: [flyer, target],
+                flyer_cells: counts[0],
+                impact_speed,
+                mass: Vec::new(),
+                length0: Vec::new(),
+                density0: Vec::new(),
+                end_time: f64::INFINITY,
+            },
+            state: StatePlate {
+                setup_digest: 0,
+                x: Vec::new(),
+                v: Vec::new(),
+                cells: Vec::new(),
+                stress: Vec::new(),
+                specific_energy: Vec::new(),
+                clock: Clock::default(),
+                energy: EnergyBook::new(0.0),
+                reading: FreeSurfaceReading::default(),
+                spall: None,
+            },
+            pipe: PipelinePlate {
+                free_surface: Vec::new(),
+                keep_history: true,
+            },
         };
         let mut start = -flyer_thickness;
         for (k, (&n, thickness)) in counts
@@ -144,35 +185,36 @@ impl PlateImpact {
             .zip([flyer_thickness, target_thickness])
             .enumerate()
         {
-            let layer = sim.layers[k];
+            let layer = sim.setup.layers[k];
             let rho = layer.density()?;
             let h = thickness / n as f64;
             let speed = if k == 0 { impact_speed } else { 0.0 };
-            let first = sim.x.len();
+            let first = sim.state.x.len();
             for i in 0..=n {
-                sim.x.push(start + h * i as f64);
-                sim.v.push(speed);
-                sim.mass.push(0.0);
+                sim.state.x.push(start + h * i as f64);
+                sim.state.v.push(speed);
+                sim.setup.mass.push(0.0);
             }
             for i in 0..n {
-                sim.length0.push(h);
-                sim.density0.push(rho);
-                sim.state.push(layer.initial_state());
-                sim.stress.push(0.0);
-                sim.specific_energy.push(0.0);
-                sim.mass[first + i] += 0.5 * rho * h;
-                sim.mass[first + i + 1] += 0.5 * rho * h;
+                sim.setup.length0.push(h);
+                sim.setup.density0.push(rho);
+                sim.state.cells.push(layer.initial_state());
+                sim.state.stress.push(0.0);
+                sim.state.specific_energy.push(0.0);
+                sim.setup.mass[first + i] += 0.5 * rho * h;
+                sim.setup.mass[first + i + 1] += 0.5 * rho * h;
             }
             start = 0.0;
         }
-        sim.energy.initial = sim.kinetic();
+        sim.state.energy.initial = sim.kinetic();
+        sim.state.setup_digest = crate::solver::shared::setup_digest(&sim.setup);
         sim.record();
         Ok(sim)
     }
 
     /// The two nodes of cell `c`.
     fn nodes(&self, c: usize) -> (usize, usize) {
-        if c < self.flyer_cells {
+        if c < self.setup.flyer_cells {
             (c, c + 1)
         } else {
             (c + 1, c + 2)
@@ -180,30 +222,34 @@ impl PlateImpact {
     }
 
     fn layer(&self, c: usize) -> &Layer {
-        &self.layers[usize::from(c >= self.flyer_cells)]
+        &self.setup.layers[usize::from(c >= self.setup.flyer_cells)]
     }
 
     fn kinetic(&self) -> f64 {
-        self.v
+        self.state
+            .v
             .iter()
-            .zip(&self.mass)
+            .zip(&self.setup.mass)
             .map(|(v, m)| 0.5 * m * v * v)
             .sum()
     }
 
     /// Records the free surface's velocity and reads it.
     fn record(&mut self) {
-        let u = *self.v.last().expect("nodes");
-        if self.keep_history {
-            self.free_surface.push((self.clock.time, u));
+        let u = *self.state.v.last().expect("nodes");
+        if self.pipe.keep_history {
+            self.pipe.free_surface.push((self.state.clock.time, u));
         }
-        self.reading.read(self.clock.time, u, self.impact_speed);
+        self.state
+            .reading
+            .read(self.state.clock.time, u, self.setup.impact_speed);
     }
 
     /// Runs until `end_time` (s) from now on: [`PlateImpact::finished`]
     /// holds there.
     pub fn until(mut self, end_time: f64) -> Self {
-        self.end_time = end_time;
+        self.setup.end_time = end_time;
+        self.state.setup_digest = crate::solver::shared::setup_digest(&self.setup);
         self
     }
 
@@ -211,86 +257,93 @@ impl PlateImpact {
     /// run's history would grow by 16 bytes a step; the reading and the
     /// observables do not need it).
     pub fn without_history(mut self) -> Self {
-        self.keep_history = false;
-        self.free_surface = Vec::new();
+        self.pipe.keep_history = false;
+        self.pipe.free_surface = Vec::new();
         self
     }
 
     /// Whether the run has reached its end time ([`PlateImpact::until`]).
     pub fn finished(&self) -> bool {
-        self.clock.time >= self.end_time
+        self.state.clock.time >= self.setup.end_time
     }
 
-    crate::solver::shared::clock_getters!(clock);
+    crate::solver::shared::clock_getters!(state.clock);
 
     /// The end time (s), infinite if none was set.
     pub fn end_time(&self) -> f64 {
-        self.end_time
+        self.setup.end_time
     }
 
     /// The flyer's and the target's layers.
     pub fn layers(&self) -> [Layer; 2] {
-        self.layers
+        self.setup.layers
     }
 
     /// The impact speed (m/s).
     pub fn impact_speed(&self) -> f64 {
-        self.impact_speed
+        self.setup.impact_speed
     }
 
     /// What the free-surface velocity has shown so far.
     pub fn reading(&self) -> FreeSurfaceReading {
-        self.reading
+        self.state.reading
     }
 
     /// The depth below the target's impact face of the first target cell
     /// to fail in tension (a ceramic pulverized in expansion), and the time
     /// it failed: where the target spalled.
     pub fn spall(&self) -> Option<(f64, f64)> {
-        self.spall
+        self.state.spall
     }
 
     /// The target's current free-surface velocity (m/s).
     pub fn free_surface_velocity(&self) -> f64 {
-        *self.v.last().expect("nodes")
+        *self.state.v.last().expect("nodes")
     }
 
     /// The target's free-surface velocity history `(t, u)`, one entry per
     /// step since the run was made (empty after
     /// [`PlateImpact::without_history`] and in a restored run).
     pub fn free_surface(&self) -> &[(f64, f64)] {
-        &self.free_surface
+        &self.pipe.free_surface
     }
 
     /// The kinetic and internal energies and the kinetic energy lost in
     /// the contact's merging, per unit area (J/m2).
     pub fn energies(&self) -> [f64; 3] {
-        let internal: f64 = (0..self.state.len())
-            .map(|c| self.density0[c] * self.length0[c] * self.specific_energy[c])
+        let internal: f64 = (0..self.state.cells.len())
+            .map(|c| self.setup.density0[c] * self.setup.length0[c] * self.state.specific_energy[c])
             .sum();
-        [self.kinetic(), internal, self.energy.lost[LOST_CONTACT]]
+        [
+            self.kinetic(),
+            internal,
+            self.state.energy.lost[LOST_CONTACT],
+        ]
     }
 
     /// The relative energy error `|KE + IE + contact loss - KE0| / KE0`.
     pub fn energy_error(&self) -> f64 {
         let [kinetic, internal, _] = self.energies();
-        self.energy.error_given(kinetic, internal)
+        self.state.energy.error_given(kinetic, internal)
     }
 
     /// The target's cells from the impact face: `(position, stress)` with
     /// the stress tension-positive (Pa).
     pub fn target_stress(&self) -> Vec<(f64, f64)> {
-        (self.flyer_cells..self.state.len())
+        (self.setup.flyer_cells..self.state.cells.len())
             .map(|c| {
                 let (a, b) = self.nodes(c);
-                (0.5 * (self.x[a] + self.x[b]), self.stress[c])
+                (
+                    0.5 * (self.state.x[a] + self.state.x[b]),
+                    self.state.stress[c],
+                )
             })
             .collect()
     }
 
     /// The ceramic states of the target's cells (empty for a metal target).
     pub fn target_ceramic(&self) -> Vec<CeramicPoint> {
-        self.state[self.flyer_cells..]
+        self.state.cells[self.setup.flyer_cells..]
             .iter()
             .filter_map(|s| match s {
                 CellState::Ceramic(p) => Some(*p),
@@ -302,10 +355,10 @@ impl PlateImpact {
 
 impl crate::model::Model for PlateImpact {
     fn time(&self) -> f64 {
-        self.clock.time
+        self.state.clock.time
     }
     fn steps(&self) -> u64 {
-        self.clock.steps
+        self.state.clock.steps
     }
     fn particles(&self) -> usize {
         Self::particles(self)
@@ -327,13 +380,28 @@ impl crate::model::Model for PlateImpact {
     }
     /// 400 records over the run.
     fn record_interval(&self) -> f64 {
-        self.end_time / 400.0
+        self.setup.end_time / 400.0
     }
     fn load_state(
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        *self = crate::model::read_saved(saved)?;
+        if let crate::model::SavedSolver::Json(value) = &saved {
+            crate::solver::shared::refuse_setup(
+                value,
+                &[
+                    ("layers", "its plates"),
+                    ("flyer_cells", "its cells"),
+                    ("impact_speed", "its impact speed"),
+                    ("mass", "its masses"),
+                    ("length0", "its cells"),
+                    ("density0", "its cells"),
+                    ("end_time", "its end time"),
+                ],
+            )?;
+        }
+        self.state = crate::model::read_saved(saved)?;
+        self.pipe = PipelinePlate::default();
         Ok(())
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {

@@ -5,59 +5,58 @@ use super::{LOST_CONTACT, PlateImpact};
 
 impl PlateImpact {
     /// Checks a restored run against `fresh`, a new run of the same
-    /// parameters: the same layers, cells, masses and end time, finite
+    /// parameters: made by a run of the same setup (plates, cells, masses,
+    /// end time: its digest), the same impact energy, finite
     /// fields, cells of positive length, speeds and cracks a run can reach,
     /// and a clock within the run.
     pub fn check_restored(&self, fresh: &PlateImpact) -> std::result::Result<(), String> {
-        let same = self.layers == fresh.layers
-            && self.flyer_cells == fresh.flyer_cells
-            && self.impact_speed.to_bits() == fresh.impact_speed.to_bits()
-            && self.mass == fresh.mass
-            && self.length0 == fresh.length0
-            && self.density0 == fresh.density0
-            && self.end_time.to_bits() == fresh.end_time.to_bits()
-            && self.energy.initial.to_bits() == fresh.energy.initial.to_bits();
-        if !same {
-            return Err("its plates, cells or masses do not follow from its parameters".into());
+        // The setup is the scene's (a restored run is built from it), and
+        // the state one that a run of it made.
+        if self.state.setup_digest != fresh.state.setup_digest {
+            return Err(crate::solver::shared::NOT_ITS_SETUP.into());
         }
-        let (nodes, cells) = (fresh.x.len(), fresh.state.len());
+        if self.state.energy.initial.to_bits() != fresh.state.energy.initial.to_bits() {
+            return Err("its impact energy does not follow from its parameters".into());
+        }
+        let (nodes, cells) = (fresh.state.x.len(), fresh.state.cells.len());
         for (what, f, n) in [
-            ("positions", &self.x, nodes),
-            ("velocities", &self.v, nodes),
-            ("stresses", &self.stress, cells),
-            ("specific energies", &self.specific_energy, cells),
+            ("positions", &self.state.x, nodes),
+            ("velocities", &self.state.v, nodes),
+            ("stresses", &self.state.stress, cells),
+            ("specific energies", &self.state.specific_energy, cells),
         ] {
             if f.len() != n || !f.iter().all(|x| x.is_finite()) {
                 return Err(format!("its {what} are not {n} finite numbers"));
             }
         }
-        if self.state.len() != cells {
+        if self.state.cells.len() != cells {
             return Err(format!(
                 "it holds {} cell states for {cells} cells",
-                self.state.len()
+                self.state.cells.len()
             ));
         }
         // The fastest a run can move: the impact speed plus twice the
         // fastest wave, with room.
         let c_max = self
+            .setup
             .layers
             .iter()
             .filter_map(|l| l.sound_speeds().ok())
             .map(|(c, _)| c)
             .fold(0.0, f64::max);
-        let bound = 10.0 * (self.impact_speed.abs() + c_max);
-        if self.v.iter().any(|v| v.abs() > bound) {
+        let bound = 10.0 * (self.setup.impact_speed.abs() + c_max);
+        if self.state.v.iter().any(|v| v.abs() > bound) {
             return Err(format!("a node moves faster than {bound} m/s"));
         }
-        let thickness: f64 = fresh.length0.iter().sum();
+        let thickness: f64 = fresh.setup.length0.iter().sum();
         for c in 0..cells {
             let (a, b) = self.nodes(c);
-            let length = self.x[b] - self.x[a];
+            let length = self.state.x[b] - self.state.x[a];
             // NaN fails the range (the positions are finite, checked above).
-            if !(length > 0.0 && length <= 100.0 * self.length0[c]) {
+            if !(length > 0.0 && length <= 100.0 * self.setup.length0[c]) {
                 return Err(format!("its cell {c} has an impossible length"));
             }
-            let ok = match (&self.state[c], self.layer(c)) {
+            let ok = match (&self.state.cells[c], self.layer(c)) {
                 (CellState::Ceramic(p), Layer::Ceramic(_)) => {
                     p.crack_size.is_finite()
                         && p.crack_size > 0.0
@@ -84,31 +83,31 @@ impl PlateImpact {
                 ));
             }
         }
-        let clock = self.clock.time.is_finite()
-            && self.clock.time >= 0.0
-            && self.clock.time <= self.end_time
-            && ((self.clock.steps == 0) == (self.clock.time == 0.0));
+        let clock = self.state.clock.time.is_finite()
+            && self.state.clock.time >= 0.0
+            && self.state.clock.time <= self.setup.end_time
+            && ((self.state.clock.steps == 0) == (self.state.clock.time == 0.0));
         if !clock {
             return Err(format!(
                 "its clock (t = {}, {} steps) is not valid",
-                self.clock.time, self.clock.steps
+                self.state.clock.time, self.state.clock.steps
             ));
         }
-        let r = self.reading;
+        let r = self.state.reading;
         let finite = r.peak.is_finite()
             && r.pullback_minimum.is_finite()
             && r.last.abs() <= bound
             && r.phase <= 2
             && r.arrival
-                .is_none_or(|t| t.is_finite() && t <= self.clock.time)
+                .is_none_or(|t| t.is_finite() && t <= self.state.clock.time)
             && r.precursor
                 .is_none_or(|u| u.is_finite() && u.abs() <= bound)
             && r.peak.abs() <= bound
             && r.pullback_minimum.abs() <= bound
-            && self.energy.lost[LOST_CONTACT].is_finite()
-            && self.energy.lost[LOST_CONTACT] >= 0.0
-            && self.spall.is_none_or(|(d, t)| {
-                d >= 0.0 && d <= thickness && t >= 0.0 && t <= self.clock.time
+            && self.state.energy.lost[LOST_CONTACT].is_finite()
+            && self.state.energy.lost[LOST_CONTACT] >= 0.0
+            && self.state.spall.is_none_or(|(d, t)| {
+                d >= 0.0 && d <= thickness && t >= 0.0 && t <= self.state.clock.time
             });
         if !finite {
             return Err("its free-surface reading or spall is not one a run can reach".into());

@@ -15,8 +15,8 @@ const COURANT: f64 = 0.5;
 impl PlateImpact {
     /// Runs to `end_time` (s).
     pub fn run(&mut self, end_time: f64) -> Result<()> {
-        while self.clock.time < end_time {
-            let dt = self.stable_step().min(end_time - self.clock.time);
+        while self.state.clock.time < end_time {
+            let dt = self.stable_step().min(end_time - self.state.clock.time);
             self.step(dt)?;
         }
         Ok(())
@@ -24,80 +24,84 @@ impl PlateImpact {
 
     /// One stable step, ending at the end time at the latest.
     pub fn advance(&mut self) -> Result<()> {
-        let dt = self.stable_step().min(self.end_time - self.clock.time);
+        let dt = self
+            .stable_step()
+            .min(self.setup.end_time - self.state.clock.time);
         self.step(dt)
     }
 
     /// The stable time step of the cells now (s).
     pub fn stable_step(&self) -> f64 {
-        (0..self.state.len())
+        (0..self.state.cells.len())
             .map(|c| {
                 let (a, b) = self.nodes(c);
-                let len = self.x[b] - self.x[a];
-                let rho = self.density0[c] * self.length0[c] / len;
-                COURANT * len / self.layer(c).wave_speed(rho, &self.state[c])
+                let len = self.state.x[b] - self.state.x[a];
+                let rho = self.setup.density0[c] * self.setup.length0[c] / len;
+                COURANT * len / self.layer(c).wave_speed(rho, &self.state.cells[c])
             })
             .fold(f64::INFINITY, f64::min)
     }
 
     /// One central-difference step of `dt`.
     pub fn step(&mut self, dt: f64) -> Result<()> {
-        let n = self.state.len();
-        let (f, t) = (self.flyer_cells, self.flyer_cells + 1);
-        let closing = self.v[f] - self.v[t];
-        let materials = self.layers.map(|l| l.material());
+        let n = self.state.cells.len();
+        let (f, t) = (self.setup.flyer_cells, self.setup.flyer_cells + 1);
+        let closing = self.state.v[f] - self.state.v[t];
+        let materials = self.setup.layers.map(|l| l.material());
         // Each cell pulls its two nodes (tension positive).
         for c in 0..n {
             let (a, b) = self.nodes(c);
-            self.v[a] += self.stress[c] / self.mass[a] * dt;
-            self.v[b] -= self.stress[c] / self.mass[b] * dt;
+            self.state.v[a] += self.state.stress[c] / self.setup.mass[a] * dt;
+            self.state.v[b] -= self.state.stress[c] / self.setup.mass[b] * dt;
         }
         // The contact pair moves as one node while pressed together. Pairs
         // that met with different velocities collide inelastically: the
         // kinetic energy of their relative motion is lost.
-        let gap = (self.x[t] + self.v[t] * dt) - (self.x[f] + self.v[f] * dt);
+        let gap =
+            (self.state.x[t] + self.state.v[t] * dt) - (self.state.x[f] + self.state.v[f] * dt);
         if gap < 0.0 {
-            let (mf, mt) = (self.mass[f], self.mass[t]);
-            let common = (mf * self.v[f] + mt * self.v[t]) / (mf + mt);
-            self.v[f] = common;
-            self.v[t] = common;
-            self.energy.lost[LOST_CONTACT] += 0.5 * mf * mt / (mf + mt) * closing * closing;
+            let (mf, mt) = (self.setup.mass[f], self.setup.mass[t]);
+            let common = (mf * self.state.v[f] + mt * self.state.v[t]) / (mf + mt);
+            self.state.v[f] = common;
+            self.state.v[t] = common;
+            self.state.energy.lost[LOST_CONTACT] += 0.5 * mf * mt / (mf + mt) * closing * closing;
         }
-        for i in 0..self.x.len() {
-            self.x[i] += self.v[i] * dt;
+        for i in 0..self.state.x.len() {
+            self.state.x[i] += self.state.v[i] * dt;
         }
-        self.clock.time += dt;
+        self.state.clock.time += dt;
         for c in 0..n {
             let (a, b) = self.nodes(c);
-            let len = self.x[b] - self.x[a];
+            let len = self.state.x[b] - self.state.x[a];
             if len.is_nan() || len <= 0.0 {
                 return Err(Error::ThroughBoundary {
                     particle: c,
                     boundary: "neighbouring node (cell inverted)",
-                    time: self.clock.time,
-                    position: self.x[a],
+                    time: self.state.clock.time,
+                    position: self.state.x[a],
                 });
             }
             // The length at the middle of the step: the cell grew by
             // (v_b - v_a) dt.
-            let d = (self.v[b] - self.v[a]) / (len - 0.5 * (self.v[b] - self.v[a]) * dt);
-            let rho = self.density0[c] * self.length0[c] / len;
+            let d = (self.state.v[b] - self.state.v[a])
+                / (len - 0.5 * (self.state.v[b] - self.state.v[a]) * dt);
+            let rho = self.setup.density0[c] * self.setup.length0[c] / len;
             let load = Loading::<Full> {
                 dt,
                 rate: [d, 0.0, 0.0, 0.0, 0.0, 0.0],
                 spin: [0.0; 3],
                 density: rho,
             };
-            let k = usize::from(c >= self.flyer_cells);
-            let layer = self.layers[k];
-            let (old, mut point_state) = self.state[c].point();
+            let k = usize::from(c >= self.setup.flyer_cells);
+            let layer = self.setup.layers[k];
+            let (old, mut point_state) = self.state.cells[c].point();
             let new = match layer {
                 // The ceramic's porous pressure takes the cell's specific
                 // internal energy.
                 Layer::Ceramic(_) => materials[k].update_with_energy(
                     &load,
                     &old,
-                    self.specific_energy[c],
+                    self.state.specific_energy[c],
                     &mut point_state,
                 ),
                 // A metal's pressure is at its temperature, as in the other
@@ -106,15 +110,15 @@ impl PlateImpact {
             }
             .map_err(|e| Error::CompressionLimit {
                 particle: c,
-                time: self.clock.time,
+                time: self.state.clock.time,
                 compression: e.compression,
                 limit: e.limit,
             })?;
-            self.state[c].set(new, point_state);
+            self.state.cells[c].set(new, point_state);
             // The first target cell pulverized in tension (its elastic
             // volumetric strain at pulverization, which the pulverized
             // state keeps, an expansion): the spall.
-            if self.spall.is_none()
+            if self.state.spall.is_none()
                 && k == 1
                 && matches!(layer, Layer::Ceramic(_))
                 && point_state
@@ -122,12 +126,13 @@ impl PlateImpact {
                     .and_then(|v| v.pulverized)
                     .is_some_and(|z| z.volumetric_strain > 0.0)
             {
-                let depth = (c - self.flyer_cells) as f64;
-                self.spall = Some(((depth + 0.5) * self.length0[c], self.clock.time));
+                let depth = (c - self.setup.flyer_cells) as f64;
+                self.state.spall =
+                    Some(((depth + 0.5) * self.setup.length0[c], self.state.clock.time));
             }
             let material = new.deviator[0] - new.pressure;
             let q = if d < 0.0 {
-                let c_l = layer.wave_speed(rho, &self.state[c]);
+                let c_l = layer.wave_speed(rho, &self.state.cells[c]);
                 let (cq, cl) = VISCOSITY;
                 rho * (cq * cq * len * len * d * d - cl * c_l * len * d)
             } else {
@@ -138,20 +143,20 @@ impl PlateImpact {
                 return Err(Error::NonFinite {
                     field: "stress",
                     particle: c,
-                    time: self.clock.time,
+                    time: self.state.clock.time,
                 });
             }
-            self.specific_energy[c] += 0.5 * (self.stress[c] + stress) * d * dt / rho;
-            self.stress[c] = stress;
+            self.state.specific_energy[c] += 0.5 * (self.state.stress[c] + stress) * d * dt / rho;
+            self.state.stress[c] = stress;
         }
-        if let Some(i) = self.v.iter().position(|v| !v.is_finite()) {
+        if let Some(i) = self.state.v.iter().position(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 field: "velocity",
                 particle: i,
-                time: self.clock.time,
+                time: self.state.clock.time,
             });
         }
-        self.clock.steps += 1;
+        self.state.clock.steps += 1;
         self.record();
         Ok(())
     }
