@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::isa::Isa;
-use crate::observe::FieldSpec;
+use crate::observe::{Field, FieldSpec, Snapshot};
 use std::any::Any;
 
 /// What every solver state offers alike: copies, saving, and its own type
@@ -196,3 +196,32 @@ macro_rules! inherent_basics {
     };
 }
 pub(crate) use inherent_basics;
+
+/// A snapshot of a run (written here, with the interface it reads, so that
+/// `src/observe.rs` knows nothing of the models).
+impl Snapshot {
+    /// Every field of a run now: `position` as the positions (its
+    /// components padded with zeros to three), the others as fields.
+    pub fn of(model: &dyn Model) -> Snapshot {
+        let specs = model.field_specs();
+        let value = |name| model.field(name).expect("a field the model lists");
+        let (position, rest) = specs.split_first().expect("every scene has positions");
+        let k = position.components.len();
+        Snapshot {
+            time: model.time(),
+            positions: value(position.name)
+                .chunks(k)
+                .map(|c| std::array::from_fn(|k| c.get(k).copied().unwrap_or(0.0)))
+                .collect(),
+            fields: rest
+                .iter()
+                .map(|f| Field {
+                    name: f.name,
+                    components: f.components,
+                    unit: f.unit,
+                    data: value(f.name),
+                })
+                .collect(),
+        }
+    }
+}

@@ -236,31 +236,6 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
-    /// Every field of a run now: `position` as the positions (its
-    /// components padded with zeros to three), the others as fields.
-    pub fn of(model: &dyn crate::model::Model) -> Snapshot {
-        let specs = model.field_specs();
-        let value = |name| model.field(name).expect("a field the model lists");
-        let (position, rest) = specs.split_first().expect("every scene has positions");
-        let k = position.components.len();
-        Snapshot {
-            time: model.time(),
-            positions: value(position.name)
-                .chunks(k)
-                .map(|c| std::array::from_fn(|k| c.get(k).copied().unwrap_or(0.0)))
-                .collect(),
-            fields: rest
-                .iter()
-                .map(|f| Field {
-                    name: f.name,
-                    components: f.components,
-                    unit: f.unit,
-                    data: value(f.name),
-                })
-                .collect(),
-        }
-    }
-
     /// The field called `name`.
     pub fn field(&self, name: &str) -> Option<&Field> {
         self.fields.iter().find(|f| f.name == name)

@@ -11,7 +11,7 @@
 //! that needs it), while names and ranges are checked by the setter.
 
 use super::error::{Fail, mi_result};
-use super::panic::{get_into, guard, with_sim};
+use super::panic::{Handle, get_into, guard, with_sim};
 use super::ptr::{need_out, put, text};
 use crate::error::Error;
 use crate::scene::{Scene, SceneKind};
@@ -87,6 +87,18 @@ pub struct mi_sim {
     pub(crate) meta: Meta,
 }
 
+impl Handle for mi_sim {
+    fn poisoned(&self) -> bool {
+        self.poisoned
+    }
+    fn poison(&mut self) {
+        self.poisoned = true;
+    }
+    fn set_error(&mut self, message: String) {
+        self.last_error = message;
+    }
+}
+
 impl mi_sim {
     fn new(scene: Scene) -> Self {
         mi_sim {
@@ -109,10 +121,6 @@ impl mi_sim {
             progress_data: self.progress_data,
             ..mi_sim::new(scene)
         };
-    }
-
-    pub(crate) fn set_error(&mut self, message: String) {
-        self.last_error = message;
     }
 
     /// The kind of scene (fixed for the handle's life, except by

@@ -5,7 +5,6 @@
 //! further work, since its state may be half-updated.
 
 use super::error::{Fail, mi_result};
-use super::handle::mi_sim;
 use crate::ffi::panic_text;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -18,9 +17,20 @@ pub(crate) fn guard(f: impl FnOnce() -> mi_result) -> mi_result {
 /// Runs `f` on the handle behind `sim`: NULL gives `MI_NULL_POINTER`, a
 /// poisoned handle `MI_PANIC`; a failure is kept as the handle's last error;
 /// a panic poisons the handle.
-pub(crate) fn with_sim(
-    sim: *mut mi_sim,
-    f: impl FnOnce(&mut mi_sim) -> Result<(), Fail>,
+/// What [`with_sim`] needs of a handle: its poisoned flag and its last
+/// error (implemented by `mi_sim`, `src/capi/handle.rs`).
+pub(crate) trait Handle {
+    /// Whether a panic has made the handle unusable.
+    fn poisoned(&self) -> bool;
+    /// Marks the handle unusable after a panic.
+    fn poison(&mut self);
+    /// Records the message of the last error.
+    fn set_error(&mut self, message: String);
+}
+
+pub(crate) fn with_sim<H: Handle>(
+    sim: *mut H,
+    f: impl FnOnce(&mut H) -> Result<(), Fail>,
 ) -> mi_result {
     guard(|| {
         // SAFETY: the caller guarantees that a non-NULL `sim` is a live handle
@@ -28,7 +38,7 @@ pub(crate) fn with_sim(
         let Some(s) = (unsafe { sim.as_mut() }) else {
             return mi_result::MI_NULL_POINTER;
         };
-        if s.poisoned {
+        if s.poisoned() {
             return mi_result::MI_PANIC;
         }
         match catch_unwind(AssertUnwindSafe(|| f(s))) {
@@ -38,7 +48,7 @@ pub(crate) fn with_sim(
                 fail.code
             }
             Err(payload) => {
-                s.poisoned = true;
+                s.poison();
                 s.set_error(format!(
                     "panic inside meshless-impact (handle now unusable): {}",
                     panic_text(payload.as_ref())
@@ -55,11 +65,11 @@ pub(crate) fn with_sim(
 ///
 /// # Safety
 /// `out` must be NULL or valid for a write of one `T`.
-pub(crate) unsafe fn get_into<T>(
-    sim: *mut mi_sim,
+pub(crate) unsafe fn get_into<H: Handle, T>(
+    sim: *mut H,
     out: *mut T,
     what: &str,
-    value: impl FnOnce(&mut mi_sim) -> Result<T, Fail>,
+    value: impl FnOnce(&mut H) -> Result<T, Fail>,
 ) -> mi_result {
     with_sim(sim, |s| {
         super::ptr::need_out(out, what)?;

@@ -5,10 +5,10 @@
 //! the panic boundary around every call on an instance.
 
 use super::fmu::{Fmu, Variable};
-use super::log::{CAT_ERROR, CAT_EVENTS, CAT_WARNING, LogSink};
+use super::log::{CAT_ERROR, CAT_EVENTS, CAT_WARNING, LogSink, category_names, set_categories};
 use crate::ffi::panic_text;
 use crate::{Scene, Simulation};
-use std::ffi::{CString, c_int, c_void};
+use std::ffi::{CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Status codes; the numbers are those of `fmi3Status` and `fmi2Status`.
@@ -118,6 +118,39 @@ pub(crate) struct Instance {
 }
 
 impl Instance {
+    /// Sends a message to the host's logger. Errors always go out; other
+    /// categories only when logging is on for them.
+    pub(crate) fn log(&self, status: Status, category: usize, message: &str) {
+        if category != CAT_ERROR && !self.categories[category] {
+            return;
+        }
+        self.log
+            .emit(&self.name, status as c_int, category, message);
+    }
+
+    /// `fmi3SetDebugLogging` / `fmi2SetDebugLogging`: logging `on` or off
+    /// for the host's `n` categories (all of them when `n` is 0).
+    ///
+    /// # Safety
+    /// `categories` must be NULL or hold `n` pointers, each NULL or a
+    /// NUL-terminated string.
+    pub(crate) unsafe fn set_debug_logging(
+        &mut self,
+        function: &str,
+        on: bool,
+        categories: *const *const c_char,
+        n: usize,
+    ) -> Status {
+        // SAFETY: forwarded contract.
+        let Some(names) = (unsafe { category_names(categories, n) }) else {
+            return self.fail(&format!("{function}: categories is NULL"));
+        };
+        match set_categories(&mut self.categories, on, &names) {
+            Ok(()) => Status::Ok,
+            Err(e) => self.fail(&e),
+        }
+    }
+
     pub(crate) fn new(
         standard: Standard,
         fmu: Fmu,

@@ -2,9 +2,8 @@
 //! ([`LOG_CATEGORIES`]), the host's logger of either standard ([`LogSink`]),
 //! and the instance's sending of messages and switching of categories.
 
-use super::instance::{Instance, Status};
 use crate::ffi::{c_string_lossy, slice};
-use std::ffi::{CString, c_char, c_int, c_void};
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
 
 /// Log categories declared in the model description, with their meaning.
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
@@ -59,40 +58,33 @@ pub(crate) enum LogSink {
     },
 }
 
-impl Instance {
-    /// Sends a message to the host's logger. Errors always go out; other
-    /// categories only when logging is on for them.
-    pub(crate) fn log(&self, status: Status, category: usize, message: &str) {
-        if category != CAT_ERROR && !self.categories[category] {
-            return;
-        }
+impl LogSink {
+    /// Sends `message` of `category` with the FMI status `status` to the
+    /// host's logger of the instance called `name` (nothing with no
+    /// logger): the message's NULs become spaces, and for FMI 2 (a printf
+    /// format) its `%` are doubled.
+    pub(crate) fn emit(&self, name: &CStr, status: c_int, category: usize, message: &str) {
         let cat = CString::new(LOG_CATEGORIES[category].0).expect("no NUL in category names");
-        match self.log {
+        match *self {
             LogSink::None => {}
             LogSink::Fmi3 {
                 callback,
                 environment,
             } => {
                 let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
-                // SAFETY: the host gave this callback and environment at
-                // instantiation and guarantees them valid for the instance's
-                // lifetime; the strings are NUL-terminated and outlive the call.
-                unsafe { callback(environment, status as c_int, cat.as_ptr(), msg.as_ptr()) }
+                unsafe { callback(environment, status, cat.as_ptr(), msg.as_ptr()) }
             }
             LogSink::Fmi2 {
                 callback,
                 environment,
             } => {
-                // The FMI 2 message is a printf format: escape '%'.
                 let msg =
                     CString::new(message.replace('\0', " ").replace('%', "%%")).unwrap_or_default();
-                // SAFETY: as above; the format has no conversions left, so no
-                // variadic arguments are read.
                 unsafe {
                     callback(
                         environment,
-                        self.name.as_ptr(),
-                        status as c_int,
+                        name.as_ptr(),
+                        status,
                         cat.as_ptr(),
                         msg.as_ptr(),
                     )
@@ -100,51 +92,50 @@ impl Instance {
             }
         }
     }
+}
 
-    /// `fmi3SetDebugLogging` / `fmi2SetDebugLogging`: logging `on` or off
-    /// for the host's `n` categories (all of them when `n` is 0).
-    ///
-    /// # Safety
-    /// `categories` must be NULL or hold `n` pointers, each NULL or a
-    /// NUL-terminated string.
-    pub(crate) unsafe fn set_debug_logging(
-        &mut self,
-        function: &str,
-        on: bool,
-        categories: *const *const c_char,
-        n: usize,
-    ) -> Status {
-        // SAFETY: forwarded contract.
-        let Some(categories) = (unsafe { slice(categories, n) }) else {
-            return self.fail(&format!("{function}: categories is NULL"));
-        };
-        let names: Vec<String> = categories
+/// The category names of a `setDebugLogging` call, read from the host's
+/// array (`None`: the array is NULL).
+///
+/// # Safety
+/// `categories` is NULL or points to `n` pointers, each NULL or to a
+/// NUL-terminated string.
+pub(crate) unsafe fn category_names(
+    categories: *const *const c_char,
+    n: usize,
+) -> Option<Vec<String>> {
+    let categories = unsafe { slice(categories, n) }?;
+    Some(
+        categories
             .iter()
-            // SAFETY: forwarded contract.
             .map(|&c| unsafe { c_string_lossy(c) }.unwrap_or_default())
-            .collect();
-        self.set_categories(on, &names)
-    }
+            .collect(),
+    )
+}
 
-    /// Logging `on` or off for the named categories (all of them when none
-    /// is named); an unknown name is an Error naming the known ones.
-    fn set_categories(&mut self, on: bool, categories: &[String]) -> Status {
-        if categories.is_empty() {
-            self.categories = [on; 4];
-            return Status::Ok;
-        }
-        for c in categories {
-            match LOG_CATEGORIES.iter().position(|(n, _)| n == c) {
-                Some(k) => self.categories[k] = on,
-                None => {
-                    let allowed: Vec<_> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
-                    return self.fail(&format!(
-                        "unknown log category `{c}`; allowed: {}",
-                        allowed.join(", ")
-                    ));
-                }
+/// Turns the named categories (all of them when none is named) `on` or
+/// off in `flags`; an unknown name is an error that lists the allowed ones
+/// (and leaves the flags of the names before it set).
+pub(crate) fn set_categories(
+    flags: &mut [bool; 4],
+    on: bool,
+    names: &[String],
+) -> Result<(), String> {
+    if names.is_empty() {
+        *flags = [on; 4];
+        return Ok(());
+    }
+    for c in names {
+        match LOG_CATEGORIES.iter().position(|(n, _)| n == c) {
+            Some(k) => flags[k] = on,
+            None => {
+                let allowed: Vec<_> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
+                return Err(format!(
+                    "unknown log category `{c}`; allowed: {}",
+                    allowed.join(", ")
+                ));
             }
         }
-        Status::Ok
     }
+    Ok(())
 }

@@ -8,6 +8,7 @@ pub mod penetration;
 pub mod plate_impact;
 pub mod reference;
 pub mod registry;
+pub mod row;
 pub mod table1;
 pub mod taylor;
 pub mod taylor3d;

@@ -4,7 +4,7 @@
 
 use super::Scene;
 use super::params::{ParamSpec, Range, spec};
-use super::registry::{SceneRow, no_variants};
+use super::row::{SceneRow, no_variants};
 use crate::budget::MemoryPerNode;
 use crate::observe::NOH_OBSERVABLES;
 use crate::solver::radial::NohSolver;

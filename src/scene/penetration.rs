@@ -9,7 +9,7 @@
 
 use super::Scene;
 use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
-use super::registry::{SceneRow, no_variants};
+use super::row::{SceneRow, no_variants};
 use super::taylor3d::{RingLattice, mlpg_memory};
 use crate::approx::lattice::Cylinder;
 use crate::error::{Error, Result};
@@ -38,7 +38,7 @@ pub static ROW: SceneRow = SceneRow {
     // plate add little to the heap (docs/notes/2026-11-29-memory-bounds.md).
     memory: mlpg_memory,
     build: |s: &Scene| Ok(Box::new(penetration(s)?)),
-    fmu: Some(super::registry::FmuIdentity {
+    fmu: Some(super::row::FmuIdentity {
         model_identifier: "BallisticImpact",
         model_name: "BallisticImpact",
         description: "Ballistic penetration in 3-D: a bilinear elastoplastic projectile through a Rajendran-Grove \

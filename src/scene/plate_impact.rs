@@ -15,7 +15,7 @@
 
 use super::Scene;
 use super::params::{Level, ParamSpec, Range, concat, levels_spec, spec as row};
-use super::registry::{FmuIdentity, SceneRow, no_variants};
+use super::row::{FmuIdentity, SceneRow, no_variants};
 use crate::budget::MemoryPerNode;
 use crate::error::{Error, Result};
 use crate::material::Damage;

@@ -1,7 +1,6 @@
 //! Table 1 of Batra & Zhang (2008): the twelve House et al. (1995) Taylor tests
 //! on 4340 steel, with the experimental and the paper's MSPH results.
 
-use super::{Scene, SceneKind};
 use std::collections::BTreeMap;
 
 /// The table as shipped in `data/house1995_4340_table1.csv`.
@@ -89,42 +88,12 @@ impl Table1Row {
         }
         r
     }
-
-    /// The Taylor scene of this configuration (other parameters default).
-    pub fn scene(&self) -> Scene {
-        let mut s = Scene::default_of(SceneKind::default_of_row(&super::taylor::ROW));
-        for (name, v) in [
-            ("impact_speed", self.v),
-            ("initial_length", self.l0),
-            ("initial_diameter", self.d0),
-        ] {
-            s.set(name, v).expect("Table 1 values lie in the ranges");
-        }
-        s.title = format!(
-            "House et al. (1995) test {}: L0 = {} mm, D0 = {} mm, V = {} m/s",
-            self.test,
-            self.l0 * 1e3,
-            self.d0 * 1e3,
-            self.v
-        );
-        s.reference = self.reference();
-        s
-    }
-}
-
-/// The twelve configurations as named variants of the `taylor` scene,
-/// `table1-1` ... `table1-12`.
-pub fn variants() -> Vec<(String, Scene)> {
-    Table1Row::all()
-        .iter()
-        .enumerate()
-        .map(|(k, row)| (format!("table1-{}", k + 1), row.scene()))
-        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Scene;
 
     #[test]
     fn twelve_rows_with_test7_as_published() {

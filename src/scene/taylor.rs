@@ -11,9 +11,10 @@
 //! existed), `TaylorImpactBilinear`, `TaylorImpactMieGruneisen` and
 //! `TaylorImpactBilinearMieGruneisen`.
 
-use super::Scene;
 use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec};
-use super::registry::{FmuIdentity, MaterialSlot, SceneRow};
+use super::row::{FmuIdentity, MaterialSlot, SceneRow};
+use super::table1::Table1Row;
+use super::{Scene, SceneKind};
 use crate::budget::MemoryPerNode;
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::observe::TAYLOR_OBSERVABLES;
@@ -63,8 +64,8 @@ pub static ROW: SceneRow = SceneRow {
     }),
     observables: TAYLOR_OBSERVABLES,
     fields: crate::solver::axisymmetric::TAYLOR_FIELDS,
-    reference: || super::table1::Table1Row::all()[6].reference(),
-    variants: super::table1::variants,
+    reference: || Table1Row::all()[6].reference(),
+    variants: table1_variants,
     check: |s| {
         material_choice(s).check_consistency(Prefix::None, |n| s.get(n))?;
         TaylorParams::of(s).check_consistency()
@@ -273,6 +274,41 @@ impl TaylorParams {
         }
         Ok(())
     }
+}
+
+/// The Taylor scenes of Table 1 (written here, with the row they are
+/// variants of, so that `table1.rs` holds only the table).
+impl Table1Row {
+    /// The Taylor scene of this configuration (other parameters default).
+    pub fn scene(&self) -> Scene {
+        let mut s = Scene::default_of(SceneKind::default_of_row(&ROW));
+        for (name, v) in [
+            ("impact_speed", self.v),
+            ("initial_length", self.l0),
+            ("initial_diameter", self.d0),
+        ] {
+            s.set(name, v).expect("Table 1 values lie in the ranges");
+        }
+        s.title = format!(
+            "House et al. (1995) test {}: L0 = {} mm, D0 = {} mm, V = {} m/s",
+            self.test,
+            self.l0 * 1e3,
+            self.d0 * 1e3,
+            self.v
+        );
+        s.reference = self.reference();
+        s
+    }
+}
+
+/// The twelve configurations as named variants of the `taylor` scene,
+/// `table1-1` ... `table1-12`.
+pub fn table1_variants() -> Vec<(String, Scene)> {
+    Table1Row::all()
+        .iter()
+        .enumerate()
+        .map(|(k, row)| (format!("table1-{}", k + 1), row.scene()))
+        .collect()
 }
 
 #[cfg(test)]

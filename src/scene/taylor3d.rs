@@ -10,7 +10,7 @@
 
 use super::Scene;
 use super::params::{Level, ParamSpec, Range, choice_tables, levels_spec, param_struct};
-use super::registry::{MaterialSlot, SceneRow};
+use super::row::{MaterialSlot, SceneRow};
 use super::taylor::{BEFORE, END_TIME, TaylorParams, spec};
 use crate::approx::lattice::Cylinder;
 use crate::budget::MemoryPerNode;
@@ -50,7 +50,7 @@ pub static ROW: SceneRow = SceneRow {
         let material = material_choice(s).material(Prefix::None, |n| s.get(n))?;
         Ok(Box::new(Taylor3dParams::of(s).build_with(material)?))
     },
-    fmu: Some(super::registry::FmuIdentity {
+    fmu: Some(super::row::FmuIdentity {
         model_identifier: "Taylor3dImpact",
         model_name: "Taylor3dImpact",
         description: "Taylor rod impact on a rigid anvil in 3-D: the MLPG mixed method (Han, Liu, Rajendran & Atluri) \
