@@ -58,31 +58,11 @@ impl NamedPairs {
 /// passes them.
 const PRE_TEST_MARGIN: f64 = 1e-9;
 
-impl Mlpg3d {
-    /// The smallest current distance between a node and one it names.
-    pub(super) fn nearest_distance(&self) -> f64 {
-        let sup = self.supports();
-        let mut buf = Vec::new();
-        let pos = extended(self.mirror(), &self.state.pos, &mut buf, mirror::vector);
-        (0..self.state.pos.len())
-            .into_par_iter()
-            .map(|i| {
-                sup.named
-                    .of(i)
-                    .iter()
-                    .map(|&j| distance(&pos[i], &pos[j]))
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect::<Vec<f64>>()
-            .into_iter()
-            .fold(f64::INFINITY, f64::min)
-    }
-
+impl Pipeline3d {
     /// The mirror images of the last computation of the supports (none
     /// for the whole body).
     pub(super) fn mirror(&self) -> &Mirror {
         &self
-            .pipe
             .geometry
             .as_ref()
             .expect("the geometry is built before use")
@@ -90,242 +70,268 @@ impl Mlpg3d {
     }
 
     pub(super) fn supports(&self) -> &Supports {
-        self.pipe
-            .geometry
+        self.geometry
             .as_ref()
             .and_then(|g| g.supports.as_ref())
             .expect("the geometry is built before use")
     }
+}
 
-    /// Rebuilds the geometry at `built_at` (and the supports at
-    /// `supports_at` when `supports` is true or none exist).
-    pub(super) fn build_geometry(&mut self, supports: bool) -> Result<()> {
-        let time = self.state.clock.time;
-        let stamp = |e: Error| at_time(e, time);
-        let mut watch = self.pipe.profile.stopwatch();
-        let mut g = self.pipe.geometry.take().unwrap_or_default();
-        // The old traction operator goes before the new is built; the
-        // shapes and the nodal operator are rebuilt in their own buffers.
-        // They are most of the heap (BENCHMARKS.md, memory).
-        g.op = TractionOperator::default();
-        let n = self.state.pos.len();
-        if supports || g.supports.is_none() {
-            let (sup, mirror) = self.supports_with_images().map_err(stamp)?;
-            g.supports = Some(sup);
-            g.mirror = mirror;
-            self.pipe.profile.supports += 1;
-        }
-        self.pipe.profile.lap(Phase::Supports, &mut watch);
-        let sup = g.supports.as_ref().expect("computed above");
-        let mut buf = Vec::new();
-        let pts = extended(&g.mirror, &self.state.built_at, &mut buf, mirror::vector);
-        g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
-        self.pipe.profile.lap(Phase::Shapes, &mut watch);
-        if self.setup.rod.scheme.forces == Forces::Conforming {
-            let volume: Vec<f64> = (0..n)
-                .map(|i| self.setup.mass[i] / self.state.built_rho[i])
-                .collect();
-            let inner: Vec<bool> = self
-                .setup
-                .lattice
-                .surfaces
+/// The smallest current distance between a node and one it names.
+pub(super) fn nearest_distance(state: &State3d, pipe: &Pipeline3d) -> f64 {
+    let sup = pipe.supports();
+    let mut buf = Vec::new();
+    let pos = extended(pipe.mirror(), &state.pos, &mut buf, mirror::vector);
+    (0..state.pos.len())
+        .into_par_iter()
+        .map(|i| {
+            sup.named
+                .of(i)
                 .iter()
-                .map(|s| s.interior())
-                .collect();
-            // The start: the last build's multipliers in this process, or
-            // the saved start of a restored run's last build.
-            if !g.multipliers.is_empty() {
-                self.state.built_multipliers.clone_from(&g.multipliers);
-            }
-            g.multipliers.clone_from(&self.state.built_multipliers);
-            let c = conform(
-                self.pipe.isa,
-                &mut g.shapes,
-                pts,
-                &volume,
-                &inner,
-                CONFORM_TOLERANCE,
-                &mut g.multipliers,
-            );
-            self.pipe.profile.conform_iterations += c.iterations as u64;
-        }
-        self.pipe.profile.lap(Phase::Conform, &mut watch);
-        match self.setup.rod.scheme.forces {
-            Forces::Sphere => {
-                g.spheres = self.spheres(pts, &g.mirror, sup, &g.shapes);
-                self.pipe.profile.lap(Phase::Spheres, &mut watch);
-                g.op = TractionOperator::build(
-                    self.pipe.isa,
-                    pts,
-                    sup,
-                    &g.spheres,
-                    &SphereRule::of(DEFAULT_RULE),
-                    &SphereRule::of(BOUNDARY_RULE),
-                )
-                .map_err(stamp)?;
-            }
-            Forces::Nodal | Forces::Conforming => {
-                g.spheres.clear();
-            }
-        }
-        if self.setup.rod.scheme.forces.nodal()
-            || self.setup.rod.scheme.order == SmoothingOrder::Two
-        {
-            g.nodal.rebuild(&g.shapes, pts.len());
-        } else {
-            g.nodal = NodalOperator::default();
-        }
-        self.pipe.profile.lap(Phase::Operator, &mut watch);
-        self.pipe.profile.operators += 1;
-        self.pipe.geometry = Some(g);
-        self.state.rebuilds += 1;
-        Ok(())
-    }
+                .map(|&j| distance(&pos[i], &pos[j]))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect::<Vec<f64>>()
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+}
 
-    /// The supports at `supports_at` and, in the quarter model, the mirror
-    /// images they take (`src/approx/mirror.rs`). An image can matter to a real
-    /// row only if it is among the `k` nearest of a real node (within the
-    /// largest `k`-th distance `d_k` of the plane) or covers a point of a
-    /// real node's test sphere (within `r_J + d_k` of the quarter, the test
-    /// radius being below the nearest distance); so the supports are
-    /// computed with the images within a layer of the planes at least as
-    /// wide as the largest `r_J + d_k` (from six spacings, widened until
-    /// it is), and the images farther than their `r_J + d_k` are then
-    /// dropped: the rows are the same.
-    pub(super) fn supports_with_images(&self) -> Result<(Supports, Mirror)> {
-        let n = self.state.pos.len();
-        let at = &self.state.supports_at;
-        if self.setup.plane.is_empty() {
-            let sup = Supports::compute_grouped(at, &self.setup.group, SupportParams::default())?;
-            return Ok((sup, Mirror::default()));
-        }
-        let mut layer = 6.0 * self.setup.reach;
-        let (mut sup, m, dk) = loop {
-            let m = Mirror::choose(at, &self.setup.plane, layer);
-            let (mut pts, mut group) = (Vec::new(), Vec::new());
-            m.extend(at, &mut pts, mirror::vector);
-            if !self.setup.group.is_empty() {
-                m.extend(&self.setup.group, &mut group, mirror::same);
-            }
-            let mut sup = Supports::compute_rows(&pts, &group, n, SupportParams::default())?;
-            // A node's radius covers what its images' do (their namers are
-            // the images of its own), and its images have its radius.
-            for (k, &j) in m.source.iter().enumerate() {
-                sup.radius[j] = sup.radius[j].max(sup.radius[n + k]);
-            }
-            for (k, &j) in m.source.iter().enumerate() {
-                sup.radius[n + k] = sup.radius[j];
-            }
-            let widest = sup.radius[..n].iter().copied().fold(0.0, f64::max);
-            let dk = sup.named_distance.iter().copied().fold(0.0, f64::max);
-            if !(widest + dk).is_finite() {
-                // Only positions that overflow get here: never grow for ever.
-                return Err(Error::NonFinite {
-                    field: "support radius",
-                    particle: sup.radius.iter().position(|r| !r.is_finite()).unwrap_or(0),
-                    time: self.state.clock.time,
-                });
-            }
-            if widest + dk < layer {
-                break (sup, m, dk);
-            }
-            layer = 1.25 * (widest + dk);
-        };
-        // Drop the images that no real row can see.
-        let at_ext = |k: usize| mirror::vector(&at[m.source[k]], m.flip[k]);
-        let keep: Vec<bool> = (0..m.len())
-            .map(|k| {
-                let x = at_ext(k);
-                // Distance to the quarter x ≥ 0, y ≥ 0.
-                let d = (x[0].min(0.0).powi(2) + x[1].min(0.0).powi(2)).sqrt();
-                d < sup.radius[n + k] + dk
-            })
+/// Rebuilds the geometry of the pipeline at the state's `built_at`
+/// (and the supports at `supports_at` when `supports` is true or none
+/// exist); records the build in the state (`rebuilds`, the multipliers
+/// the conforming correction started from).
+pub(super) fn build_geometry(
+    setup: &Setup3d,
+    state: &mut State3d,
+    pipe: &mut Pipeline3d,
+    supports: bool,
+) -> Result<()> {
+    let time = state.clock.time;
+    let stamp = |e: Error| at_time(e, time);
+    let mut watch = pipe.profile.stopwatch();
+    let mut g = pipe.geometry.take().unwrap_or_default();
+    // The old traction operator goes before the new is built; the
+    // shapes and the nodal operator are rebuilt in their own buffers.
+    // They are most of the heap (BENCHMARKS.md, memory).
+    g.op = TractionOperator::default();
+    let n = state.pos.len();
+    if supports || g.supports.is_none() {
+        let (sup, mirror) = supports_with_images(setup, state).map_err(stamp)?;
+        g.supports = Some(sup);
+        g.mirror = mirror;
+        pipe.profile.supports += 1;
+    }
+    pipe.profile.lap(Phase::Supports, &mut watch);
+    let sup = g.supports.as_ref().expect("computed above");
+    let mut buf = Vec::new();
+    let pts = extended(&g.mirror, &state.built_at, &mut buf, mirror::vector);
+    g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
+    pipe.profile.lap(Phase::Shapes, &mut watch);
+    if setup.rod.scheme.forces == Forces::Conforming {
+        let volume: Vec<f64> = (0..n).map(|i| setup.mass[i] / state.built_rho[i]).collect();
+        let inner: Vec<bool> = setup
+            .lattice
+            .surfaces
+            .iter()
+            .map(|s| s.interior())
             .collect();
-        let mut index: Vec<usize> = (0..n).collect();
-        let mut kept = Mirror::default();
-        for (k, &keep) in keep.iter().enumerate() {
-            if keep {
-                index.push(n + kept.len());
-                kept.source.push(m.source[k]);
-                kept.flip.push(m.flip[k]);
-            } else {
-                index.push(usize::MAX);
-            }
+        // The start: the last build's multipliers in this process, or
+        // the saved start of a restored run's last build.
+        if !g.multipliers.is_empty() {
+            state.built_multipliers.clone_from(&g.multipliers);
         }
-        for j in &mut sup.named.indices {
-            *j = index[*j];
-            debug_assert!(*j != usize::MAX, "a named image is kept");
-        }
-        /// The entries of the kept nodes.
-        fn compact<T: Copy>(v: &[T], index: &[usize]) -> Vec<T> {
-            v.iter()
-                .zip(index)
-                .filter(|(_, i)| **i != usize::MAX)
-                .map(|(x, _)| *x)
-                .collect()
-        }
-        sup.radius = compact(&sup.radius, &index);
-        if !sup.group.is_empty() {
-            sup.group = compact(&sup.group, &index);
-        }
-        Ok((sup, kept))
-    }
-
-    /// One pass over the named pairs at the current positions `x` (the
-    /// positions at the last build `b`; both the real nodes', then their
-    /// images'): the smallest distance (the spacing check), whether a pair
-    /// has left the range of [`Supports::recompute_reason`] (the supports
-    /// are recomputed), and whether a pair has moved since the last build
-    /// by more than [`RodSetup::rebuild_strain`] of its length then
-    /// ([`REBUILD_STRAIN`]). Minima and "any"s: the same for any number of
-    /// threads.
-    ///
-    /// The two tests compare squares first, with a margin
-    /// ([`PRE_TEST_MARGIN`]): only a pair near a bound (or one with a
-    /// non-finite position) takes the exact test's square root and
-    /// division, so the answers are the exact tests' (the smallest
-    /// distance is the root of the smallest square: the root is monotone
-    /// and correctly rounded).
-    pub(super) fn named_pairs(&self, x: &[[f64; 3]], b: &[[f64; 3]]) -> NamedPairs {
-        let sup = self.supports();
-        let limit = 0.5 * (1.0 + sup.params.factor);
-        let rebuild = self.setup.rod.rebuild_strain;
-        let (within, beyond) = (
-            limit * limit * (1.0 - PRE_TEST_MARGIN),
-            (1.0 + PRE_TEST_MARGIN) / (limit * limit),
+        g.multipliers.clone_from(&state.built_multipliers);
+        let c = conform(
+            pipe.isa,
+            &mut g.shapes,
+            pts,
+            &volume,
+            &inner,
+            CONFORM_TOLERANCE,
+            &mut g.multipliers,
         );
-        let still = rebuild * rebuild * (1.0 - PRE_TEST_MARGIN);
-        let dot = |a: [f64; 3]| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        let pairs = (0..self.state.pos.len())
-            .into_par_iter()
-            .map(|i| {
-                let lo = sup.named.offsets[i];
-                let mut out = NamedPairs::NONE;
-                for (q, &j) in sup.named.of(i).iter().enumerate() {
-                    let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
-                    let d2 = dot(now);
-                    out.nearest = out.nearest.min(d2);
-                    let named = sup.named_distance[lo + q];
-                    let n2 = named * named;
-                    // Inside the squared bounds (false for a NaN).
-                    let inside = d2 <= within * n2 && d2 >= beyond * n2;
-                    if !out.recompute && !inside {
-                        let ratio = distance(&x[i], &x[j]) / named;
-                        out.recompute = ratio > limit || ratio < 1.0 / limit;
-                    }
-                    let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
-                    let moved: [f64; 3] = std::array::from_fn(|d| now[d] - then[d]);
-                    let small = dot(moved) <= still * dot(then);
-                    if !out.strained && !small {
-                        out.strained = norm(moved) / norm(then) > rebuild;
-                    }
-                }
-                out
-            })
-            .reduce(|| NamedPairs::NONE, NamedPairs::join);
-        NamedPairs {
-            nearest: pairs.nearest.sqrt(),
-            ..pairs
+        pipe.profile.conform_iterations += c.iterations as u64;
+    }
+    pipe.profile.lap(Phase::Conform, &mut watch);
+    match setup.rod.scheme.forces {
+        Forces::Sphere => {
+            g.spheres = spheres::spheres(setup, state, pts, &g.mirror, sup, &g.shapes);
+            pipe.profile.lap(Phase::Spheres, &mut watch);
+            g.op = TractionOperator::build(
+                pipe.isa,
+                pts,
+                sup,
+                &g.spheres,
+                &SphereRule::of(DEFAULT_RULE),
+                &SphereRule::of(BOUNDARY_RULE),
+            )
+            .map_err(stamp)?;
         }
+        Forces::Nodal | Forces::Conforming => {
+            g.spheres.clear();
+        }
+    }
+    if setup.rod.scheme.forces.nodal() || setup.rod.scheme.order == SmoothingOrder::Two {
+        g.nodal.rebuild(&g.shapes, pts.len());
+    } else {
+        g.nodal = NodalOperator::default();
+    }
+    pipe.profile.lap(Phase::Operator, &mut watch);
+    pipe.profile.operators += 1;
+    pipe.geometry = Some(g);
+    state.rebuilds += 1;
+    Ok(())
+}
+
+/// The supports at `supports_at` and, in the quarter model, the mirror
+/// images they take (`src/approx/mirror.rs`). An image can matter to a real
+/// row only if it is among the `k` nearest of a real node (within the
+/// largest `k`-th distance `d_k` of the plane) or covers a point of a
+/// real node's test sphere (within `r_J + d_k` of the quarter, the test
+/// radius being below the nearest distance); so the supports are
+/// computed with the images within a layer of the planes at least as
+/// wide as the largest `r_J + d_k` (from six spacings, widened until
+/// it is), and the images farther than their `r_J + d_k` are then
+/// dropped: the rows are the same.
+pub(super) fn supports_with_images(setup: &Setup3d, state: &State3d) -> Result<(Supports, Mirror)> {
+    let n = state.pos.len();
+    let at = &state.supports_at;
+    if setup.plane.is_empty() {
+        let sup = Supports::compute_grouped(at, &setup.group, SupportParams::default())?;
+        return Ok((sup, Mirror::default()));
+    }
+    let mut layer = 6.0 * setup.reach;
+    let (mut sup, m, dk) = loop {
+        let m = Mirror::choose(at, &setup.plane, layer);
+        let (mut pts, mut group) = (Vec::new(), Vec::new());
+        m.extend(at, &mut pts, mirror::vector);
+        if !setup.group.is_empty() {
+            m.extend(&setup.group, &mut group, mirror::same);
+        }
+        let mut sup = Supports::compute_rows(&pts, &group, n, SupportParams::default())?;
+        // A node's radius covers what its images' do (their namers are
+        // the images of its own), and its images have its radius.
+        for (k, &j) in m.source.iter().enumerate() {
+            sup.radius[j] = sup.radius[j].max(sup.radius[n + k]);
+        }
+        for (k, &j) in m.source.iter().enumerate() {
+            sup.radius[n + k] = sup.radius[j];
+        }
+        let widest = sup.radius[..n].iter().copied().fold(0.0, f64::max);
+        let dk = sup.named_distance.iter().copied().fold(0.0, f64::max);
+        if !(widest + dk).is_finite() {
+            // Only positions that overflow get here: never grow for ever.
+            return Err(Error::NonFinite {
+                field: "support radius",
+                particle: sup.radius.iter().position(|r| !r.is_finite()).unwrap_or(0),
+                time: state.clock.time,
+            });
+        }
+        if widest + dk < layer {
+            break (sup, m, dk);
+        }
+        layer = 1.25 * (widest + dk);
+    };
+    // Drop the images that no real row can see.
+    let at_ext = |k: usize| mirror::vector(&at[m.source[k]], m.flip[k]);
+    let keep: Vec<bool> = (0..m.len())
+        .map(|k| {
+            let x = at_ext(k);
+            // Distance to the quarter x ≥ 0, y ≥ 0.
+            let d = (x[0].min(0.0).powi(2) + x[1].min(0.0).powi(2)).sqrt();
+            d < sup.radius[n + k] + dk
+        })
+        .collect();
+    let mut index: Vec<usize> = (0..n).collect();
+    let mut kept = Mirror::default();
+    for (k, &keep) in keep.iter().enumerate() {
+        if keep {
+            index.push(n + kept.len());
+            kept.source.push(m.source[k]);
+            kept.flip.push(m.flip[k]);
+        } else {
+            index.push(usize::MAX);
+        }
+    }
+    for j in &mut sup.named.indices {
+        *j = index[*j];
+        debug_assert!(*j != usize::MAX, "a named image is kept");
+    }
+    /// The entries of the kept nodes.
+    fn compact<T: Copy>(v: &[T], index: &[usize]) -> Vec<T> {
+        v.iter()
+            .zip(index)
+            .filter(|(_, i)| **i != usize::MAX)
+            .map(|(x, _)| *x)
+            .collect()
+    }
+    sup.radius = compact(&sup.radius, &index);
+    if !sup.group.is_empty() {
+        sup.group = compact(&sup.group, &index);
+    }
+    Ok((sup, kept))
+}
+
+/// One pass over the named pairs at the current positions `x` (the
+/// positions at the last build `b`; both the real nodes', then their
+/// images'): the smallest distance (the spacing check), whether a pair
+/// has left the range of [`Supports::recompute_reason`] (the supports
+/// are recomputed), and whether a pair has moved since the last build
+/// by more than [`RodSetup::rebuild_strain`] of its length then
+/// ([`REBUILD_STRAIN`]). Minima and "any"s: the same for any number of
+/// threads.
+///
+/// The two tests compare squares first, with a margin
+/// ([`PRE_TEST_MARGIN`]): only a pair near a bound (or one with a
+/// non-finite position) takes the exact test's square root and
+/// division, so the answers are the exact tests' (the smallest
+/// distance is the root of the smallest square: the root is monotone
+/// and correctly rounded).
+pub(super) fn named_pairs(
+    setup: &Setup3d,
+    state: &State3d,
+    pipe: &Pipeline3d,
+    x: &[[f64; 3]],
+    b: &[[f64; 3]],
+) -> NamedPairs {
+    let sup = pipe.supports();
+    let limit = 0.5 * (1.0 + sup.params.factor);
+    let rebuild = setup.rod.rebuild_strain;
+    let (within, beyond) = (
+        limit * limit * (1.0 - PRE_TEST_MARGIN),
+        (1.0 + PRE_TEST_MARGIN) / (limit * limit),
+    );
+    let still = rebuild * rebuild * (1.0 - PRE_TEST_MARGIN);
+    let dot = |a: [f64; 3]| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    let pairs = (0..state.pos.len())
+        .into_par_iter()
+        .map(|i| {
+            let lo = sup.named.offsets[i];
+            let mut out = NamedPairs::NONE;
+            for (q, &j) in sup.named.of(i).iter().enumerate() {
+                let now: [f64; 3] = std::array::from_fn(|d| x[i][d] - x[j][d]);
+                let d2 = dot(now);
+                out.nearest = out.nearest.min(d2);
+                let named = sup.named_distance[lo + q];
+                let n2 = named * named;
+                // Inside the squared bounds (false for a NaN).
+                let inside = d2 <= within * n2 && d2 >= beyond * n2;
+                if !out.recompute && !inside {
+                    let ratio = distance(&x[i], &x[j]) / named;
+                    out.recompute = ratio > limit || ratio < 1.0 / limit;
+                }
+                let then: [f64; 3] = std::array::from_fn(|d| b[i][d] - b[j][d]);
+                let moved: [f64; 3] = std::array::from_fn(|d| now[d] - then[d]);
+                let small = dot(moved) <= still * dot(then);
+                if !out.strained && !small {
+                    out.strained = norm(moved) / norm(then) > rebuild;
+                }
+            }
+            out
+        })
+        .reduce(|| NamedPairs::NONE, NamedPairs::join);
+    NamedPairs {
+        nearest: pairs.nearest.sqrt(),
+        ..pairs
     }
 }

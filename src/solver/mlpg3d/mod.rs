@@ -436,8 +436,8 @@ impl Mlpg3d {
             },
             pipe: Pipeline3d::default(),
         };
-        s.build_geometry(true)?;
-        s.setup.d_min0 = s.nearest_distance();
+        geometry::build_geometry(&s.setup, &mut s.state, &mut s.pipe, true)?;
+        s.setup.d_min0 = geometry::nearest_distance(&s.state, &s.pipe);
         let cp = s.wave_speed();
         check_derived("wave speed", cp, " m/s")?;
         s.setup.damping_time = 2.0 * setup.damping * s.setup.d_min0 / (setup.omega_factor() * cp);
@@ -490,7 +490,7 @@ impl Mlpg3d {
     pub fn step(&mut self) -> Result<()> {
         if self.pipe.geometry.is_none() {
             let fresh = self.state.supports_at == self.state.built_at;
-            self.build_geometry(fresh)?;
+            geometry::build_geometry(&self.setup, &mut self.state, &mut self.pipe, fresh)?;
             self.state.rebuilds -= 1;
         }
         let n = self.particles();

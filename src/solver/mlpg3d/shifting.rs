@@ -6,106 +6,103 @@ use super::scratch::{ImageBuffers, ShiftBuffers};
 use super::*;
 use crate::material::PointState;
 
-impl Mlpg3d {
-    /// Node shifting ([`super::shift`]): pushes apart the pairs closer than
-    /// [`SHIFT_RANGE`] of the initial spacing and carries the fields of the
-    /// moved nodes to their new places with the shapes of the last build.
-    /// An interior node on the anvil moves in its plane. With the sphere
-    /// form the surfaces (face, mantle, top) stay put (measured: letting
-    /// the surface nodes move in their tangent planes, the face nodes on
-    /// the anvil in its plane, made the Wilkins bar in 3-D stop earlier,
-    /// EnergyDrift at 44.7 µs against 55.6 µs); with the nodal form, which
-    /// has no test sphere to cut, a node of the mantle alone moves in the
-    /// mantle's tangent plane (its Nanson normal, as the sphere form's cut
-    /// planes) and a face node held on the anvil in the anvil's plane, while
-    /// edges, the top and the free face stay put (measured: with the mantle
-    /// fixed, two mantle nodes of the Wilkins bar's bulge close to the
-    /// guard at 59.6 µs; README, "3-D MLPG mixed method"). The moved nodes
-    /// take their stress, density, plastic strain, temperature and
-    /// reference place by [`carry`], and their velocities by [`carry`] or,
-    /// with [`RodSetup::conservative_carry`], by [`exchange`] (the momentum
-    /// drawn from the nodes around). The kinetic energy the carrying
-    /// changes is booked with the smoothing. Fails with the compression
-    /// limit of the equation of state at a moved node.
-    pub(super) fn shift(&mut self, scratch: &mut Scratch) -> Result<()> {
-        let g = self.pipe.geometry.as_ref().expect("built before the step");
-        let frame = ShiftFrame {
-            geometry: g,
-            spacing: self.setup.d_min0,
-            anvil: self.setup.anvil,
-            nodal: self.setup.rod.scheme.forces.nodal(),
-            surfaces: &self.setup.lattice.surfaces,
-            contact: &self.state.contact,
-            plane: &self.setup.plane,
-            held: &self.setup.held,
-            mass: &self.setup.mass,
-            points: self.state.material_state.points(),
-            materials: (&self.setup.material, &self.setup.others, &self.setup.group),
-            time: self.state.clock.time,
-        };
-        let (buffers, ext) = (&mut scratch.shifting, &mut scratch.images);
-        let images = &g.mirror;
-        let reference = extended(
-            images,
-            &self.state.reference,
-            &mut ext.built,
-            mirror::vector,
-        );
-        freedoms(&frame, reference, &mut buffers.free);
-        let pos = extended(images, &self.state.pos, &mut ext.pos, mirror::vector);
-        let (spacing, step_scale) = (frame.spacing, self.setup.rod.step_scale());
-        shifts(
-            pos,
-            &g.shapes,
-            &buffers.free,
-            spacing,
-            SHIFT_RANGE * spacing,
-            self.setup.rod.scheme.shifting * step_scale,
-            SHIFT_CAP * spacing * step_scale,
-            &mut buffers.shift,
-        );
-        // A node on a symmetry plane moves in it; a held node stays.
-        for (d, &on) in buffers.shift.iter_mut().zip(frame.plane) {
-            pin(d, on);
-        }
-        for (d, _) in buffers
-            .shift
-            .iter_mut()
-            .zip(frame.held)
-            .filter(|(_, h)| **h)
-        {
-            *d = [0.0; 3];
-        }
-        if buffers.shift.iter().all(|d| *d == [0.0; 3]) {
-            return Ok(());
-        }
-        let mut fields = ShiftedFields {
-            pos: &mut self.state.pos,
-            vel: &mut self.state.vel,
-            dev: &mut self.state.dev,
-            pressure: &mut self.state.pressure,
-            rho: &mut self.state.rho,
-            eps_p: &mut self.state.eps_p,
-            temp: &mut self.state.temp,
-            reference: &mut self.state.reference,
-        };
-        pack(&fields, &mut buffers.carried);
-        let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
-        carry(&g.shapes, carried, &buffers.shift, &mut buffers.carried_out);
-        let conservative = self.setup.rod.conservative_carry;
-        let mut ke = [0.0; 2];
-        if conservative {
-            ke[0] = kinetic(fields.vel, frame.mass);
-            exchange_velocities(&frame, fields.vel, buffers, ext);
-        }
-        unpack(&frame, &mut fields, buffers, conservative, &mut ke)?;
-        if conservative {
-            ke[1] = kinetic(fields.vel, frame.mass);
-        }
-        self.state.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
-        self.state.shift_dissipation += ke[0] - ke[1];
-        Ok(())
+/// Node shifting ([`super::shift`]): pushes apart the pairs closer than
+/// [`SHIFT_RANGE`] of the initial spacing and carries the fields of the
+/// moved nodes to their new places with the shapes of the last build.
+/// An interior node on the anvil moves in its plane. With the sphere
+/// form the surfaces (face, mantle, top) stay put (measured: letting
+/// the surface nodes move in their tangent planes, the face nodes on
+/// the anvil in its plane, made the Wilkins bar in 3-D stop earlier,
+/// EnergyDrift at 44.7 µs against 55.6 µs); with the nodal form, which
+/// has no test sphere to cut, a node of the mantle alone moves in the
+/// mantle's tangent plane (its Nanson normal, as the sphere form's cut
+/// planes) and a face node held on the anvil in the anvil's plane, while
+/// edges, the top and the free face stay put (measured: with the mantle
+/// fixed, two mantle nodes of the Wilkins bar's bulge close to the
+/// guard at 59.6 µs; README, "3-D MLPG mixed method"). The moved nodes
+/// take their stress, density, plastic strain, temperature and
+/// reference place by [`carry`], and their velocities by [`carry`] or,
+/// with [`RodSetup::conservative_carry`], by [`exchange`] (the momentum
+/// drawn from the nodes around). The kinetic energy the carrying
+/// changes is booked with the smoothing. Fails with the compression
+/// limit of the equation of state at a moved node.
+pub(super) fn shift(
+    setup: &Setup3d,
+    state: &mut State3d,
+    g: &Geometry,
+    scratch: &mut Scratch,
+) -> Result<()> {
+    let frame = ShiftFrame {
+        geometry: g,
+        spacing: setup.d_min0,
+        anvil: setup.anvil,
+        nodal: setup.rod.scheme.forces.nodal(),
+        surfaces: &setup.lattice.surfaces,
+        contact: &state.contact,
+        plane: &setup.plane,
+        held: &setup.held,
+        mass: &setup.mass,
+        points: state.material_state.points(),
+        materials: (&setup.material, &setup.others, &setup.group),
+        time: state.clock.time,
+    };
+    let (buffers, ext) = (&mut scratch.shifting, &mut scratch.images);
+    let images = &g.mirror;
+    let reference = extended(images, &state.reference, &mut ext.built, mirror::vector);
+    freedoms(&frame, reference, &mut buffers.free);
+    let pos = extended(images, &state.pos, &mut ext.pos, mirror::vector);
+    let (spacing, step_scale) = (frame.spacing, setup.rod.step_scale());
+    shifts(
+        pos,
+        &g.shapes,
+        &buffers.free,
+        spacing,
+        SHIFT_RANGE * spacing,
+        setup.rod.scheme.shifting * step_scale,
+        SHIFT_CAP * spacing * step_scale,
+        &mut buffers.shift,
+    );
+    // A node on a symmetry plane moves in it; a held node stays.
+    for (d, &on) in buffers.shift.iter_mut().zip(frame.plane) {
+        pin(d, on);
     }
+    for (d, _) in buffers
+        .shift
+        .iter_mut()
+        .zip(frame.held)
+        .filter(|(_, h)| **h)
+    {
+        *d = [0.0; 3];
+    }
+    if buffers.shift.iter().all(|d| *d == [0.0; 3]) {
+        return Ok(());
+    }
+    let mut fields = ShiftedFields {
+        pos: &mut state.pos,
+        vel: &mut state.vel,
+        dev: &mut state.dev,
+        pressure: &mut state.pressure,
+        rho: &mut state.rho,
+        eps_p: &mut state.eps_p,
+        temp: &mut state.temp,
+        reference: &mut state.reference,
+    };
+    pack(&fields, &mut buffers.carried);
+    let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
+    carry(&g.shapes, carried, &buffers.shift, &mut buffers.carried_out);
+    let conservative = setup.rod.conservative_carry;
+    let mut ke = [0.0; 2];
+    if conservative {
+        ke[0] = kinetic(fields.vel, frame.mass);
+        exchange_velocities(&frame, fields.vel, buffers, ext);
+    }
+    unpack(&frame, &mut fields, buffers, conservative, &mut ke)?;
+    if conservative {
+        ke[1] = kinetic(fields.vel, frame.mass);
+    }
+    state.energy.lost[LOST_SMOOTHING] += ke[0] - ke[1];
+    state.shift_dissipation += ke[0] - ke[1];
+    Ok(())
 }
 
 /// What the shifting reads and does not write.

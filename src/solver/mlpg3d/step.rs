@@ -106,7 +106,8 @@ impl Mlpg3d {
         motion::check_planes(&self.state.pos, &self.setup.plane, self.state.clock.time)?;
         self.pipe.profile.lap(Phase::Move, &mut watch);
         if self.setup.rod.scheme.shifting > 0.0 {
-            self.shift(scratch)?;
+            let g = self.pipe.geometry.as_ref().expect("built before the step");
+            shifting::shift(&self.setup, &mut self.state, g, scratch)?;
         }
         self.pipe.profile.lap(Phase::Shift, &mut watch);
         // 4. The geometry follows the body.
@@ -173,7 +174,7 @@ impl Mlpg3d {
             &mut scratch.images.built,
             mirror::vector,
         );
-        let pairs = self.named_pairs(x, b);
+        let pairs = geometry::named_pairs(&self.setup, &self.state, &self.pipe, x, b);
         self.pipe.profile.lap(Phase::Pairs, watch);
         let d_min = pairs.nearest;
         let ratio = d_min / self.setup.d_min0;
@@ -188,7 +189,7 @@ impl Mlpg3d {
             self.state.built_reference.clone_from(&self.state.reference);
             self.state.built_contact.clone_from(&self.state.contact);
             self.state.built_rho.clone_from(&self.state.rho);
-            self.build_geometry(supports)?;
+            geometry::build_geometry(&self.setup, &mut self.state, &mut self.pipe, supports)?;
             *watch = self.pipe.profile.stopwatch();
         }
         Ok(d_min)

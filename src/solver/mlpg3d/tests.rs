@@ -128,7 +128,8 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             let mut scratch = std::mem::take(&mut run.pipe.scratch);
             scratch.fit(n);
             scratch.fit_shift(n);
-            run.shift(&mut scratch).unwrap();
+            let g = run.pipe.geometry.as_ref().unwrap();
+            super::shifting::shift(&run.setup, &mut run.state, g, &mut scratch).unwrap();
             let moved = (0..n).filter(|&i| run.state.pos[i] != pos0[i]).count();
             assert!(moved >= 3, "{moved} nodes moved");
             let (p1, _) = momentum(&run);
