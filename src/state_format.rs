@@ -76,18 +76,15 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
                     ("quiet_since", Value::Null),
                 ],
             );
-            // The setup follows from the scene: its digest stays.
-            let keys = [
+            // The setup follows from the scene: the digest of what it is
+            // made from stays.
+            let made_from = parts(state, &["p", "material"])?;
+            for key in [
                 "p", "material", "nr", "nz", "h", "r0", "mass", "mantle", "top", "face",
-            ];
-            let mut setup = Map::new();
-            for key in keys {
-                setup.insert(key.to_string(), take(state, key)?);
+            ] {
+                take(state, key)?;
             }
-            state.insert(
-                "setup_digest".into(),
-                Value::from(digest_json(&Value::Object(setup))),
-            );
+            state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
             clock(state)?;
             energy(
                 state,
@@ -97,15 +94,13 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
             )
         }
         "Noh" => {
-            // The setup follows from the scene: its digest stays.
-            let mut setup = Map::new();
+            // The setup follows from the scene: the digest of what it is
+            // made from stays.
+            let made_from = parts(state, &["p", "gas"])?;
             for key in ["p", "gas", "h", "mass"] {
-                setup.insert(key.to_string(), take(state, key)?);
+                take(state, key)?;
             }
-            state.insert(
-                "setup_digest".into(),
-                Value::from(digest_json(&Value::Object(setup))),
-            );
+            state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
             clock(state)?;
             energy(state, "initial_energy", None, &[])
         }
@@ -117,7 +112,10 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
             state.insert("specific_energy".into(), energies);
             let cells = take(state, "state")?;
             state.insert("cells".into(), cells);
-            let mut setup = Map::new();
+            let made_from = parts(
+                state,
+                &["layers", "flyer_cells", "impact_speed", "end_time"],
+            )?;
             for key in [
                 "layers",
                 "flyer_cells",
@@ -127,12 +125,9 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
                 "density0",
                 "end_time",
             ] {
-                setup.insert(key.to_string(), take(state, key)?);
+                take(state, key)?;
             }
-            state.insert(
-                "setup_digest".into(),
-                Value::from(digest_json(&Value::Object(setup))),
-            );
+            state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
             clock(state)?;
             energy(state, "initial_kinetic", None, &["contact_loss"])
         }
@@ -161,6 +156,21 @@ fn defaults(state: &mut Map<String, Value>, defaults: &[(&str, Value)]) {
             .entry(key.to_string())
             .or_insert_with(|| value.clone());
     }
+}
+
+/// The values of `keys` in `state`, in that order, as one JSON array: what
+/// a solver's setup is made from, whose digest a state of format 2 carries
+/// (the solvers take it of the same values as a tuple).
+fn parts(state: &Map<String, Value>, keys: &[&str]) -> Result<Value, String> {
+    keys.iter()
+        .map(|key| {
+            state
+                .get(*key)
+                .cloned()
+                .ok_or_else(|| format!("its solver has no {key}"))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Value::Array)
 }
 
 /// Moves `key` out of `state`, or says that it is missing.
@@ -227,9 +237,10 @@ const MLPG_SETUP: &[&str] = &[
 ];
 
 /// The 3-D solver's state of format 1 in format 2: the setup dropped (it
-/// follows from the scene) and its digest kept, taken as format 2 takes
-/// it (the rod's setup under `rod`, its scheme typed); the clock and the
-/// energy book gathered.
+/// follows from the scene) and the digest of what it is made from kept,
+/// taken as format 2 takes it (the rod's setup with its scheme typed, the
+/// material, the further bodies, the anvil); the clock and the energy book
+/// gathered.
 fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
     let empty = || Value::Array(Vec::new());
     defaults(
@@ -256,19 +267,17 @@ fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
             defaults(body, &[("clamped_rim", Value::Bool(false))]);
         }
     }
-    let mut setup = Map::new();
+    let mut rod = match state.get("setup") {
+        Some(Value::Object(rod)) => rod.clone(),
+        _ => return Err("its setup is not an object".into()),
+    };
+    typed_scheme(&mut rod)?;
+    state.insert("setup".into(), Value::Object(rod));
+    let made_from = parts(state, &["setup", "material", "others", "anvil"])?;
     for key in MLPG_SETUP {
-        let value = take(state, key)?;
-        setup.insert(if *key == "setup" { "rod" } else { key }.to_string(), value);
+        take(state, key)?;
     }
-    match setup.get_mut("rod").and_then(Value::as_object_mut) {
-        Some(rod) => typed_scheme(rod)?,
-        None => return Err("its setup is not an object".into()),
-    }
-    state.insert(
-        "setup_digest".into(),
-        Value::from(digest_json(&Value::Object(setup))),
-    );
+    state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
     clock(state)?;
     energy(
         state,

@@ -105,12 +105,20 @@ pub struct NohSolver {
 
 /// What a Noh run is built from, from its scene, and never changes: the
 /// parameters, the gas, the smoothing length and the masses. Not saved.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone)]
 struct SetupNoh {
     p: NohParams,
     gas: IdealGas,
     h: f64,
     mass: Vec<f64>,
+}
+
+impl SetupNoh {
+    /// The digest of what the setup is made from, the parameters and the
+    /// gas: the smoothing length and the masses follow from them.
+    fn digest(&self) -> u64 {
+        crate::solver::shared::setup_digest(&(&self.p, &self.gas))
+    }
 }
 
 /// What a Noh run changes, and all that it saves (format 2 of
@@ -183,7 +191,7 @@ impl NohSolver {
         };
         s.state.clock = Clock::start(s.stable_dt());
         check_derived("time step", s.state.clock.dt, "")?;
-        s.state.setup_digest = crate::solver::shared::setup_digest(&s.setup);
+        s.state.setup_digest = s.setup.digest();
         Ok(s)
     }
 

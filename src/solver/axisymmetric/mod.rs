@@ -105,9 +105,8 @@ pub struct TaylorSolver {
 /// What a Taylor run is built from, from its scene, and never changes: the
 /// parameters, the material, the lattice and its masses, the surfaces.
 /// Not saved: a restored run is built from its scene, and the state it
-/// loads carries the digest of the setup that made it (serialized for
-/// that digest only).
-#[derive(Debug, Clone, serde::Serialize)]
+/// loads carries the digest of the setup that made it.
+#[derive(Debug, Clone)]
 struct SetupAxi {
     /// The parameters (the scheme's knobs among them).
     p: TaylorParams,
@@ -126,6 +125,14 @@ struct SetupAxi {
     mantle: Surface,
     top: Surface,
     face: Surface,
+}
+
+impl SetupAxi {
+    /// The digest of what the setup is made from, the parameters and the
+    /// material: the lattice, masses and surfaces follow from them.
+    fn digest(&self) -> u64 {
+        crate::solver::shared::setup_digest(&(&self.p, &self.material))
+    }
 }
 
 /// What a Taylor run changes, and all that it saves (format 2 of

@@ -151,7 +151,7 @@ impl TaylorSolver {
         check_derived("wave speed", s.wave_speed(), " m/s")?;
         s.state.clock = Clock::start(s.stable_dt());
         check_derived("time step", s.state.clock.dt, " s")?;
-        s.state.setup_digest = crate::solver::shared::setup_digest(&s.setup);
+        s.state.setup_digest = s.setup.digest();
         Ok(s)
     }
 }

@@ -150,9 +150,8 @@ pub struct Mlpg3d {
 /// rod's setup with its typed scheme, the bodies and their materials, the
 /// lattice, the nodal masses and the quantities that follow from them.
 /// Not saved: a restored run is built from its scene, and the state it
-/// loads carries the digest of the setup that made it (serialized for
-/// that digest only).
-#[derive(Debug, Clone, serde::Serialize)]
+/// loads carries the digest of the setup that made it.
+#[derive(Debug, Clone)]
 struct Setup3d {
     /// The rod and the solver's choices.
     rod: RodSetup,
@@ -184,6 +183,15 @@ struct Setup3d {
     d_min0: f64,
     /// Damping time `c = 2 ζ / ω_max` of the viscous stress (s).
     damping_time: f64,
+}
+
+impl Setup3d {
+    /// The digest of what the setup is made from, the rod's setup (its
+    /// scheme included), the rod's material, the further bodies and the
+    /// anvil: everything else in it follows from them.
+    fn digest(&self) -> u64 {
+        crate::solver::shared::setup_digest(&(&self.rod, &self.material, &self.others, self.anvil))
+    }
 }
 
 /// What a 3-D run changes, and all that it saves (format 2 of
@@ -447,7 +455,7 @@ impl Mlpg3d {
         let fastest = s.state.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max);
         s.state.clock = Clock::start(s.stable_dt(cp + fastest, s.setup.d_min0));
         check_derived("time step", s.state.clock.dt, " s")?;
-        s.state.setup_digest = crate::solver::shared::setup_digest(&s.setup);
+        s.state.setup_digest = s.setup.digest();
         Ok(s)
     }
 

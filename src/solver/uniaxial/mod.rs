@@ -51,7 +51,7 @@ pub struct PlateImpact {
 /// What a plate-impact run is built from, from its scene, and never
 /// changes: the two plates, the cells' masses, lengths and densities at the
 /// start, and the end time. Not saved.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone)]
 struct SetupPlate {
     layers: [Layer; 2],
     /// Flyer cells first; the flyer's last node and the target's first
@@ -65,6 +65,20 @@ struct SetupPlate {
     /// Where [`PlateImpact::finished`] holds (s); infinite unless set by
     /// [`PlateImpact::until`].
     end_time: f64,
+}
+
+impl SetupPlate {
+    /// The digest of what the setup is made from, the plates, the flyer's
+    /// cells, the impact speed and the end time: the cells' masses, lengths
+    /// and densities follow from them.
+    fn digest(&self) -> u64 {
+        crate::solver::shared::setup_digest(&(
+            &self.layers,
+            self.flyer_cells,
+            self.impact_speed,
+            self.end_time,
+        ))
+    }
 }
 
 /// What a plate-impact run changes, and all that it saves (format 2 of
@@ -207,7 +221,7 @@ impl PlateImpact {
             start = 0.0;
         }
         sim.state.energy.initial = sim.kinetic();
-        sim.state.setup_digest = crate::solver::shared::setup_digest(&sim.setup);
+        sim.state.setup_digest = sim.setup.digest();
         sim.record();
         Ok(sim)
     }
@@ -249,7 +263,7 @@ impl PlateImpact {
     /// holds there.
     pub fn until(mut self, end_time: f64) -> Self {
         self.setup.end_time = end_time;
-        self.state.setup_digest = crate::solver::shared::setup_digest(&self.setup);
+        self.state.setup_digest = self.setup.digest();
         self
     }
 
