@@ -673,7 +673,9 @@ mi_result mi_sim_field(mi_sim *sim, const char *name, double *buf, size_t len, s
 /**
  * Copies the complete state of the run (solver, history, scene) as bytes,
  * by the buffer convention, for hosts that save and roll back. The bytes are
- * only meant for `mi_sim_state_load` of the same library version. Every
+ * read by `mi_sim_state_load`: they carry their format's number (JSON key
+ * `format`, 2 today), and a build reads its own format and every older
+ * one, and refuses a newer one with `MI_INVALID_STATE`. Every
  * state saved loads back, stopped or not; a run stopped on a non-finite
  * field has none to save, and returns its stop (`MI_NON_FINITE`, or
  * `MI_ENERGY_DRIFT` when its energy overflowed).
