@@ -274,17 +274,18 @@ fn the_fmu_state_is_compact() {
         let inst = stepped_fmu(pr, length);
         let data = serialized_state(inst);
         let n = particles(pr, length);
-        // Per particle: position 2, velocity 2, mass, density, deviatoric
-        // stress 4, pressure, plastic strain, temperature, boundary
-        // stress 4 doubles, and two flags: 17 doubles + 2 bytes.
-        let floor = n * (17 * 8 + 2);
+        // Per particle: position 2, velocity 2, density, deviatoric stress
+        // 4, pressure, plastic strain, temperature, boundary stress 4
+        // doubles, and two flags: 16 doubles + 2 bytes (the masses and the
+        // surfaces are the setup's, built from the scene, not saved).
+        let floor = n * (16 * 8 + 2);
         assert!(data.len() > floor, "{} bytes, {n} particles", data.len());
         per_particle.push((data.len() - floor) as f64 / n as f64);
         // SAFETY: a live instance, not used afterwards.
         unsafe { fmi3FreeInstance(inst) };
     }
-    // Beyond the floor: the histories, the surfaces and the scene, a few
-    // bytes a particle at most and fewer as the rod grows.
+    // Beyond the floor: the histories and the scene, a few bytes a
+    // particle at most and fewer as the rod grows.
     assert!(
         per_particle.windows(2).all(|w| w[1] < w[0]),
         "{per_particle:?}"

@@ -68,6 +68,7 @@ use crate::isa::Isa;
 use crate::material::{Material, MaterialState};
 use crate::observe::FieldSpec;
 use crate::solver::shared::{Clock, EnergyBook, QuietEnd};
+use scheme::MsphScheme;
 
 /// The place in the energy book of the kinetic energy the smoothing removed.
 const LOST_SMOOTHING: usize = 0;
@@ -110,6 +111,9 @@ pub struct TaylorSolver {
 struct SetupAxi {
     /// The parameters (the scheme's knobs among them).
     p: TaylorParams,
+    /// The scheme, typed, as the passes take it ([`MsphScheme::of`] the
+    /// parameters).
+    scheme: MsphScheme,
     /// The rod's material.
     material: Material,
     /// Particles across the radius and along the length.

@@ -9,7 +9,7 @@ use crate::kernel::SUPPORT;
 use crate::lanes::W;
 use crate::neighbours::padded_rows;
 use crate::solver::axisymmetric::pairs::PairPass;
-use crate::solver::axisymmetric::scheme::{MsphScheme, SmoothingOrder};
+use crate::solver::axisymmetric::scheme::SmoothingOrder;
 use crate::solver::shared::SPACING_COLLAPSE_BOUND;
 
 impl TaylorSolver {
@@ -96,7 +96,7 @@ impl TaylorSolver {
         ws.fields.sbc.resize(m, [0.0; 4]);
         ws.fields.vel.resize(m, [0.0; 2]);
         ws.fields.vel_s.resize(m, [0.0; 2]);
-        if MsphScheme::of(&self.setup.p).order == SmoothingOrder::BiLaplacian {
+        if self.setup.scheme.order == SmoothingOrder::BiLaplacian {
             ws.fields.lap.resize(m, [0.0; 2]);
             ws.fields.lap_rho.resize(m, [0.0]);
         }

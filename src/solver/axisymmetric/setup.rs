@@ -3,6 +3,7 @@
 //! and ranges are the `taylor` scene's), and the rod on its (R, Z) lattice
 //! at the instant of impact, of the material they describe.
 
+use super::scheme::MsphScheme;
 use super::{PipelineAxi, SetupAxi, StateAxi, TaylorSolver};
 use crate::error::{Error, Result};
 use crate::material::choice::{MaterialChoice, Prefix};
@@ -135,6 +136,7 @@ impl TaylorSolver {
                 min_spacing: 1.0,
             },
             setup: SetupAxi {
+                scheme: MsphScheme::of(&p),
                 material,
                 nr,
                 nz,

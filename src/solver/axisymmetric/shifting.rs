@@ -123,7 +123,7 @@ impl TaylorSolver {
             &outward,
             spacing,
             SHIFT_RANGE * spacing,
-            self.setup.p.shifting,
+            self.setup.scheme.shifting,
             SHIFT_CAP * spacing,
         );
         self.leave_axis(&free, spacing, &mut d);

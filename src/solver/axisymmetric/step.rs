@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::lanes::W;
 use crate::solver::COURANT;
 use crate::solver::axisymmetric::pairs::{PairInputs, Rows};
-use crate::solver::axisymmetric::scheme::{MsphScheme, SmoothingOrder};
+use crate::solver::axisymmetric::scheme::SmoothingOrder;
 use crate::solver::axisymmetric::team::{Chunks, Team};
 use crate::solver::shared::{ENERGY_ERROR_BOUND, above, check_spacing};
 
@@ -38,7 +38,7 @@ impl TaylorSolver {
             }
             // New lists may bring new mirror images, and pairs with them.
             let margin = if rebuilt { None } else { ws.shift_margin };
-            if self.setup.p.shifting > 0.0
+            if self.setup.scheme.shifting > 0.0
                 && self.shift(&mut ws, margin)?
                 && self.needs_rebuild(&ws)
             {
@@ -53,7 +53,7 @@ impl TaylorSolver {
     fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
         let n = self.particles();
         let dt = self.state.clock.dt;
-        let scheme = MsphScheme::of(&self.setup.p);
+        let scheme = self.setup.scheme;
         ws.rate.resize(n, [0.0; 4]);
         self.state.material_state.fit(n);
         ws.scratch.fit();
@@ -122,7 +122,7 @@ impl TaylorSolver {
         check_spacing(
             ratio,
             self.state.clock.time,
-            if self.setup.p.shifting == 0.0 {
+            if self.setup.scheme.shifting == 0.0 {
                 "; at large strain, use scheme = large_strain, the default (it sets \
                  smoothing_order = 2, smoothing_ratio = 2 and shifting = 0.1; README, \
                  \"Particle shifting\")"
