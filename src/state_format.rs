@@ -78,7 +78,7 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
             );
             // The setup follows from the scene: the digest of what it is
             // made from stays.
-            let made_from = parts(state, &["p", "material"])?;
+            let made_from = taylor_made_from(state)?;
             for key in [
                 "p", "material", "nr", "nz", "h", "r0", "mass", "mantle", "top", "face",
             ] {
@@ -156,6 +156,54 @@ fn defaults(state: &mut Map<String, Value>, defaults: &[(&str, Value)]) {
             .entry(key.to_string())
             .or_insert_with(|| value.clone());
     }
+}
+
+/// What a Taylor run's setup is made from, as format 2 takes its digest:
+/// the rod (its impact, geometry, density, temperature, resolution and
+/// end), the typed scheme and the material, from the parameters `p` and
+/// the material of a format-1 state.
+fn taylor_made_from(state: &Map<String, Value>) -> Result<Value, String> {
+    let p = state
+        .get("p")
+        .and_then(Value::as_object)
+        .ok_or("its solver has no parameters")?;
+    let get = |key: &str| {
+        p.get(key)
+            .cloned()
+            .ok_or_else(|| format!("its parameters have no {key}"))
+    };
+    let mut rod = Map::new();
+    for key in [
+        "impact_speed",
+        "initial_length",
+        "initial_diameter",
+        "density",
+        "initial_temperature",
+        "particles_radial",
+        "end_time",
+    ] {
+        rod.insert(key.into(), get(key)?);
+    }
+    let order = get("smoothing_order")?
+        .as_f64()
+        .ok_or("its smoothing order is not a number")?;
+    let mut scheme = Map::new();
+    scheme.insert("smoothing_ratio".into(), get("smoothing_ratio")?);
+    scheme.insert("smoothing".into(), get("smoothing_coefficient")?);
+    scheme.insert(
+        "order".into(),
+        Value::from(if order >= 1.5 { "BiLaplacian" } else { "Paper" }),
+    );
+    scheme.insert("shifting".into(), get("shifting")?);
+    let material = state
+        .get("material")
+        .cloned()
+        .ok_or("its solver has no material")?;
+    Ok(Value::Array(vec![
+        Value::Object(rod),
+        Value::Object(scheme),
+        material,
+    ]))
 }
 
 /// The values of `keys` in `state`, in that order, as one JSON array: what

@@ -109,8 +109,9 @@ pub struct TaylorSolver {
 /// loads carries the digest of the setup that made it.
 #[derive(Debug, Clone)]
 struct SetupAxi {
-    /// The parameters (the scheme's knobs among them).
-    p: TaylorParams,
+    /// The rod and the run's end, of the parameters (their material
+    /// constants are the material's).
+    rod: RodAxi,
     /// The scheme, typed, as the passes take it ([`MsphScheme::of`] the
     /// parameters).
     scheme: MsphScheme,
@@ -132,10 +133,39 @@ struct SetupAxi {
 }
 
 impl SetupAxi {
-    /// The digest of what the setup is made from, the parameters and the
-    /// material: the lattice, masses and surfaces follow from them.
+    /// The digest of what the setup is made from, the rod, the scheme and
+    /// the material: the lattice, masses and surfaces follow from them.
     fn digest(&self) -> u64 {
-        crate::solver::shared::setup_digest(&(&self.p, &self.material))
+        crate::solver::shared::setup_digest(&(&self.rod, &self.scheme, &self.material))
+    }
+}
+
+/// What the setup of a Taylor run keeps of its parameters besides the
+/// scheme: the rod, its impact, its lattice's resolution and the run's end
+/// (SI units; the material's constants are the material's).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+struct RodAxi {
+    impact_speed: f64,
+    initial_length: f64,
+    initial_diameter: f64,
+    density: f64,
+    initial_temperature: f64,
+    particles_radial: f64,
+    end_time: f64,
+}
+
+impl RodAxi {
+    /// The rod of the parameters `p`.
+    fn of(p: &TaylorParams) -> RodAxi {
+        RodAxi {
+            impact_speed: p.impact_speed,
+            initial_length: p.initial_length,
+            initial_diameter: p.initial_diameter,
+            density: p.density,
+            initial_temperature: p.initial_temperature,
+            particles_radial: p.particles_radial,
+            end_time: p.end_time,
+        }
     }
 }
 
@@ -246,7 +276,7 @@ impl TaylorSolver {
     /// Whether the end condition holds: the rod is at rest, or `end_time` has
     /// been reached.
     pub fn finished(&self) -> bool {
-        self.state.at_rest || self.state.clock.time >= self.setup.p.end_time
+        self.state.at_rest || self.state.clock.time >= self.setup.rod.end_time
     }
 
     /// Smallest distance between neighbouring particles relative to the
@@ -266,8 +296,8 @@ impl TaylorSolver {
         (self
             .setup
             .material
-            .longitudinal_modulus(self.setup.p.density, 0.0)
-            / self.setup.p.density)
+            .longitudinal_modulus(self.setup.rod.density, 0.0)
+            / self.setup.rod.density)
             .sqrt()
     }
 
@@ -284,7 +314,14 @@ impl TaylorSolver {
 
     /// Initial particle spacing.
     fn spacing(&self) -> f64 {
-        self.setup.r0 / (self.setup.nr - 1) as f64
+        self.setup.spacing()
+    }
+}
+
+impl SetupAxi {
+    /// Initial particle spacing.
+    fn spacing(&self) -> f64 {
+        self.r0 / (self.nr - 1) as f64
     }
 }
 
@@ -298,7 +335,7 @@ impl crate::model::Model for TaylorSolver {
     }
     /// 64 records per elastic transit of the rod.
     fn record_interval(&self) -> f64 {
-        self.setup.p.initial_length / self.wave_speed() / 64.0
+        self.setup.rod.initial_length / self.wave_speed() / 64.0
     }
     fn rod_profile(&self) -> Option<Vec<[f64; 2]>> {
         Some(crate::rod::profile(

@@ -9,6 +9,8 @@ use crate::solver::shared::json;
 /// does not hold, and what each is.
 const SETUP_KEYS: &[(&str, &str)] = &[
     ("p", "its parameters"),
+    ("rod", "its rod's parameters"),
+    ("scheme", "its scheme"),
     ("material", "its material"),
     ("nr", "its lattice"),
     ("nz", "its lattice"),

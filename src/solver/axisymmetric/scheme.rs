@@ -8,7 +8,7 @@
 use crate::solver::axisymmetric::TaylorParams;
 
 /// The velocity and density smoothing's order (`smoothing_order`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum SmoothingOrder {
     /// 1: the paper's conservative smoothing (3.23).
     Paper,
@@ -17,7 +17,7 @@ pub enum SmoothingOrder {
 }
 
 /// A scheme of the MSPH solver, decoded from a run's parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct MsphScheme {
     /// `h` over the particle spacing.
     pub smoothing_ratio: f64,

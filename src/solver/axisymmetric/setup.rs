@@ -4,7 +4,7 @@
 //! at the instant of impact, of the material they describe.
 
 use super::scheme::MsphScheme;
-use super::{PipelineAxi, SetupAxi, StateAxi, TaylorSolver};
+use super::{PipelineAxi, RodAxi, SetupAxi, StateAxi, TaylorSolver};
 use crate::error::{Error, Result};
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::{Material, MaterialState};
@@ -136,6 +136,7 @@ impl TaylorSolver {
                 min_spacing: 1.0,
             },
             setup: SetupAxi {
+                rod: RodAxi::of(&p),
                 scheme: MsphScheme::of(&p),
                 material,
                 nr,
@@ -146,7 +147,6 @@ impl TaylorSolver {
                 mantle,
                 top,
                 face,
-                p,
             },
             pipe: PipelineAxi::default(),
         };

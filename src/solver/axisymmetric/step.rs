@@ -12,6 +12,7 @@ use super::passes::{
 };
 use super::workspace::{BatchTally, Tally, Workspace};
 use super::{LOST_CONTACT, LOST_SMOOTHING, MIN_LEN, TaylorSolver};
+use super::{neighbours, shifting, surfaces};
 use crate::error::{Error, Result};
 use crate::lanes::W;
 use crate::solver::COURANT;
@@ -32,17 +33,17 @@ impl TaylorSolver {
         // support (so that it does not depend on when they were built, and a
         // restored run shifts as the original did).
         let result = rayon::scope(|_| {
-            let rebuilt = self.needs_rebuild(&ws);
+            let rebuilt = neighbours::needs_rebuild(&self.setup, &self.state, &ws);
             if rebuilt {
-                self.rebuild_neighbours(&mut ws);
+                neighbours::rebuild_neighbours(&self.setup, &self.state, &mut ws);
             }
             // New lists may bring new mirror images, and pairs with them.
             let margin = if rebuilt { None } else { ws.shift_margin };
             if self.setup.scheme.shifting > 0.0
-                && self.shift(&mut ws, margin)?
-                && self.needs_rebuild(&ws)
+                && shifting::shift(&self.setup, &mut self.state, &mut ws, margin)?
+                && neighbours::needs_rebuild(&self.setup, &self.state, &ws)
             {
-                self.rebuild_neighbours(&mut ws);
+                neighbours::rebuild_neighbours(&self.setup, &self.state, &mut ws);
             }
             Team::lead(|team| self.step_in(&mut ws, team))
         });
@@ -247,7 +248,7 @@ impl TaylorSolver {
         // from the new half of the step's stress power.
         ws.raw_bc.clear();
         ws.raw_bc.extend_from_slice(&self.state.stress_bc);
-        self.apply_surface_stress_bc();
+        surfaces::apply_surface_stress_bc(&self.setup, &mut self.state);
         let mut booked = 0.0;
         for ((bc, raw), w) in self.state.stress_bc.iter().zip(&ws.raw_bc).zip(&ws.rate) {
             for c in 0..4 {
@@ -275,7 +276,7 @@ impl TaylorSolver {
         // leaves it, and the rod rings elastically on it for ever. Its impact
         // energy is spent once the kinetic energy has stayed below
         // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
-        let (length, speed) = (self.setup.p.initial_length, self.wave_speed());
+        let (length, speed) = (self.setup.rod.initial_length, self.wave_speed());
         if self.state.quiet_since.at_rest(
             self.state.clock.time,
             t.kinetic,

@@ -2,7 +2,7 @@
 //! the mantle, the top and the part of the impact face off the anvil, no
 //! shear on the anvil.
 
-use super::TaylorSolver;
+use super::{SetupAxi, StateAxi};
 use crate::solver::axisymmetric::boundary::{Surface, corner_free, traction_free};
 
 /// The outward normal of the top at the axis.
@@ -22,40 +22,39 @@ pub(super) fn normal_from_axis(
     if k == 0 { on_axis } else { s.normal(k, pos) }
 }
 
-impl TaylorSolver {
-    /// Stress used by the momentum equation: the traction-free and
-    /// smooth-contact conditions applied on the surfaces to the constitutive
-    /// stress `dev - p I` (which the update pass writes for every particle).
-    pub(super) fn apply_surface_stress_bc(&mut self) {
-        let n = self.particles();
-        let (nr, nz) = (self.setup.nr, self.setup.nz);
-        for (k, &i) in self.setup.mantle.particles.iter().enumerate() {
-            let s = &self.state.stress_bc[i];
-            self.state.stress_bc[i] = if k == nz - 1 || (k == 0 && !self.state.contact[i]) {
-                corner_free(s)
-            } else {
-                traction_free(s, self.setup.mantle.normal(k, &self.state.pos))
-            };
+/// Stress used by the momentum equation: the traction-free and
+/// smooth-contact conditions applied on the surfaces of `setup` to the
+/// constitutive stress `dev - p I` of `state` (which the update pass writes
+/// for every particle), in its `stress_bc`.
+pub(super) fn apply_surface_stress_bc(setup: &SetupAxi, state: &mut StateAxi) {
+    let n = state.pos.len();
+    let (nr, nz) = (setup.nr, setup.nz);
+    for (k, &i) in setup.mantle.particles.iter().enumerate() {
+        let s = &state.stress_bc[i];
+        state.stress_bc[i] = if k == nz - 1 || (k == 0 && !state.contact[i]) {
+            corner_free(s)
+        } else {
+            traction_free(s, setup.mantle.normal(k, &state.pos))
+        };
+    }
+    for (k, &i) in setup.top.particles.iter().enumerate().take(nr - 1) {
+        let n = normal_from_axis(&setup.top, k, &state.pos, TOP_ON_AXIS);
+        state.stress_bc[i] = traction_free(&state.stress_bc[i], n);
+    }
+    for (k, &i) in setup.face.particles.iter().enumerate().take(nr - 1) {
+        if state.contact[i] {
+            // Smooth anvil: no shear traction.
+            state.stress_bc[i][3] = 0.0;
+        } else {
+            let n = normal_from_axis(&setup.face, k, &state.pos, FACE_ON_AXIS);
+            state.stress_bc[i] = traction_free(&state.stress_bc[i], n);
         }
-        for (k, &i) in self.setup.top.particles.iter().enumerate().take(nr - 1) {
-            let n = normal_from_axis(&self.setup.top, k, &self.state.pos, TOP_ON_AXIS);
-            self.state.stress_bc[i] = traction_free(&self.state.stress_bc[i], n);
-        }
-        for (k, &i) in self.setup.face.particles.iter().enumerate().take(nr - 1) {
-            if self.state.contact[i] {
-                // Smooth anvil: no shear traction.
-                self.state.stress_bc[i][3] = 0.0;
-            } else {
-                let n = normal_from_axis(&self.setup.face, k, &self.state.pos, FACE_ON_AXIS);
-                self.state.stress_bc[i] = traction_free(&self.state.stress_bc[i], n);
-            }
-        }
-        // Particles that started elsewhere but touch the anvil (a folded
-        // mantle) carry no shear there either.
-        for i in 0..n {
-            if self.state.contact[i] && i >= self.setup.nr {
-                self.state.stress_bc[i][3] = 0.0;
-            }
+    }
+    // Particles that started elsewhere but touch the anvil (a folded
+    // mantle) carry no shear there either.
+    for i in 0..n {
+        if state.contact[i] && i >= setup.nr {
+            state.stress_bc[i][3] = 0.0;
         }
     }
 }
