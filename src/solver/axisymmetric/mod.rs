@@ -293,12 +293,7 @@ impl TaylorSolver {
 
     /// Longitudinal elastic wave speed sqrt((K + 4 mu / 3) / rho0).
     pub fn wave_speed(&self) -> f64 {
-        (self
-            .setup
-            .material
-            .longitudinal_modulus(self.setup.rod.density, 0.0)
-            / self.setup.rod.density)
-            .sqrt()
+        self.setup.wave_speed()
     }
 
     fn stable_dt(&self) -> f64 {
@@ -311,14 +306,14 @@ impl TaylorSolver {
             .fold(0.0, f64::max);
         COURANT * self.setup.h / worst
     }
-
-    /// Initial particle spacing.
-    fn spacing(&self) -> f64 {
-        self.setup.spacing()
-    }
 }
 
 impl SetupAxi {
+    /// Longitudinal elastic wave speed of the reference state (m/s).
+    fn wave_speed(&self) -> f64 {
+        (self.material.longitudinal_modulus(self.rod.density, 0.0) / self.rod.density).sqrt()
+    }
+
     /// Initial particle spacing.
     fn spacing(&self) -> f64 {
         self.r0 / (self.nr - 1) as f64

@@ -11,9 +11,10 @@ use super::passes::{
     pair_pass, smooth_velocity, update,
 };
 use super::workspace::{BatchTally, Tally, Workspace};
-use super::{LOST_CONTACT, LOST_SMOOTHING, MIN_LEN, TaylorSolver};
+use super::{LOST_CONTACT, LOST_SMOOTHING, MIN_LEN, SetupAxi, StateAxi, TaylorSolver};
 use super::{neighbours, shifting, surfaces};
 use crate::error::{Error, Result};
+use crate::isa::Isa;
 use crate::lanes::W;
 use crate::solver::COURANT;
 use crate::solver::axisymmetric::pairs::{PairInputs, Rows};
@@ -45,247 +46,265 @@ impl TaylorSolver {
             {
                 neighbours::rebuild_neighbours(&self.setup, &self.state, &mut ws);
             }
-            Team::lead(|team| self.step_in(&mut ws, team))
+            let isa = self.pipe.isa;
+            Team::lead(|team| step_in(&self.setup, &mut self.state, isa, &mut ws, team))
         });
         self.pipe.ws = ws;
         result
     }
+}
 
-    fn step_in(&mut self, ws: &mut Workspace, team: &Team) -> Result<()> {
-        let n = self.particles();
-        let dt = self.state.clock.dt;
-        let scheme = self.setup.scheme;
-        ws.rate.resize(n, [0.0; 4]);
-        self.state.material_state.fit(n);
-        ws.scratch.fit();
-        let stride = ws.lists.stride.max(1);
-        let images = &ws.lists.images;
-        let f = &mut ws.fields;
-        // Mirror images across the axis and the anvil of the particles near
-        // them, so that those particles see a symmetric neighbourhood (the
-        // anvil is rigid and smooth): the velocity component and the shear
-        // stress odd across the plane, the rest even.
-        f.pos[..n].copy_from_slice(&self.state.pos);
-        fill_images(&mut f.pos, n, images);
-        for ((v, m), r) in f.vol.iter_mut().zip(&self.setup.mass).zip(&self.state.rho) {
-            *v = m / r;
-        }
-        fill_images(&mut f.vol, n, images);
-        f.sbc[..n].copy_from_slice(&self.state.stress_bc);
-        fill_images(&mut f.sbc, n, images);
+/// The step's passes, in order, once the neighbour lists (and the
+/// shifting) are done: a function of the setup, the state, the compiled
+/// copy and the workspace.
+fn step_in(
+    setup: &SetupAxi,
+    state: &mut StateAxi,
+    isa: Isa,
+    ws: &mut Workspace,
+    team: &Team,
+) -> Result<()> {
+    let n = state.pos.len();
+    let dt = state.clock.dt;
+    let scheme = setup.scheme;
+    ws.rate.resize(n, [0.0; 4]);
+    state.material_state.fit(n);
+    ws.scratch.fit();
+    let stride = ws.lists.stride.max(1);
+    let images = &ws.lists.images;
+    let f = &mut ws.fields;
+    // Mirror images across the axis and the anvil of the particles near
+    // them, so that those particles see a symmetric neighbourhood (the
+    // anvil is rigid and smooth): the velocity component and the shear
+    // stress odd across the plane, the rest even.
+    f.pos[..n].copy_from_slice(&state.pos);
+    fill_images(&mut f.pos, n, images);
+    for ((v, m), r) in f.vol.iter_mut().zip(&setup.mass).zip(&state.rho) {
+        *v = m / r;
+    }
+    fill_images(&mut f.vol, n, images);
+    f.sbc[..n].copy_from_slice(&state.stress_bc);
+    fill_images(&mut f.sbc, n, images);
 
-        // 1-2. The pair pass and the momentum equation.
-        let inputs = PairInputs {
-            pos: &f.pos,
-            vol: &f.vol,
-            sbc: &f.sbc,
-            nbr: &ws.lists.nbr,
-            nbr_len: &ws.lists.nbr_len,
-            stride,
-            vel: &self.state.vel,
-            rho: &self.state.rho,
-            on_axis: &self.state.on_axis,
-            h: self.setup.h,
-            dt,
-        };
-        let r = &mut ws.rows;
-        let rows = MIN_LEN * stride;
-        let out = PairChunks {
-            act: Chunks::new(&mut r.act, rows),
-            wr: Chunks::new(&mut r.wr, rows),
-            wz: Chunks::new(&mut r.wz, rows),
-            wk: Chunks::new(&mut r.wk, rows),
-            part: Chunks::new(&mut r.part, MIN_LEN),
-            vel: Chunks::new(&mut f.vel[..n], MIN_LEN),
-            tallies: Chunks::new(&mut ws.sums.batches, MIN_LEN / W),
-        };
-        pair_pass(
-            team,
-            self.pipe.isa,
-            &inputs,
-            out,
-            &ws.scratch,
-            &self.setup.mass,
-            &self.state.contact,
-        );
-        let a = BatchTally::total(&ws.sums.batches);
-        if let Some((particle, condition)) = a.singular {
-            return Err(Error::SingularMomentMatrix {
-                method: crate::error::MomentMethod::Msph,
-                particle,
-                time: self.state.clock.time,
-                condition,
-            });
-        }
-        let d0 = self.spacing();
-        let ratio = a.min_d2.sqrt() / d0;
-        self.state.min_spacing = self.state.min_spacing.min(ratio);
-        check_spacing(
-            ratio,
-            self.state.clock.time,
-            if self.setup.scheme.shifting == 0.0 {
-                "; at large strain, use scheme = large_strain, the default (it sets \
+    // 1-2. The pair pass and the momentum equation.
+    let inputs = PairInputs {
+        pos: &f.pos,
+        vol: &f.vol,
+        sbc: &f.sbc,
+        nbr: &ws.lists.nbr,
+        nbr_len: &ws.lists.nbr_len,
+        stride,
+        vel: &state.vel,
+        rho: &state.rho,
+        on_axis: &state.on_axis,
+        h: setup.h,
+        dt,
+    };
+    let r = &mut ws.rows;
+    let rows = MIN_LEN * stride;
+    let out = PairChunks {
+        act: Chunks::new(&mut r.act, rows),
+        wr: Chunks::new(&mut r.wr, rows),
+        wz: Chunks::new(&mut r.wz, rows),
+        wk: Chunks::new(&mut r.wk, rows),
+        part: Chunks::new(&mut r.part, MIN_LEN),
+        vel: Chunks::new(&mut f.vel[..n], MIN_LEN),
+        tallies: Chunks::new(&mut ws.sums.batches, MIN_LEN / W),
+    };
+    pair_pass(
+        team,
+        isa,
+        &inputs,
+        out,
+        &ws.scratch,
+        &setup.mass,
+        &state.contact,
+    );
+    let a = BatchTally::total(&ws.sums.batches);
+    if let Some((particle, condition)) = a.singular {
+        return Err(Error::SingularMomentMatrix {
+            method: crate::error::MomentMethod::Msph,
+            particle,
+            time: state.clock.time,
+            condition,
+        });
+    }
+    let d0 = setup.spacing();
+    let ratio = a.min_d2.sqrt() / d0;
+    state.min_spacing = state.min_spacing.min(ratio);
+    check_spacing(
+        ratio,
+        state.clock.time,
+        if setup.scheme.shifting == 0.0 {
+            "; at large strain, use scheme = large_strain, the default (it sets \
                  smoothing_order = 2, smoothing_ratio = 2 and shifting = 0.1; README, \
                  \"Particle shifting\")"
-            } else {
-                ""
-            },
-        )?;
-        self.state.energy.lost[LOST_CONTACT] += a.held;
+        } else {
+            ""
+        },
+    )?;
+    state.energy.lost[LOST_CONTACT] += a.held;
 
-        let p = Pass {
-            team,
-            isa: self.pipe.isa,
-            rows: Rows {
-                act: &r.act,
-                wr: &r.wr,
-                wz: &r.wz,
-                wk: &r.wk,
-                part: &r.part,
-                stride,
-            },
-            n,
-            images,
-            alpha: scheme.smoothing,
-            order2: scheme.order == SmoothingOrder::BiLaplacian,
-            mass: &self.setup.mass,
-            on_axis: &self.state.on_axis,
-            pos: &f.pos,
-            dt,
-        };
+    let p = Pass {
+        team,
+        isa,
+        rows: Rows {
+            act: &r.act,
+            wr: &r.wr,
+            wz: &r.wz,
+            wk: &r.wk,
+            part: &r.part,
+            stride,
+        },
+        n,
+        images,
+        alpha: scheme.smoothing,
+        order2: scheme.order == SmoothingOrder::BiLaplacian,
+        mass: &setup.mass,
+        on_axis: &state.on_axis,
+        pos: &f.pos,
+        dt,
+    };
 
-        // 3. Conservative smoothing of the velocity.
-        fill_images(&mut f.vel, n, images);
-        if p.order2 {
-            // Order 2: first the operator L v = (Shepard mean of v) - v.
-            laplacians(p, &f.vel, &mut f.lap);
-        }
-        let ke = smooth_velocity(
-            p,
-            &self.state.contact,
-            &f.vel,
-            &f.lap,
-            &mut f.vel_s[..n],
-            &mut ws.sums.smoothing,
-        );
-        self.state.energy.lost[LOST_SMOOTHING] += ke.before - ke.after;
+    // 3. Conservative smoothing of the velocity.
+    fill_images(&mut f.vel, n, images);
+    if p.order2 {
+        // Order 2: first the operator L v = (Shepard mean of v) - v.
+        laplacians(p, &f.vel, &mut f.lap);
+    }
+    let ke = smooth_velocity(
+        p,
+        &state.contact,
+        &f.vel,
+        &f.lap,
+        &mut f.vel_s[..n],
+        &mut ws.sums.smoothing,
+    );
+    state.energy.lost[LOST_SMOOTHING] += ke.before - ke.after;
 
-        // 4. Velocity gradients and continuity.
-        fill_images(&mut f.vel_s, n, images);
-        let out = ContinuityChunks {
-            grads: Chunks::new(&mut ws.grads, MIN_LEN),
-            rho_out: Chunks::new(&mut f.rho[..n], MIN_LEN),
-        };
-        continuity(p, &f.vel_s, &self.state.rho, out);
-        fill_images(&mut f.rho, n, images);
-        // With order 2 the density is smoothed by the same bi-Laplacian as
-        // the velocity: first L ρ, then the Shepard mean of L ρ in the loop.
-        if p.order2 {
-            laplacians(p, &f.rho, &mut f.lap_rho);
-        }
-
-        // 5-6. The constitutive update, positions, contact and the sums.
-        let inputs = UpdateInputs {
-            vel: &f.vel_s,
-            grads: &ws.grads,
-            rho_raw: &f.rho,
-            lap_rho: &f.lap_rho,
-            material: self.setup.material,
-            h: self.setup.h,
-        };
-        let out = UpdateChunks {
-            dev: Chunks::new(&mut self.state.dev, MIN_LEN),
-            pressure: Chunks::new(&mut self.state.pressure, MIN_LEN),
-            eps_p: Chunks::new(&mut self.state.eps_p, MIN_LEN),
-            temp: Chunks::new(&mut self.state.temp, MIN_LEN),
-            rho: Chunks::new(&mut self.state.rho, MIN_LEN),
-            models: Chunks::new(self.state.material_state.points_mut(), MIN_LEN),
-            pos: Chunks::new(&mut self.state.pos, MIN_LEN),
-            vel: Chunks::new(&mut self.state.vel, MIN_LEN),
-            contact: Chunks::new(&mut self.state.contact, MIN_LEN),
-            stress_bc: Chunks::new(&mut self.state.stress_bc, MIN_LEN),
-            tally: Chunks::new(&mut ws.sums.tallies, 1),
-            work: Chunks::new(&mut ws.rate[..], MIN_LEN),
-        };
-        update(p, &inputs, out);
-        let t = Tally::total(&ws.sums.tallies);
-        self.end_step(ws, &t, dt)
+    // 4. Velocity gradients and continuity.
+    fill_images(&mut f.vel_s, n, images);
+    let out = ContinuityChunks {
+        grads: Chunks::new(&mut ws.grads, MIN_LEN),
+        rho_out: Chunks::new(&mut f.rho[..n], MIN_LEN),
+    };
+    continuity(p, &f.vel_s, &state.rho, out);
+    fill_images(&mut f.rho, n, images);
+    // With order 2 the density is smoothed by the same bi-Laplacian as
+    // the velocity: first L ρ, then the Shepard mean of L ρ in the loop.
+    if p.order2 {
+        laplacians(p, &f.rho, &mut f.lap_rho);
     }
 
-    /// The end of a step from the sums of its update pass: the energy books,
-    /// the clock, the stops, the stress boundary conditions (and the work
-    /// they take), the next time step and the rest test.
-    fn end_step(&mut self, ws: &mut Workspace, t: &Tally, dt: f64) -> Result<()> {
-        self.state.energy.internal += t.internal;
-        self.state.energy.lost[LOST_CONTACT] += t.contact_lost;
-        ws.shift_margin = Some(2.0 * dt * t.fastest2.sqrt());
-        self.state.clock.time += dt;
-        self.state.clock.steps += 1;
-        if let Some(b) = t.through {
-            return Err(Error::ThroughBoundary {
-                particle: b.particle,
-                boundary: b.boundary,
-                time: self.state.clock.time,
-                position: b.position,
-            });
-        }
-        if let Some(c) = t.compression {
-            return Err(Error::CompressionLimit {
-                particle: c.particle,
-                time: self.state.clock.time,
-                compression: c.compression,
-                limit: c.limit,
-            });
-        }
-        if let Some((field, particle)) = t.non_finite.map(|(i, f)| (f, i)) {
-            return Err(Error::NonFinite {
-                field,
-                particle,
-                time: self.state.clock.time,
-            });
-        }
-        // The boundary conditions on the new stress, and the work they take
-        // from the new half of the step's stress power.
-        ws.raw_bc.clear();
-        ws.raw_bc.extend_from_slice(&self.state.stress_bc);
-        surfaces::apply_surface_stress_bc(&self.setup, &mut self.state);
-        let mut booked = 0.0;
-        for ((bc, raw), w) in self.state.stress_bc.iter().zip(&ws.raw_bc).zip(&ws.rate) {
-            for c in 0..4 {
-                booked += (bc[c] - raw[c]) * w[c];
-            }
-        }
-        self.state.energy.internal += booked;
+    // 5-6. The constitutive update, positions, contact and the sums.
+    let inputs = UpdateInputs {
+        vel: &f.vel_s,
+        grads: &ws.grads,
+        rho_raw: &f.rho,
+        lap_rho: &f.lap_rho,
+        material: setup.material,
+        h: setup.h,
+    };
+    let out = UpdateChunks {
+        dev: Chunks::new(&mut state.dev, MIN_LEN),
+        pressure: Chunks::new(&mut state.pressure, MIN_LEN),
+        eps_p: Chunks::new(&mut state.eps_p, MIN_LEN),
+        temp: Chunks::new(&mut state.temp, MIN_LEN),
+        rho: Chunks::new(&mut state.rho, MIN_LEN),
+        models: Chunks::new(state.material_state.points_mut(), MIN_LEN),
+        pos: Chunks::new(&mut state.pos, MIN_LEN),
+        vel: Chunks::new(&mut state.vel, MIN_LEN),
+        contact: Chunks::new(&mut state.contact, MIN_LEN),
+        stress_bc: Chunks::new(&mut state.stress_bc, MIN_LEN),
+        tally: Chunks::new(&mut ws.sums.tallies, 1),
+        work: Chunks::new(&mut ws.rate[..], MIN_LEN),
+    };
+    update(p, &inputs, out);
+    let t = Tally::total(&ws.sums.tallies);
+    end_step(setup, state, ws, &t, dt)
+}
 
-        let e = self.energy_error_with(t.kinetic);
-        if above(e, ENERGY_ERROR_BOUND) {
-            return Err(Error::EnergyDrift {
-                error: e,
-                bound: ENERGY_ERROR_BOUND,
-                time: self.state.clock.time,
-            });
-        }
-        self.state.clock.dt = COURANT * self.setup.h / t.worst_speed;
-        self.state.clock.check_step(self.state.clock.dt)?;
-        // The rod is at rest once its momentum toward the anvil is spent: the
-        // centre of mass no longer moves toward the anvil.
-        if -t.momentum / t.mass <= 0.0 && !t.touching {
-            self.state.at_rest = true;
-        }
-        // Or once it is quiet: a flange pressed flat on the anvil never
-        // leaves it, and the rod rings elastically on it for ever. Its impact
-        // energy is spent once the kinetic energy has stayed below
-        // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
-        let (length, speed) = (self.setup.rod.initial_length, self.wave_speed());
-        if self.state.quiet_since.at_rest(
-            self.state.clock.time,
-            t.kinetic,
-            self.state.energy.initial,
-            length,
-            speed,
-        ) {
-            self.state.at_rest = true;
-        }
-        Ok(())
+/// The end of a step from the sums of its update pass: the energy books,
+/// the clock, the stops, the stress boundary conditions (and the work
+/// they take), the next time step and the rest test.
+/// The end of a step: the boundary stresses, the energies, the guards,
+/// the next step and the rest detector.
+fn end_step(
+    setup: &SetupAxi,
+    state: &mut StateAxi,
+    ws: &mut Workspace,
+    t: &Tally,
+    dt: f64,
+) -> Result<()> {
+    state.energy.internal += t.internal;
+    state.energy.lost[LOST_CONTACT] += t.contact_lost;
+    ws.shift_margin = Some(2.0 * dt * t.fastest2.sqrt());
+    state.clock.time += dt;
+    state.clock.steps += 1;
+    if let Some(b) = t.through {
+        return Err(Error::ThroughBoundary {
+            particle: b.particle,
+            boundary: b.boundary,
+            time: state.clock.time,
+            position: b.position,
+        });
     }
+    if let Some(c) = t.compression {
+        return Err(Error::CompressionLimit {
+            particle: c.particle,
+            time: state.clock.time,
+            compression: c.compression,
+            limit: c.limit,
+        });
+    }
+    if let Some((field, particle)) = t.non_finite.map(|(i, f)| (f, i)) {
+        return Err(Error::NonFinite {
+            field,
+            particle,
+            time: state.clock.time,
+        });
+    }
+    // The boundary conditions on the new stress, and the work they take
+    // from the new half of the step's stress power.
+    ws.raw_bc.clear();
+    ws.raw_bc.extend_from_slice(&state.stress_bc);
+    surfaces::apply_surface_stress_bc(setup, state);
+    let mut booked = 0.0;
+    for ((bc, raw), w) in state.stress_bc.iter().zip(&ws.raw_bc).zip(&ws.rate) {
+        for c in 0..4 {
+            booked += (bc[c] - raw[c]) * w[c];
+        }
+    }
+    state.energy.internal += booked;
+
+    let e = state.energy.error(t.kinetic);
+    if above(e, ENERGY_ERROR_BOUND) {
+        return Err(Error::EnergyDrift {
+            error: e,
+            bound: ENERGY_ERROR_BOUND,
+            time: state.clock.time,
+        });
+    }
+    state.clock.dt = COURANT * setup.h / t.worst_speed;
+    state.clock.check_step(state.clock.dt)?;
+    // The rod is at rest once its momentum toward the anvil is spent: the
+    // centre of mass no longer moves toward the anvil.
+    if -t.momentum / t.mass <= 0.0 && !t.touching {
+        state.at_rest = true;
+    }
+    // Or once it is quiet: a flange pressed flat on the anvil never
+    // leaves it, and the rod rings elastically on it for ever. Its impact
+    // energy is spent once the kinetic energy has stayed below
+    // QUIET_FRACTION of it for QUIET_TRANSITS elastic transits L0/Ce.
+    let (length, speed) = (setup.rod.initial_length, setup.wave_speed());
+    if state.quiet_since.at_rest(
+        state.clock.time,
+        t.kinetic,
+        state.energy.initial,
+        length,
+        speed,
+    ) {
+        state.at_rest = true;
+    }
+    Ok(())
 }

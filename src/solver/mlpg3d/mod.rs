@@ -186,6 +186,40 @@ struct Setup3d {
 }
 
 impl Setup3d {
+    /// The stable step of eq. (15) for the wave speed `c` and the smallest
+    /// node distance `d`, times the safety factor, shortened for the
+    /// damping: `(2 / ω_max)(√(1 + ζ²) − ζ)`.
+    fn stable_dt(&self, c: f64, d: f64) -> f64 {
+        let z = self.rod.damping;
+        let kappa = self.rod.omega_factor();
+        stable_step_with(kappa, c, d, self.rod.safety) * ((1.0 + z * z).sqrt() - z)
+    }
+
+    /// Whether a body's material has a damage model (no pass over the
+    /// nodes: the step asks every time).
+    fn damaging(&self) -> bool {
+        std::iter::once(&self.material)
+            .chain(self.others.iter().map(|b| &b.material))
+            .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)))
+    }
+}
+
+/// Longitudinal elastic wave speed of the reference state (m/s), the
+/// fastest of the bodies' (a body whose equation of state has no reference
+/// density takes the first node's).
+fn wave_speed(setup: &Setup3d, state: &State3d) -> f64 {
+    let speed = |m: &Material| {
+        let rho = m.eos.reference_density().unwrap_or(state.rho[0]);
+        (m.longitudinal_modulus(rho, 0.0) / rho).sqrt()
+    };
+    setup
+        .others
+        .iter()
+        .map(|b| speed(&b.material))
+        .fold(speed(&setup.material), f64::max)
+}
+
+impl Setup3d {
     /// The digest of what the setup is made from, the rod's setup (its
     /// scheme included), the rod's material, the further bodies and the
     /// anvil: everything else in it follows from them.
@@ -453,45 +487,16 @@ impl Mlpg3d {
         // own speed, so that no body crosses a spacing (and past a contact)
         // in the first step.
         let fastest = s.state.vel.iter().map(|v| norm(*v)).fold(0.0, f64::max);
-        s.state.clock = Clock::start(s.stable_dt(cp + fastest, s.setup.d_min0));
+        s.state.clock = Clock::start(s.setup.stable_dt(cp + fastest, s.setup.d_min0));
         check_derived("time step", s.state.clock.dt, " s")?;
         s.state.setup_digest = s.setup.digest();
         Ok(s)
     }
 
-    /// The stable step of eq. (15) for the wave speed `c` and the smallest
-    /// node distance `d`, times the safety factor, shortened for the
-    /// damping: `(2 / ω_max)(√(1 + ζ²) − ζ)`.
-    fn stable_dt(&self, c: f64, d: f64) -> f64 {
-        let z = self.setup.rod.damping;
-        let kappa = self.setup.rod.omega_factor();
-        stable_step_with(kappa, c, d, self.setup.rod.safety) * ((1.0 + z * z).sqrt() - z)
-    }
-
     /// Longitudinal elastic wave speed of the reference state (m/s), the
     /// fastest of the bodies'.
     pub fn wave_speed(&self) -> f64 {
-        let speed = |m: &Material| {
-            let rho = m.eos.reference_density().unwrap_or(self.state.rho[0]);
-            (m.longitudinal_modulus(rho, 0.0) / rho).sqrt()
-        };
-        self.setup
-            .others
-            .iter()
-            .map(|b| speed(&b.material))
-            .fold(speed(&self.setup.material), f64::max)
-    }
-
-    /// Whether a body's material has a damage model (no pass over the
-    /// nodes: the step asks every time).
-    fn damaging(&self) -> bool {
-        std::iter::once(&self.setup.material)
-            .chain(self.setup.others.iter().map(|b| &b.material))
-            .any(|m| matches!(m.damage, crate::material::Damage::RajendranGrove(_)))
-    }
-
-    fn energy_error_with(&self, kinetic: f64) -> f64 {
-        self.state.energy.error(kinetic)
+        wave_speed(&self.setup, &self.state)
     }
 
     /// One step (see the module docs).
@@ -509,7 +514,13 @@ impl Mlpg3d {
         if self.setup.rod.scheme.shifting > 0.0 {
             scratch.fit_shift(n);
         }
-        let result = self.step_with(&mut scratch, watch);
+        let result = step::step_with(
+            &self.setup,
+            &mut self.state,
+            &mut self.pipe,
+            &mut scratch,
+            watch,
+        );
         self.pipe.scratch = scratch;
         result
     }

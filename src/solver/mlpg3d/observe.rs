@@ -77,7 +77,7 @@ impl Mlpg3d {
             damping: k * self.state.energy.lost[LOST_DAMPING],
             contact: k * self.state.energy.lost[LOST_CONTACT],
             smoothing: k * self.state.energy.lost[LOST_SMOOTHING],
-            error: self.energy_error_with(kinetic),
+            error: self.state.energy.error(kinetic),
         }
     }
 

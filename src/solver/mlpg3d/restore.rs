@@ -136,7 +136,9 @@ impl Mlpg3d {
                 return Err(format!("its node {i} is off its side of a symmetry plane"));
             }
         }
-        if self.damaging() && self.state.clock.steps > 0 && !self.state.material_state.has_damage()
+        if self.setup.damaging()
+            && self.state.clock.steps > 0
+            && !self.state.material_state.has_damage()
         {
             return Err("its damage variables are missing".into());
         }

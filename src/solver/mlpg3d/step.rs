@@ -8,238 +8,238 @@ use super::scratch::ForceBuffers;
 use super::update::{self, MaterialFields, MaterialInputs};
 use super::*;
 
-impl Mlpg3d {
-    /// The step with its buffers (reused from step to step: the step
-    /// allocates nothing once they have their size).
-    pub(super) fn step_with(&mut self, scratch: &mut Scratch, mut watch: Stopwatch) -> Result<()> {
-        let dt = self.state.clock.dt;
-        let nodal = self.setup.rod.scheme.forces.nodal();
-        // 1. Forces from σ^n and the viscous stress.
-        let g = self.pipe.geometry.as_ref().expect("built above");
-        total_stress(
-            &self.state.dev,
-            &self.state.pressure,
-            &self.state.visc,
-            &mut scratch.forces.total,
-        );
-        forces(
-            g,
-            nodal,
-            (&self.setup.mass, &self.state.rho),
-            &mut scratch.forces,
-            &mut scratch.images.total,
-        );
-        self.pipe.profile.lap(Phase::Force, &mut watch);
-        // 2-3. Velocities, contact, positions.
-        let damaging = self.damaging();
-        if !self.setup.group.is_empty() || damaging {
-            scratch.contact.before.clone_from(&self.state.vel);
-        }
-        let frame = Frame {
-            dt,
-            now: self.state.clock.time,
-            nodal,
-            spacing: self.setup.d_min0,
-            reach: self.setup.reach,
-            geometry: g,
-            mass: &self.setup.mass,
-            rho: &self.state.rho,
-            group: &self.setup.group,
-            plane: &self.setup.plane,
-            held: &self.setup.held,
-        };
-        motion::kick(
+/// The step with its buffers (reused from step to step: the step
+/// allocates nothing once they have their size).
+pub(super) fn step_with(
+    setup: &Setup3d,
+    state: &mut State3d,
+    pipe: &mut Pipeline3d,
+    scratch: &mut Scratch,
+    mut watch: Stopwatch,
+) -> Result<()> {
+    let dt = state.clock.dt;
+    let nodal = setup.rod.scheme.forces.nodal();
+    // 1. Forces from σ^n and the viscous stress.
+    let g = pipe.geometry.as_ref().expect("built above");
+    total_stress(
+        &state.dev,
+        &state.pressure,
+        &state.visc,
+        &mut scratch.forces.total,
+    );
+    forces(
+        g,
+        nodal,
+        (&setup.mass, &state.rho),
+        &mut scratch.forces,
+        &mut scratch.images.total,
+    );
+    pipe.profile.lap(Phase::Force, &mut watch);
+    // 2-3. Velocities, contact, positions.
+    let damaging = setup.damaging();
+    if !setup.group.is_empty() || damaging {
+        scratch.contact.before.clone_from(&state.vel);
+    }
+    let frame = Frame {
+        dt,
+        now: state.clock.time,
+        nodal,
+        spacing: setup.d_min0,
+        reach: setup.reach,
+        geometry: g,
+        mass: &setup.mass,
+        rho: &state.rho,
+        group: &setup.group,
+        plane: &setup.plane,
+        held: &setup.held,
+    };
+    motion::kick(
+        &frame,
+        &scratch.forces.force,
+        &mut state.vel,
+        &mut state.contact,
+        &mut state.reaction,
+        &mut scratch.kicks,
+    );
+    pipe.profile.lap(Phase::Kick, &mut watch);
+    // Velocity smoothing toward the MLS approximation at the node.
+    let alpha = setup.rod.scheme.smoothing * setup.rod.step_scale();
+    if alpha > 0.0 {
+        state.energy.lost[LOST_SMOOTHING] += motion::smooth(
             &frame,
-            &scratch.forces.force,
-            &mut self.state.vel,
-            &mut self.state.contact,
-            &mut self.state.reaction,
-            &mut scratch.kicks,
-        );
-        self.pipe.profile.lap(Phase::Kick, &mut watch);
-        // Velocity smoothing toward the MLS approximation at the node.
-        let alpha = self.setup.rod.scheme.smoothing * self.setup.rod.step_scale();
-        if alpha > 0.0 {
-            self.state.energy.lost[LOST_SMOOTHING] += motion::smooth(
-                &frame,
-                (alpha, self.setup.rod.scheme.order.power()),
-                &mut self.state.vel,
-                &self.state.contact,
-                &mut scratch.smoothing,
-                &mut scratch.images.vel,
-            );
-        }
-        self.pipe.profile.lap(Phase::Smoothing, &mut watch);
-        // Contact between the bodies, then between pulverized nodes closer
-        // than half a spacing.
-        motion::collide(
-            &frame,
-            &self.state.pos,
-            damaging.then(|| self.state.material_state.points()),
-            &mut self.state.vel,
-            &mut scratch.contact,
-            &mut scratch.images,
-            &mut self.state.energy.lost[LOST_CONTACT],
-        );
-        motion::clamp(
-            &frame,
-            &mut self.state.vel,
-            &mut self.state.energy.lost[LOST_CONTACT],
-        );
-        motion::drift(
-            &frame,
-            self.setup.anvil,
-            &mut self.state.vel,
-            &mut self.state.pos,
-            &mut self.state.contact,
-            &scratch.kicks,
-            &mut scratch.moves,
-        );
-        self.state.clock.time += dt;
-        self.state.clock.steps += 1;
-        motion::settle(
-            &scratch.moves,
-            &mut self.state.energy.lost[LOST_CONTACT],
-            &mut self.state.last_release,
-            self.state.clock.time,
-        )?;
-        motion::check_planes(&self.state.pos, &self.setup.plane, self.state.clock.time)?;
-        self.pipe.profile.lap(Phase::Move, &mut watch);
-        if self.setup.rod.scheme.shifting > 0.0 {
-            let g = self.pipe.geometry.as_ref().expect("built before the step");
-            shifting::shift(&self.setup, &mut self.state, g, scratch)?;
-        }
-        self.pipe.profile.lap(Phase::Shift, &mut watch);
-        // 4. The geometry follows the body.
-        let d_min = self.follow(scratch, &mut watch)?;
-        // 5. Velocity gradients and the material.
-        let g = self.pipe.geometry.as_ref().expect("built above");
-        let vel_ext = extended(
-            &g.mirror,
-            &self.state.vel,
+            (alpha, setup.rod.scheme.order.power()),
+            &mut state.vel,
+            &state.contact,
+            &mut scratch.smoothing,
             &mut scratch.images.vel,
-            mirror::vector,
         );
-        g.shapes.velocity_gradients(vel_ext, &mut scratch.grad);
-        self.pipe.profile.lap(Phase::Gradients, &mut watch);
-        update::update_material(
-            &MaterialInputs {
-                dt,
-                damping_time: self.setup.damping_time,
-                rod: &self.setup.material,
-                others: &self.setup.others,
-                group: &self.setup.group,
-                mass: &self.setup.mass,
-                vel: &self.state.vel,
-                grad: &scratch.grad,
-            },
-            MaterialFields {
-                dev: &mut self.state.dev,
-                pressure: &mut self.state.pressure,
-                eps_p: &mut self.state.eps_p,
-                temp: &mut self.state.temp,
-                rho: &mut self.state.rho,
-                visc: &mut self.state.visc,
-                states: self.state.material_state.points_mut(),
-            },
-            &mut scratch.results,
-        );
-        let t = update::sum(&scratch.results, self.state.clock.time)?;
-        self.pipe.profile.lap(Phase::Material, &mut watch);
-        self.state.energy.internal += t.internal;
-        self.state.plastic_work += t.plastic;
-        self.state.energy.lost[LOST_DAMPING] += t.damping;
-        // 6. Checks and the next step.
-        self.end_step(&t, d_min)?;
-        self.pipe.profile.lap(Phase::Checks, &mut watch);
-        Ok(())
     }
+    pipe.profile.lap(Phase::Smoothing, &mut watch);
+    // Contact between the bodies, then between pulverized nodes closer
+    // than half a spacing.
+    motion::collide(
+        &frame,
+        &state.pos,
+        damaging.then(|| state.material_state.points()),
+        &mut state.vel,
+        &mut scratch.contact,
+        &mut scratch.images,
+        &mut state.energy.lost[LOST_CONTACT],
+    );
+    motion::clamp(&frame, &mut state.vel, &mut state.energy.lost[LOST_CONTACT]);
+    motion::drift(
+        &frame,
+        setup.anvil,
+        &mut state.vel,
+        &mut state.pos,
+        &mut state.contact,
+        &scratch.kicks,
+        &mut scratch.moves,
+    );
+    state.clock.time += dt;
+    state.clock.steps += 1;
+    motion::settle(
+        &scratch.moves,
+        &mut state.energy.lost[LOST_CONTACT],
+        &mut state.last_release,
+        state.clock.time,
+    )?;
+    motion::check_planes(&state.pos, &setup.plane, state.clock.time)?;
+    pipe.profile.lap(Phase::Move, &mut watch);
+    if setup.rod.scheme.shifting > 0.0 {
+        let g = pipe.geometry.as_ref().expect("built before the step");
+        shifting::shift(setup, state, g, scratch)?;
+    }
+    pipe.profile.lap(Phase::Shift, &mut watch);
+    // 4. The geometry follows the body.
+    let d_min = follow(setup, state, pipe, scratch, &mut watch)?;
+    // 5. Velocity gradients and the material.
+    let g = pipe.geometry.as_ref().expect("built above");
+    let vel_ext = extended(
+        &g.mirror,
+        &state.vel,
+        &mut scratch.images.vel,
+        mirror::vector,
+    );
+    g.shapes.velocity_gradients(vel_ext, &mut scratch.grad);
+    pipe.profile.lap(Phase::Gradients, &mut watch);
+    update::update_material(
+        &MaterialInputs {
+            dt,
+            damping_time: setup.damping_time,
+            rod: &setup.material,
+            others: &setup.others,
+            group: &setup.group,
+            mass: &setup.mass,
+            vel: &state.vel,
+            grad: &scratch.grad,
+        },
+        MaterialFields {
+            dev: &mut state.dev,
+            pressure: &mut state.pressure,
+            eps_p: &mut state.eps_p,
+            temp: &mut state.temp,
+            rho: &mut state.rho,
+            visc: &mut state.visc,
+            states: state.material_state.points_mut(),
+        },
+        &mut scratch.results,
+    );
+    let t = update::sum(&scratch.results, state.clock.time)?;
+    pipe.profile.lap(Phase::Material, &mut watch);
+    state.energy.internal += t.internal;
+    state.plastic_work += t.plastic;
+    state.energy.lost[LOST_DAMPING] += t.damping;
+    // 6. Checks and the next step.
+    end_step(setup, state, &t, d_min)?;
+    pipe.profile.lap(Phase::Checks, &mut watch);
+    Ok(())
+}
 
-    /// Step 4: the spacing check over the named pairs, and the supports
-    /// or the operator rebuilt when a pair has left its range or moved past
-    /// [`RodSetup::rebuild_strain`] (the watch restarted after a rebuild,
-    /// which books its own phases). Returns the smallest distance between
-    /// named nodes.
-    fn follow(&mut self, scratch: &mut Scratch, watch: &mut Stopwatch) -> Result<f64> {
-        let images = &self.pipe.geometry.as_ref().expect("built above").mirror;
-        let x = extended(
-            images,
-            &self.state.pos,
-            &mut scratch.images.pos,
-            mirror::vector,
-        );
-        let b = extended(
-            images,
-            &self.state.built_at,
-            &mut scratch.images.built,
-            mirror::vector,
-        );
-        let pairs = geometry::named_pairs(&self.setup, &self.state, &self.pipe, x, b);
-        self.pipe.profile.lap(Phase::Pairs, watch);
-        let d_min = pairs.nearest;
-        let ratio = d_min / self.setup.d_min0;
-        self.state.min_spacing = self.state.min_spacing.min(ratio);
-        check_spacing(ratio, self.state.clock.time, "")?;
-        let supports = pairs.recompute;
-        if supports || pairs.strained {
-            if supports {
-                self.state.supports_at.clone_from(&self.state.pos);
-            }
-            self.state.built_at.clone_from(&self.state.pos);
-            self.state.built_reference.clone_from(&self.state.reference);
-            self.state.built_contact.clone_from(&self.state.contact);
-            self.state.built_rho.clone_from(&self.state.rho);
-            geometry::build_geometry(&self.setup, &mut self.state, &mut self.pipe, supports)?;
-            *watch = self.pipe.profile.stopwatch();
+/// Step 4: the spacing check over the named pairs, and the supports
+/// or the operator rebuilt when a pair has left its range or moved past
+/// [`RodSetup::rebuild_strain`] (the watch restarted after a rebuild,
+/// which books its own phases). Returns the smallest distance between
+/// named nodes.
+fn follow(
+    setup: &Setup3d,
+    state: &mut State3d,
+    pipe: &mut Pipeline3d,
+    scratch: &mut Scratch,
+    watch: &mut Stopwatch,
+) -> Result<f64> {
+    let images = &pipe.geometry.as_ref().expect("built above").mirror;
+    let x = extended(images, &state.pos, &mut scratch.images.pos, mirror::vector);
+    let b = extended(
+        images,
+        &state.built_at,
+        &mut scratch.images.built,
+        mirror::vector,
+    );
+    let pairs = geometry::named_pairs(setup, state, pipe, x, b);
+    pipe.profile.lap(Phase::Pairs, watch);
+    let d_min = pairs.nearest;
+    let ratio = d_min / setup.d_min0;
+    state.min_spacing = state.min_spacing.min(ratio);
+    check_spacing(ratio, state.clock.time, "")?;
+    let supports = pairs.recompute;
+    if supports || pairs.strained {
+        if supports {
+            state.supports_at.clone_from(&state.pos);
         }
-        Ok(d_min)
+        state.built_at.clone_from(&state.pos);
+        state.built_reference.clone_from(&state.reference);
+        state.built_contact.clone_from(&state.contact);
+        state.built_rho.clone_from(&state.rho);
+        geometry::build_geometry(setup, state, pipe, supports)?;
+        *watch = pipe.profile.stopwatch();
     }
+    Ok(d_min)
+}
 
-    /// Step 6: the checks of the step (non-finite positions, energy drift),
-    /// the next step (eq. 15) and its floor, and the end of a Taylor run:
-    /// the rod has left the anvil, or it has been quiet for
-    /// [`crate::solver::shared::QUIET_TRANSITS`] transits ([`QuietEnd`]).
-    fn end_step(&mut self, t: &Tally, d_min: f64) -> Result<()> {
-        if let Some(i) = self
-            .state
-            .pos
-            .par_iter()
-            .position_first(|x| !x.iter().all(|v| v.is_finite()))
-        {
-            return Err(Error::NonFinite {
-                field: "position",
-                particle: i,
-                time: self.state.clock.time,
-            });
-        }
-        let e = self.energy_error_with(t.kinetic);
-        if above(e, ENERGY_ERROR_BOUND) {
-            return Err(Error::EnergyDrift {
-                error: e,
-                bound: ENERGY_ERROR_BOUND,
-                time: self.state.clock.time,
-            });
-        }
-        self.state.clock.dt = self.stable_dt(t.worst_speed, d_min);
-        self.state.clock.check_step(self.state.clock.dt)?;
-        let touching = self.state.contact.par_iter().any(|&c| c);
-        if self.setup.anvil && -t.momentum / t.mass <= 0.0 && !touching {
-            self.state.at_rest = true;
-        }
-        // A run of several bodies (no anvil) ends at its end time.
-        if self.setup.anvil
-            && self.state.quiet_since.at_rest(
-                self.state.clock.time,
-                t.kinetic,
-                self.state.energy.initial,
-                self.setup.rod.cylinder.length,
-                self.wave_speed(),
-            )
-        {
-            self.state.at_rest = true;
-        }
-        Ok(())
+/// Step 6: the checks of the step (non-finite positions, energy drift),
+/// the next step (eq. 15) and its floor, and the end of a Taylor run:
+/// the rod has left the anvil, or it has been quiet for
+/// [`crate::solver::shared::QUIET_TRANSITS`] transits ([`QuietEnd`]).
+fn end_step(setup: &Setup3d, state: &mut State3d, t: &Tally, d_min: f64) -> Result<()> {
+    if let Some(i) = state
+        .pos
+        .par_iter()
+        .position_first(|x| !x.iter().all(|v| v.is_finite()))
+    {
+        return Err(Error::NonFinite {
+            field: "position",
+            particle: i,
+            time: state.clock.time,
+        });
     }
+    let e = state.energy.error(t.kinetic);
+    if above(e, ENERGY_ERROR_BOUND) {
+        return Err(Error::EnergyDrift {
+            error: e,
+            bound: ENERGY_ERROR_BOUND,
+            time: state.clock.time,
+        });
+    }
+    state.clock.dt = setup.stable_dt(t.worst_speed, d_min);
+    state.clock.check_step(state.clock.dt)?;
+    let touching = state.contact.par_iter().any(|&c| c);
+    if setup.anvil && -t.momentum / t.mass <= 0.0 && !touching {
+        state.at_rest = true;
+    }
+    // A run of several bodies (no anvil) ends at its end time.
+    if setup.anvil
+        && state.quiet_since.at_rest(
+            state.clock.time,
+            t.kinetic,
+            state.energy.initial,
+            setup.rod.cylinder.length,
+            wave_speed(setup, state),
+        )
+    {
+        state.at_rest = true;
+    }
+    Ok(())
 }
 
 /// The total stress `σ + σ_v = S − p I + σ_v` at each node.
