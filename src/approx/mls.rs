@@ -58,7 +58,7 @@
 use crate::approx::buffers::refill;
 use crate::approx::msph::{MAX_CONDITION, invert};
 use crate::isa::{Isa, hot};
-use crate::neighbours::{Cells, NeighbourList, cell_list_first};
+use crate::neighbours::Cells;
 use crate::{Error, Result};
 use rayon::prelude::*;
 

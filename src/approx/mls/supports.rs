@@ -2,8 +2,16 @@
 //! sizes"): each node's named neighbours and support radius, when they are
 //! recomputed, and the candidate nodes of a point's covering supports.
 
-use super::*;
-
+use crate::Error;
+use crate::approx::mls::BASIS;
+use crate::approx::mls::ROWS_PER_BLOCK;
+use crate::approx::mls::distance;
+use crate::error::Result;
+use crate::neighbours::Cells;
+use crate::neighbours::NeighbourList;
+use crate::neighbours::cell_list_first;
+use rayon::iter::IntoParallelIterator;
+use rayon::iter::ParallelIterator;
 /// The choices behind the support sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SupportParams {

@@ -3,8 +3,34 @@
 //! nodes, the traction operator, and the pass over the named pairs that
 //! decides when they are rebuilt.
 
-use super::*;
-
+use super::profile::Phase;
+use super::spheres;
+use super::util::at_time;
+use super::util::extended;
+use super::util::norm;
+use crate::Error;
+use crate::approx::conform::CONFORM_TOLERANCE;
+use crate::approx::conform::conform;
+use crate::approx::mirror;
+use crate::approx::mirror::Mirror;
+use crate::approx::mls::NodalShapes;
+use crate::approx::mls::SupportParams;
+use crate::approx::mls::Supports;
+use crate::approx::mls::distance;
+use crate::approx::nodal::NodalOperator;
+use crate::approx::sphere::BOUNDARY_RULE;
+use crate::approx::sphere::DEFAULT_RULE;
+use crate::approx::sphere::SphereRule;
+use crate::approx::sphere::TestSphere;
+use crate::approx::weak::TractionOperator;
+use crate::error::Result;
+use crate::solver::mlpg3d::Pipeline3d;
+use crate::solver::mlpg3d::Setup3d;
+use crate::solver::mlpg3d::State3d;
+use crate::solver::mlpg3d::scheme::Forces;
+use crate::solver::mlpg3d::scheme::SmoothingOrder;
+use rayon::iter::IntoParallelIterator;
+use rayon::iter::ParallelIterator;
 /// What follows from the positions at the last build: supports, nodal
 /// shapes, test spheres and the traction operator. Rebuilt, never saved.
 #[derive(Debug, Clone, Default)]

@@ -95,22 +95,13 @@ mod tests;
 mod update;
 mod util;
 
-use crate::approx::conform::{CONFORM_TOLERANCE, conform};
-use crate::approx::lattice::{Cylinder, NodeLattice, Surfaces};
-use crate::approx::mirror::{self, Mirror};
-use crate::approx::mls::{NodalShapes, SupportParams, Supports, distance};
-use crate::approx::nodal::NodalOperator;
-use crate::approx::sphere::{
-    ALPHA, BOUNDARY_RULE, DEFAULT_RULE, SphereRule, TestSphere, test_radii,
-};
+use crate::approx::lattice::{NodeLattice, Surfaces};
 use crate::approx::step::stable_step_with;
-use crate::approx::weak::TractionOperator;
 use crate::error::{Error, Result};
 use crate::isa::Isa;
-use crate::material::tensor::{Full, SymTensor};
-use crate::material::{Loading, Material, MaterialState, Point};
-use crate::observe::{FieldSpec, TAYLOR3D_OBSERVABLES};
-use crate::rod::{RodObservables, radius};
+use crate::material::tensor::Full;
+use crate::material::{Material, MaterialState};
+use crate::observe::TAYLOR3D_OBSERVABLES;
 /// The place in the energy book of the damping's loss.
 const LOST_DAMPING: usize = 0;
 /// The place in the energy book of the loss at the anvil or between bodies.
@@ -119,20 +110,14 @@ const LOST_CONTACT: usize = 1;
 /// included).
 const LOST_SMOOTHING: usize = 2;
 
-use crate::solver::shared::{
-    Clock, ENERGY_ERROR_BOUND, EnergyBook, QuietEnd, SHIFT_CAP, SHIFT_RANGE, above, check_derived,
-    check_spacing,
-};
+use crate::solver::shared::{Clock, EnergyBook, QuietEnd, check_derived};
 use geometry::Geometry;
 pub use observe::{Energies, MLPG_FIELDS};
-use profile::{Phase, PhaseTimes, Stopwatch};
-use rayon::prelude::*;
-use scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
-use scratch::{CARRIED, Scratch, Tally};
+use profile::PhaseTimes;
+use scheme::Lattice;
+use scratch::Scratch;
 pub use setup::{Body, DAMPING, REBUILD_STRAIN, RodSetup, SMOOTHING};
-use shift::{Freedom, carry, exchange, shifts};
-use spheres::{nanson, radial};
-use util::{at_time, extended, kinetic, kinetic1, material_of, norm, pin};
+use util::{kinetic, kinetic1, norm};
 
 /// A 3-D MLPG run of a rod striking a rigid smooth anvil, or of several
 /// bodies: its setup, its state and its pipeline, apart.

@@ -5,9 +5,22 @@
 //! over the node fields it reads and writes; the energies they remove are
 //! added to the accumulators passed in, in node order.
 
+use super::contact;
+use super::geometry::Geometry;
 use super::scratch::{ContactBuffers, ImageBuffers, Kick, Move, SmoothingBuffers};
-use super::*;
+use super::util::extended;
+use super::util::kinetic;
+use super::util::pin;
+use crate::Error;
+use crate::approx::mirror;
+use crate::error::Result;
 use crate::material::PointState;
+use crate::solver::mlpg3d::kinetic1;
+use crate::solver::shared::SHIFT_RANGE;
+use rayon::iter::IndexedParallelIterator;
+use rayon::iter::IntoParallelRefIterator;
+use rayon::iter::IntoParallelRefMutIterator;
+use rayon::iter::ParallelIterator;
 
 /// What the passes of steps 2 and 3 read and none writes.
 pub(super) struct Frame<'a> {

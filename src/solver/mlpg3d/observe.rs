@@ -2,7 +2,23 @@
 //! observables, the node fields, the memory by part, and the [`crate::model::Model`]
 //! seam.
 
-use super::*;
+use super::LOST_CONTACT;
+use super::LOST_DAMPING;
+use super::LOST_SMOOTHING;
+use super::profile::PhaseTimes;
+use super::util::kinetic;
+use crate::FieldSpec;
+use crate::Isa;
+use crate::approx::lattice::NodeLattice;
+use crate::approx::lattice::Surfaces;
+use crate::material::tensor::Full;
+use crate::materials::Material;
+use crate::rod::RodObservables;
+use crate::rod::radius;
+use crate::solver::mlpg3d::Body;
+use crate::solver::mlpg3d::Mlpg3d;
+use crate::solver::mlpg3d::RodSetup;
+use crate::solver::mlpg3d::TAYLOR3D_OBSERVABLES;
 use crate::solver::shared::SolidNodes;
 
 impl Mlpg3d {

@@ -19,6 +19,10 @@ use super::scratch::{ContactBuffers, ImageBuffers, Kick, Move, SmoothingBuffers,
 use super::spheres::cross;
 use super::update::{MaterialFields, MaterialInputs, update_material};
 use super::*;
+use crate::approx::mls::NodalShapes;
+use crate::approx::mls::SupportParams;
+use crate::approx::mls::Supports;
+use crate::approx::nodal::NodalOperator;
 use crate::material::PointState;
 
 /// The spacing of the hand-made grid (m).

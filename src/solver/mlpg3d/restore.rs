@@ -1,8 +1,12 @@
 //! The checks of a restored run against a fresh one of the same
 //! parameters.
 
-use super::*;
-
+use super::LOST_CONTACT;
+use super::LOST_DAMPING;
+use super::LOST_SMOOTHING;
+use super::util::norm;
+use crate::approx::mirror;
+use crate::solver::mlpg3d::Mlpg3d;
 /// The fields of the setup ([`Setup3d`]), which a saved state does not
 /// hold, and what each is.
 const SETUP_KEYS: &[(&str, &str)] = &[

@@ -1,8 +1,8 @@
 //! The step's buffers, reused from step to step (not saved), and the sums
 //! of one step.
 
-use super::*;
-
+use super::shift::Freedom;
+use crate::Error;
 /// The buffers of a step, reused from step to step (not saved), one group
 /// per pass.
 #[derive(Debug, Clone, Default)]

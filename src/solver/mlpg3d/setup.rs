@@ -2,8 +2,9 @@
 //! choices ([`RodSetup`], with its typed scheme), the further bodies of a run of
 //! several ([`Body`]), and the defaults with the measurements behind them.
 
-use super::*;
-
+use crate::approx::lattice::Cylinder;
+use crate::materials::Material;
+use crate::solver::mlpg3d::scheme::MlpgScheme;
 /// Default damping ratio ζ at the highest frequency `ω_max` of the
 /// stiffness-proportional damping: none, as in the seed. Measured (README,
 /// "3-D MLPG mixed method: the instability"): on the free bar ζ = 0.1

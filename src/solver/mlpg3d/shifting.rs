@@ -2,9 +2,37 @@
 //! the carry): who may move where, and the carry of the moved nodes'
 //! fields.
 
+use super::LOST_SMOOTHING;
+use super::geometry::Geometry;
+use super::scratch::CARRIED;
+use super::scratch::Scratch;
 use super::scratch::{ImageBuffers, ShiftBuffers};
-use super::*;
+use super::shift::Freedom;
+use super::shift::carry;
+use super::shift::exchange;
+use super::shift::shifts;
+use super::spheres::nanson;
+use super::spheres::radial;
+use super::util::extended;
+use super::util::kinetic;
+use super::util::material_of;
+use super::util::pin;
+use crate::Error;
+use crate::approx::lattice::Surfaces;
+use crate::approx::mirror;
+use crate::error::Result;
 use crate::material::PointState;
+use crate::material::tensor::Full;
+use crate::materials::Material;
+use crate::solver::mlpg3d::Body;
+use crate::solver::mlpg3d::Setup3d;
+use crate::solver::mlpg3d::State3d;
+use crate::solver::mlpg3d::kinetic1;
+use crate::solver::shared::SHIFT_CAP;
+use crate::solver::shared::SHIFT_RANGE;
+use rayon::iter::IndexedParallelIterator;
+use rayon::iter::IntoParallelRefMutIterator;
+use rayon::iter::ParallelIterator;
 
 /// Node shifting ([`super::shift`]): pushes apart the pairs closer than
 /// [`SHIFT_RANGE`] of the initial spacing and carries the fields of the

@@ -2,8 +2,21 @@
 //! [`super`]): Nanson's normals of the boundary nodes, the cut planes, and
 //! the interior nodes' radii shrunk to the tangent planes.
 
-use super::*;
-
+use super::util::extended;
+use super::util::norm;
+use crate::approx::lattice::Surfaces;
+use crate::approx::mirror;
+use crate::approx::mirror::Mirror;
+use crate::approx::mls::NodalShapes;
+use crate::approx::mls::Supports;
+use crate::approx::mls::distance;
+use crate::approx::sphere::ALPHA;
+use crate::approx::sphere::TestSphere;
+use crate::approx::sphere::test_radii;
+use crate::solver::mlpg3d::Setup3d;
+use crate::solver::mlpg3d::State3d;
+use rayon::iter::IntoParallelIterator;
+use rayon::iter::ParallelIterator;
 /// The test spheres of the real nodes at the points `pts` (the real
 /// nodes, then the images of `mirror`; see the module docs: the deformed
 /// free boundary), from the lattice's surfaces (`setup`) and the state's

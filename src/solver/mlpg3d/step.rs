@@ -3,10 +3,35 @@
 //! smoothing, contact, positions), the shifting, the geometry, the
 //! material pass of [`super::update`], the checks and the next step.
 
+use super::LOST_CONTACT;
+use super::LOST_DAMPING;
+use super::LOST_SMOOTHING;
+use super::geometry;
+use super::geometry::Geometry;
 use super::motion::{self, Frame};
+use super::profile::Phase;
+use super::profile::Stopwatch;
 use super::scratch::ForceBuffers;
+use super::scratch::Scratch;
+use super::scratch::Tally;
+use super::shifting;
 use super::update::{self, MaterialFields, MaterialInputs};
-use super::*;
+use super::util::extended;
+use super::wave_speed;
+use crate::ENERGY_ERROR_BOUND;
+use crate::Error;
+use crate::approx::mirror;
+use crate::error::Result;
+use crate::material::tensor::Full;
+use crate::solver::mlpg3d::Pipeline3d;
+use crate::solver::mlpg3d::Setup3d;
+use crate::solver::mlpg3d::State3d;
+use crate::solver::shared::above;
+use crate::solver::shared::check_spacing;
+use rayon::iter::IndexedParallelIterator;
+use rayon::iter::IntoParallelRefIterator;
+use rayon::iter::IntoParallelRefMutIterator;
+use rayon::iter::ParallelIterator;
 
 /// The step with its buffers (reused from step to step: the step
 /// allocates nothing once they have their size).

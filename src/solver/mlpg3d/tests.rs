@@ -1,9 +1,19 @@
 //! Unit tests of the 3-D solver.
 
+use super::util::pin;
 use super::*;
+use crate::approx::lattice::Cylinder;
+use crate::approx::mirror;
+use crate::approx::mls::distance;
+use crate::approx::sphere::BOUNDARY_RULE;
+use crate::approx::sphere::DEFAULT_RULE;
+use crate::approx::sphere::SphereRule;
+use crate::approx::weak::TractionOperator;
 use crate::material::bilinear::Bilinear;
 use crate::material::eos::LinearEos;
 use crate::material::{Damage, Eos, Strength};
+use crate::solver::mlpg3d::scheme::Forces;
+use crate::solver::mlpg3d::scheme::SmoothingOrder;
 
 /// 4340-like steel with bilinear hardening (yield 500 MPa, H = 1 GPa).
 pub(super) fn plastic_steel() -> Material {

@@ -4,8 +4,23 @@
 //! 3-D ([`Full`]) form, with each node's share of the step's energies and
 //! its checks; then the sums over the nodes in node order.
 
-use super::*;
+use super::scratch::Tally;
+use super::util::at_time;
+use super::util::material_of;
+use super::util::norm;
+use crate::Error;
+use crate::error::Result;
+use crate::material::Loading;
+use crate::material::Point;
 use crate::material::PointState;
+use crate::material::tensor::Full;
+use crate::material::tensor::SymTensor;
+use crate::materials::Material;
+use crate::solver::mlpg3d::Body;
+use crate::solver::mlpg3d::kinetic1;
+use rayon::iter::IndexedParallelIterator;
+use rayon::iter::IntoParallelRefMutIterator;
+use rayon::iter::ParallelIterator;
 
 /// What the material pass reads.
 pub(super) struct MaterialInputs<'a> {

@@ -2,8 +2,11 @@
 //! quarter model's extended fields, the symmetry planes' pin, kinetic
 //! energy.
 
-use super::*;
-
+use crate::Error;
+use crate::approx::mirror;
+use crate::approx::mirror::Mirror;
+use crate::materials::Material;
+use crate::solver::mlpg3d::Body;
 /// The material of node `i`: the rod's, or that of its body in `others`.
 #[inline]
 pub(super) fn material_of<'a>(
