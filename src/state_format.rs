@@ -79,12 +79,13 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
             // The setup follows from the scene: the digest of what it is
             // made from stays.
             let made_from = taylor_made_from(state)?;
-            for key in [
-                "p", "material", "nr", "nz", "h", "r0", "mass", "mantle", "top", "face",
-            ] {
-                take(state, key)?;
-            }
-            state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
+            drop_setup(
+                state,
+                &made_from,
+                &[
+                    "p", "material", "nr", "nz", "h", "r0", "mass", "mantle", "top", "face",
+                ],
+            )?;
             clock(state)?;
             energy(
                 state,
@@ -97,10 +98,7 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
             // The setup follows from the scene: the digest of what it is
             // made from stays.
             let made_from = parts(state, &["p", "gas"])?;
-            for key in ["p", "gas", "h", "mass"] {
-                take(state, key)?;
-            }
-            state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
+            drop_setup(state, &made_from, &["p", "gas", "h", "mass"])?;
             clock(state)?;
             energy(state, "initial_energy", None, &[])
         }
@@ -116,18 +114,19 @@ fn from_1(root: &mut Map<String, Value>) -> Result<(), String> {
                 state,
                 &["layers", "flyer_cells", "impact_speed", "end_time"],
             )?;
-            for key in [
-                "layers",
-                "flyer_cells",
-                "impact_speed",
-                "mass",
-                "length0",
-                "density0",
-                "end_time",
-            ] {
-                take(state, key)?;
-            }
-            state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
+            drop_setup(
+                state,
+                &made_from,
+                &[
+                    "layers",
+                    "flyer_cells",
+                    "impact_speed",
+                    "mass",
+                    "length0",
+                    "density0",
+                    "end_time",
+                ],
+            )?;
             clock(state)?;
             energy(state, "initial_kinetic", None, &["contact_loss"])
         }
@@ -219,6 +218,21 @@ fn parts(state: &Map<String, Value>, keys: &[&str]) -> Result<Value, String> {
         })
         .collect::<Result<Vec<_>, _>>()
         .map(Value::Array)
+}
+
+/// Drops the fields `keys` of a format-1 solver's setup from `state` and
+/// keeps the digest of `made_from` (what the setup is made from) in their
+/// place, as `setup_digest`.
+fn drop_setup(
+    state: &mut Map<String, Value>,
+    made_from: &Value,
+    keys: &[&str],
+) -> Result<(), String> {
+    for key in keys {
+        take(state, key)?;
+    }
+    state.insert("setup_digest".into(), Value::from(digest_json(made_from)));
+    Ok(())
 }
 
 /// Moves `key` out of `state`, or says that it is missing.
@@ -322,10 +336,7 @@ fn mlpg(state: &mut Map<String, Value>) -> Result<(), String> {
     typed_scheme(&mut rod)?;
     state.insert("setup".into(), Value::Object(rod));
     let made_from = parts(state, &["setup", "material", "others", "anvil"])?;
-    for key in MLPG_SETUP {
-        take(state, key)?;
-    }
-    state.insert("setup_digest".into(), Value::from(digest_json(&made_from)));
+    drop_setup(state, &made_from, MLPG_SETUP)?;
     clock(state)?;
     energy(
         state,

@@ -620,18 +620,15 @@ impl crate::model::Model for NohSolver {
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        if let crate::model::SavedSolver::Json(value) = &saved {
-            crate::solver::shared::refuse_setup(
-                value,
-                &[
-                    ("p", "its parameters"),
-                    ("gas", "its gas"),
-                    ("h", "its smoothing length"),
-                    ("mass", "its masses"),
-                ],
-            )?;
-        }
-        self.state = crate::model::read_saved(saved)?;
+        self.state = crate::solver::shared::read_state(
+            saved,
+            &[
+                ("p", "its parameters"),
+                ("gas", "its gas"),
+                ("h", "its smoothing length"),
+                ("mass", "its masses"),
+            ],
+        )?;
         Ok(())
     }
     fn check_restored(&self, fresh: &dyn crate::model::Model) -> std::result::Result<(), String> {

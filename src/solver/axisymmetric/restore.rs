@@ -30,10 +30,7 @@ impl TaylorSolver {
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        if let crate::model::SavedSolver::Json(value) = &saved {
-            crate::solver::shared::refuse_setup(value, SETUP_KEYS)?;
-        }
-        self.state = crate::model::read_saved(saved)?;
+        self.state = crate::solver::shared::read_state(saved, SETUP_KEYS)?;
         Ok(())
     }
 

@@ -137,3 +137,16 @@ pub(crate) fn digest_json(value: &serde_json::Value) -> u64 {
             (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
         })
 }
+
+/// A saved state of a solver, read: refused, naming it, when it holds one
+/// of the `setup_keys` of the solver's setup ([`refuse_setup`]), else read
+/// as an `S` (not yet checked). Every solver's `load_state` reads so.
+pub(crate) fn read_state<S: serde::de::DeserializeOwned>(
+    saved: crate::model::SavedSolver<'_>,
+    setup_keys: &[(&str, &str)],
+) -> Result<S, String> {
+    if let crate::model::SavedSolver::Json(value) = &saved {
+        refuse_setup(value, setup_keys)?;
+    }
+    crate::model::read_saved(saved)
+}

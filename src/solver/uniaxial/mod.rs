@@ -400,21 +400,18 @@ impl crate::model::Model for PlateImpact {
         &mut self,
         saved: crate::model::SavedSolver<'_>,
     ) -> std::result::Result<(), String> {
-        if let crate::model::SavedSolver::Json(value) = &saved {
-            crate::solver::shared::refuse_setup(
-                value,
-                &[
-                    ("layers", "its plates"),
-                    ("flyer_cells", "its cells"),
-                    ("impact_speed", "its impact speed"),
-                    ("mass", "its masses"),
-                    ("length0", "its cells"),
-                    ("density0", "its cells"),
-                    ("end_time", "its end time"),
-                ],
-            )?;
-        }
-        self.state = crate::model::read_saved(saved)?;
+        self.state = crate::solver::shared::read_state(
+            saved,
+            &[
+                ("layers", "its plates"),
+                ("flyer_cells", "its cells"),
+                ("impact_speed", "its impact speed"),
+                ("mass", "its masses"),
+                ("length0", "its cells"),
+                ("density0", "its cells"),
+                ("end_time", "its end time"),
+            ],
+        )?;
         self.pipe = PipelinePlate::default();
         Ok(())
     }
