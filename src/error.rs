@@ -216,6 +216,17 @@ pub enum Error {
     /// Bytes that are not a serialized simulation state.
     #[error("invalid serialized state: {0}")]
     InvalidState(String),
+    /// A file given as a checkpoint that cannot be continued: which fault,
+    /// and the detail ([`crate::checkpoint`]).
+    #[error("checkpoint {path} is {fault}: {detail}")]
+    Checkpoint {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        fault: crate::checkpoint::CheckpointFault,
+        /// The detail: what was found, and what to do.
+        detail: String,
+    },
     /// An input/output failure while writing results.
     #[error("I/O error on {path}: {message}")]
     Io {
@@ -249,6 +260,7 @@ impl Error {
             Error::MemoryBudget { .. } => "MemoryBudget",
             Error::Cancelled { .. } => "Cancelled",
             Error::InvalidState(_) => "InvalidState",
+            Error::Checkpoint { fault, .. } => fault.name(),
             Error::Io { .. } => "Io",
         }
     }

@@ -71,6 +71,7 @@
 mod approx;
 mod budget;
 pub mod calibrate;
+pub mod checkpoint;
 // Unsafe code is allowed in these places only: the C ABI, the FMI glue and
 // the pointer and panic helpers they share (here), the dispatch to the
 // compiled copies of the hot loops (`hot!` in src/isa.rs), the team of
@@ -83,6 +84,7 @@ mod capi;
 mod error;
 #[allow(unsafe_code)]
 mod ffi;
+pub mod files;
 #[allow(unsafe_code)]
 mod fmi;
 mod isa;

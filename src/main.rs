@@ -22,6 +22,12 @@ fn main() {
             }
             1
         }
+        Err(Stop::Interrupted(lines)) => {
+            for l in lines {
+                let _ = writeln!(std::io::stderr(), "{l}");
+            }
+            cli::signals::INTERRUPTED
+        }
     };
     std::process::exit(status);
 }
@@ -33,7 +39,7 @@ fn try_main() -> Result<(), Stop> {
     };
     match args.command {
         None => cli::run::run(RunArgs {
-            scene: "taylor".into(),
+            scene: Some("taylor".into()),
             ..Default::default()
         })?,
         Some(Command::Run(a)) => cli::run::run(a)?,

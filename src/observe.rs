@@ -3,7 +3,6 @@
 //! the `.pvd` collection that gives ParaView their times).
 
 use crate::error::{Error, Result};
-use std::io::Write;
 use std::path::Path;
 
 /// One observable: a time history and a final value.
@@ -131,18 +130,21 @@ impl History {
         Some((0..self.len()).map(|k| self.row(k)[c]).collect())
     }
 
-    /// Writes the history as CSV with a header `time,<names...>`.
+    /// Writes the history as CSV with a header `time,<names...>`, whole
+    /// ([`crate::files::write_whole`]).
     pub fn write_csv(&self, path: &Path) -> Result<()> {
-        let mut w = csv::Writer::from_path(path).map_err(|e| Error::io(path, e))?;
-        let mut header = vec!["time"];
-        header.extend(self.names.iter().map(String::as_str));
-        w.write_record(&header).map_err(|e| Error::io(path, e))?;
-        for k in 0..self.len() {
-            let mut rec = vec![format!("{:e}", self.times[k])];
-            rec.extend(self.row(k).iter().map(|v| format!("{v:e}")));
-            w.write_record(&rec).map_err(|e| Error::io(path, e))?;
-        }
-        w.flush().map_err(|e| Error::io(path, e))
+        crate::files::write_whole(path, |out| {
+            let mut w = csv::Writer::from_writer(out);
+            let mut header = vec!["time"];
+            header.extend(self.names.iter().map(String::as_str));
+            w.write_record(&header)?;
+            for k in 0..self.len() {
+                let mut rec = vec![format!("{:e}", self.times[k])];
+                rec.extend(self.row(k).iter().map(|v| format!("{v:e}")));
+                w.write_record(&rec)?;
+            }
+            w.flush()
+        })
     }
 }
 
@@ -294,8 +296,10 @@ impl Snapshot {
                 },
             }),
         };
-        vtk.export(path)
-            .map_err(|e| crate::error::Error::io(path, format!("{e:?}")))
+        crate::files::write_whole(path, |w| {
+            vtk.write_xml(w)
+                .map_err(|e| std::io::Error::other(format!("{e:?}")))
+        })
     }
 }
 
@@ -306,8 +310,7 @@ impl Snapshot {
 pub fn write_pvd(path: &Path, snapshots: &[(f64, String)]) -> Result<()> {
     use quick_xml::Writer;
     use quick_xml::events::{BytesDecl, Event};
-    let f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    let mut w = Writer::new_with_indent(std::io::BufWriter::new(f), b' ', 2);
+    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
     let xml = |e: quick_xml::Error| Error::io(path, e);
     w.write_event(Event::Decl(BytesDecl::new("1.0", None, None)))
         .map_err(xml)?;
@@ -334,9 +337,9 @@ pub fn write_pvd(path: &Path, snapshots: &[(f64, String)]) -> Result<()> {
                 .map(drop)
         })
         .map_err(xml)?;
-    let mut f = w.into_inner();
-    writeln!(f).map_err(|e| Error::io(path, e))?;
-    f.flush().map_err(|e| Error::io(path, e))
+    let mut bytes = w.into_inner();
+    bytes.push(b'\n');
+    crate::files::write_whole_bytes(path, &bytes)
 }
 
 observables! {

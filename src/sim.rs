@@ -495,9 +495,15 @@ impl Simulation {
     /// [`Error::InvalidState`] unless it is one that a run of its scene can
     /// reach: see [`Simulation::check_restored`].
     pub fn deserialize_state(bytes: &[u8]) -> Result<Self> {
+        let saved: serde_json::Value =
+            serde_json::from_slice(bytes).map_err(|e| Error::InvalidState(e.to_string()))?;
+        Simulation::from_saved(saved)
+    }
+
+    /// [`Simulation::deserialize_state`] of the state already read as a
+    /// JSON tree (a checkpoint's run, [`crate::checkpoint`]).
+    pub fn from_saved(mut saved: serde_json::Value) -> Result<Self> {
         let invalid = |e: String| Error::InvalidState(e);
-        let mut saved: serde_json::Value =
-            serde_json::from_slice(bytes).map_err(|e| invalid(e.to_string()))?;
         crate::state_format::upgrade(&mut saved)
             .map_err(|e| invalid(format!("the state cannot be read: {e}")))?;
         let sim: Simulation = serde_json::from_value(saved).map_err(|e| invalid(e.to_string()))?;

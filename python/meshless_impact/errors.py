@@ -58,6 +58,34 @@ class InvalidState(InputError):
     """Bytes that are not a saved state of this kind of scene."""
 
 
+class BadCheckpoint(InvalidState):
+    """A file given as a checkpoint that cannot be continued; its subclass says why."""
+
+
+class NotACheckpoint(BadCheckpoint):
+    """A file that does not start as a checkpoint does."""
+
+
+class CheckpointTruncated(BadCheckpoint):
+    """A checkpoint cut short: it ends before its trailer."""
+
+
+class CheckpointCorrupted(BadCheckpoint):
+    """A checkpoint whose checksum or length disagrees with its content."""
+
+
+class CheckpointNewerFormat(BadCheckpoint):
+    """A checkpoint written by a newer build, in a format this one cannot read."""
+
+
+class CheckpointOtherScene(BadCheckpoint):
+    """A checkpoint of another scene than the one asked for."""
+
+
+class CheckpointContradicts(BadCheckpoint):
+    """Parameters asked for that contradict the checkpoint's."""
+
+
 class UnknownField(InputError):
     """A particle field name that the scene does not have."""
 

@@ -19,6 +19,7 @@
 
 mod calibrate;
 
+use meshless_impact::checkpoint::CheckpointFault;
 use meshless_impact::{Error, Scene, SceneKind, Simulation as Core};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -824,6 +825,36 @@ fn sample_errors() -> Vec<Error> {
         },
         Error::Cancelled { time: 1e-6 },
         Error::InvalidState("not a state".into()),
+        Error::Checkpoint {
+            path: "run.ckpt".into(),
+            fault: CheckpointFault::NotACheckpoint,
+            detail: "it does not start as one".into(),
+        },
+        Error::Checkpoint {
+            path: "run.ckpt".into(),
+            fault: CheckpointFault::Truncated,
+            detail: "it ends after 10 bytes".into(),
+        },
+        Error::Checkpoint {
+            path: "run.ckpt".into(),
+            fault: CheckpointFault::Corrupted,
+            detail: "its CRC-32 disagrees".into(),
+        },
+        Error::Checkpoint {
+            path: "run.ckpt".into(),
+            fault: CheckpointFault::NewerFormat,
+            detail: "format 9".into(),
+        },
+        Error::Checkpoint {
+            path: "run.ckpt".into(),
+            fault: CheckpointFault::OtherScene,
+            detail: "scene: `noh`".into(),
+        },
+        Error::Checkpoint {
+            path: "run.ckpt".into(),
+            fault: CheckpointFault::Contradicts,
+            detail: "impact_speed".into(),
+        },
         Error::Io {
             path: "out.csv".into(),
             message: "denied".into(),
@@ -854,6 +885,7 @@ fn every_error_is_listed(e: &Error) {
         | Error::MemoryBudget { .. }
         | Error::Cancelled { .. }
         | Error::InvalidState(_)
+        | Error::Checkpoint { .. }
         | Error::Io { .. } => {}
     }
 }

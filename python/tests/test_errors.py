@@ -13,7 +13,8 @@ from meshless_impact import errors
 from conftest import PLAIN, cli_error, cli_run
 
 INPUT = {"OutOfRange", "UnknownParameter", "UnknownScene", "UnknownModel", "ParseValue", "Inconsistent",
-         "SceneFile", "ShotsFile", "InvalidState"}
+         "SceneFile", "ShotsFile", "InvalidState", "NotACheckpoint", "CheckpointTruncated",
+         "CheckpointCorrupted", "CheckpointNewerFormat", "CheckpointOtherScene", "CheckpointContradicts"}
 STOPS = {"SingularMomentMatrix", "NonFinite", "ThroughBoundary", "TimeStepCollapse", "EnergyDrift",
          "SpacingCollapse", "CompressionLimit"}
 

@@ -58,6 +58,10 @@ pub enum mi_result {
     /// the environment variable `MI_MEMORY_BUDGET`): refused before it
     /// allocates; the message gives the estimate and the budget.
     MI_MEMORY_BUDGET = 16,
+    /// A file given as a checkpoint (`mi_sim_checkpoint_load`) that cannot
+    /// be continued: not a checkpoint, truncated, corrupted (a checksum or
+    /// length that disagrees), of a newer format; the message says which.
+    MI_BAD_CHECKPOINT = 17,
     /// The run stopped: an MSPH moment matrix was singular (too few or
     /// collinear neighbours).
     MI_SINGULAR_MOMENT_MATRIX = 20,
@@ -163,6 +167,11 @@ pub(crate) const RESULTS: &[(mi_result, &str, &str)] = &[
         "the run's estimated memory exceeds the memory budget\0",
     ),
     (
+        mi_result::MI_BAD_CHECKPOINT,
+        "MI_BAD_CHECKPOINT\0",
+        "the file cannot be continued as a checkpoint\0",
+    ),
+    (
         mi_result::MI_SINGULAR_MOMENT_MATRIX,
         "MI_SINGULAR_MOMENT_MATRIX\0",
         "singular MSPH moment matrix\0",
@@ -251,6 +260,7 @@ pub(crate) fn code_of(e: &Error) -> mi_result {
         Error::Cancelled { .. } => MI_CANCELLED,
         Error::InvalidState(_) => MI_INVALID_STATE,
         Error::Io { .. } => MI_IO,
+        Error::Checkpoint { .. } => MI_BAD_CHECKPOINT,
     }
 }
 

@@ -101,6 +101,15 @@ pub(crate) struct ChoiceArgs {
 }
 
 impl ChoiceArgs {
+    /// Whether any choice is made.
+    pub(crate) fn any(&self) -> bool {
+        self.scheme.is_some()
+            || self.strength.is_some()
+            || self.eos.is_some()
+            || self.preset.is_some()
+            || self.preset_file.is_some()
+    }
+
     /// Applies the choices to `scene`, if any is made.
     pub(crate) fn apply(&self, scene: &mut Scene) -> Result<(), Error> {
         if let Some(name) = &self.scheme {
@@ -122,9 +131,10 @@ impl ChoiceArgs {
 
 #[derive(Args, Default)]
 pub(crate) struct RunArgs {
-    /// Built-in scene (`meshless-impact scenes` lists them).
-    #[arg(default_value = "taylor", conflicts_with = "scene_file")]
-    pub(crate) scene: String,
+    /// Built-in scene (`meshless-impact scenes` lists them; default
+    /// `taylor`, or the checkpoint's with --restart).
+    #[arg(conflicts_with = "scene_file")]
+    pub(crate) scene: Option<String>,
     /// Read the scene from a TOML file instead.
     #[arg(long, value_name = "FILE")]
     pub(crate) scene_file: Option<PathBuf>,
@@ -133,6 +143,22 @@ pub(crate) struct RunArgs {
     /// Override a parameter, e.g. `--set impact_speed=200` (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub(crate) set: Vec<String>,
+    /// Save the whole run (state, histories, snapshot times, outputs) to
+    /// FILE every --checkpoint-every seconds and when stopped by SIGTERM or
+    /// SIGINT; each write replaces the last whole (docs/guide/checkpoints.md).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) checkpoint: Option<PathBuf>,
+    /// Wall-clock seconds between checkpoints (default 300).
+    #[arg(long, value_name = "SECONDS")]
+    pub(crate) checkpoint_every: Option<f64>,
+    /// Also checkpoint every N steps.
+    #[arg(long, value_name = "N")]
+    pub(crate) checkpoint_steps: Option<u64>,
+    /// Continue the run saved in a checkpoint FILE, to the bits of the run
+    /// that was never stopped, with its outputs and checkpoints unless
+    /// given again; a scene or parameters given must agree with it.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) restart: Option<PathBuf>,
     /// Write the final observables as JSON.
     #[arg(long, value_name = "FILE")]
     pub(crate) json: Option<PathBuf>,

@@ -1,11 +1,13 @@
 //! `meshless-impact run`: one scene to its end condition, with its
 //! snapshots, histories and final values, and the summary on stdout.
 
-use super::args::{RunArgs, apply_sets};
+use super::args::RunArgs;
 use super::output::{check_output_dir, check_output_file, final_json, write_json, write_profile};
-use super::stop::{Stop, outcome, outln};
+use super::resume::{RunHost, begin};
+use super::signals;
+use super::stop::{Stop, errln, outcome, outln};
 use indicatif::{ProgressBar, ProgressStyle};
-use meshless_impact::{Error, Isa, Scene, Simulation};
+use meshless_impact::{Error, Isa, Simulation};
 use std::io::{IsTerminal, Write};
 use std::time::{Duration, Instant};
 
@@ -18,27 +20,23 @@ pub(crate) fn fmt_duration(s: f64) -> String {
 }
 
 pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
-    let mut scene = match &a.scene_file {
-        Some(f) => Scene::from_file(f)?,
-        None => Scene::builtin(&a.scene)?,
-    };
-    a.material.apply(&mut scene)?;
-    apply_sets(&mut scene, &a.set)?;
-    let mut sim = Simulation::new(scene)?;
+    let (mut sim, mut host) = begin(&a)?;
     if let Some(name) = &a.isa {
         sim.set_isa(Isa::named(name).map_err(|e| Stop::failed(format!("--isa: {e}")))?);
     }
     let end_time = sim.end_time();
     // Every output is checked before the run, so that a typo does not cost
     // the results of a long run.
-    let vtk_times = check_vtk_times(&a.vtk_times, end_time)?;
-    if let Some(path) = &a.json {
+    if let Some(path) = &host.json {
         check_output_file("--json", path)?;
     }
-    if let Some(path) = &a.csv {
+    if let Some(path) = &host.csv {
         check_output_file("--csv", path)?;
     }
-    if let Some(path) = &a.profile {
+    if let Some(path) = &host.checkpoint {
+        check_output_file("--checkpoint", path)?;
+    }
+    if let Some(path) = &host.profile {
         check_output_file("--profile", path)?;
         if sim.rod_profile().is_none() {
             return Err(Stop::failed(format!(
@@ -47,51 +45,67 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
             )));
         }
     }
-    if let Some(dir) = &a.vtk_dir {
+    if let Some(dir) = &host.vtk_dir {
         check_output_dir("--vtk-dir", dir, "particles.pvd")?;
     }
-    let mut next_vtk = 0usize;
-    // (time, file name) of the snapshots written so far; the collection
-    // `particles.pvd` is rewritten after each one, so it is whole even when a
-    // run stops early.
-    let mut vtk_written: Vec<(f64, String)> = Vec::new();
-    let write_vtk = |sim: &Simulation, written: &mut Vec<(f64, String)>| -> Result<(), Error> {
-        if let Some(dir) = &a.vtk_dir {
-            let name = format!("particles_{:04}.vtu", written.len());
-            sim.snapshot().write_vtu(&dir.join(&name))?;
-            written.push((sim.time(), name));
-            meshless_impact::write_pvd(&dir.join("particles.pvd"), written)?;
-        }
-        Ok(())
-    };
+    signals::install().map_err(|e| Stop::failed(format!("installing the signal handlers: {e}")))?;
     // The first snapshot failure, reported after the run.
     let mut vtk_error = None;
-    if a.vtk_dir.is_some() && vtk_times.first().is_some_and(|&t| t <= 0.0) {
-        if let Err(e) = write_vtk(&sim, &mut vtk_written) {
-            vtk_error = Some(e);
+    if host.vtk_dir.is_some() && host.vtk_next == 0 && sim.steps() == 0 {
+        let due = host.vtk_times.iter().take_while(|&&t| t <= 0.0).count();
+        if due > 0 {
+            if let Err(e) = write_vtk(&sim, &mut host) {
+                vtk_error = Some(e);
+            }
+            host.vtk_next = due;
         }
-        next_vtk = vtk_times.iter().take_while(|&&t| t <= 0.0).count();
     }
 
     let start = Instant::now();
+    let wall_before = host.wall_s;
     let show_bar = !a.quiet && std::io::stderr().is_terminal();
     let mut bar: Option<ProgressBar> = None;
     let mut last_draw = Instant::now();
+    let mut last_checkpoint = (Instant::now(), sim.steps());
+    let mut checkpoint_error: Option<Error> = None;
     // Snapshots need the state between steps, so the loop is written out here.
     let mut status = Ok(());
+    let mut interrupted = None;
     // The whole loop runs on a worker of the thread pool, so a step does not
     // wake a worker from this thread and wait to be woken in turn.
     rayon::scope(|_| {
         while !sim.finished() {
+            if let Some(sig) = signals::received() {
+                interrupted = Some(sig);
+                break;
+            }
             if let Err(e) = sim.step() {
                 status = Err(e);
                 break;
             }
-            while next_vtk < vtk_times.len() && sim.time() >= vtk_times[next_vtk] {
-                if let Err(e) = write_vtk(&sim, &mut vtk_written) {
+            while host.vtk_next < host.vtk_times.len()
+                && sim.time() >= host.vtk_times[host.vtk_next]
+            {
+                if let Err(e) = write_vtk(&sim, &mut host) {
                     vtk_error.get_or_insert(e);
                 }
-                next_vtk += 1;
+                host.vtk_next += 1;
+            }
+            if host.checkpoint.is_some() && !sim.finished() {
+                let due = last_checkpoint.0.elapsed().as_secs_f64() >= host.checkpoint_every
+                    || host
+                        .checkpoint_steps
+                        .is_some_and(|n| sim.steps() >= last_checkpoint.1 + n);
+                if due {
+                    host.wall_s = wall_before + start.elapsed().as_secs_f64();
+                    if let Err(e) = save_checkpoint(&sim, &host) {
+                        if checkpoint_error.is_none() {
+                            let _ = errln!("warning: --checkpoint: {e}; the run goes on");
+                        }
+                        checkpoint_error.get_or_insert(e);
+                    }
+                    last_checkpoint = (Instant::now(), sim.steps());
+                }
             }
             if show_bar
                 && start.elapsed() > Duration::from_secs(1)
@@ -121,7 +135,8 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let wall = start.elapsed().as_secs_f64();
+    let wall = wall_before + start.elapsed().as_secs_f64();
+    host.wall_s = wall;
 
     // Every output is written, even when the run stopped early or another
     // output failed; the failures are reported together at the end.
@@ -129,27 +144,62 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
     if let Err(e) = &status {
         failures.push(e.to_string());
     }
-    if let Err(e) = write_vtk(&sim, &mut vtk_written) {
+    let mut saved_to = None;
+    if interrupted.is_some()
+        && let Some(path) = &host.checkpoint
+    {
+        match save_checkpoint(&sim, &host) {
+            Ok(()) => saved_to = Some(path.clone()),
+            Err(e) => failures.push(format!("--checkpoint: {e}")),
+        }
+    } else if let Some(e) = checkpoint_error {
+        failures.push(format!("--checkpoint: {e}"));
+    }
+    // The final snapshot is the run's end's: an interrupted run writes it
+    // when it is continued.
+    if interrupted.is_none()
+        && let Err(e) = write_vtk(&sim, &mut host)
+    {
         vtk_error.get_or_insert(e);
     }
     if let Some(e) = vtk_error {
         failures.push(format!("--vtk-dir: {e}"));
     }
-    if let Some(path) = &a.csv
+    if let Some(path) = &host.csv
         && let Err(e) = sim.history().write_csv(path)
     {
         failures.push(format!("--csv: {e}"));
     }
-    if let Some(path) = &a.profile
+    if let Some(path) = &host.profile
         && let Err(e) = write_profile(path, &sim)
     {
         failures.push(format!("--profile: {e}"));
     }
-    if let Some(path) = &a.json {
-        let json = final_json(&sim, wall, status.as_ref().err());
+    if let Some(path) = &host.json {
+        let mut json = final_json(&sim, wall, status.as_ref().err());
+        if let Some(sig) = interrupted {
+            json["outcome"] = "interrupted".into();
+            json["signal"] = sig.into();
+        }
         if let Err(e) = write_json(path, &json) {
             failures.push(format!("--json: {e}"));
         }
+    }
+    if let Some(sig) = interrupted {
+        let mut lines = vec![format!(
+            "interrupted by {sig} at t = {}, step {}; the outputs hold the run so far",
+            fmt_duration(sim.time()),
+            sim.steps()
+        )];
+        lines.push(match &saved_to {
+            Some(p) => format!(
+                "checkpoint written to {0}; continue with `meshless-impact run --restart {0}`",
+                p.display()
+            ),
+            None => "no checkpoint was asked for (--checkpoint FILE)".into(),
+        });
+        lines.extend(failures.into_iter().map(|f| format!("error: {f}")));
+        return Err(Stop::Interrupted(lines));
     }
     let printed = if a.quiet {
         Ok(())
@@ -159,18 +209,26 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
     outcome(failures, printed)
 }
 
-/// The snapshot times of `--vtk-times`, sorted. Each must be finite and
-/// between 0 and the scene's `end_time`: a time outside never comes.
-fn check_vtk_times(times: &[f64], end_time: f64) -> Result<Vec<f64>, Stop> {
-    if let Some(t) = times.iter().find(|t| !(0.0..=end_time).contains(*t)) {
-        return Err(Stop::failed(format!(
-            "--vtk-times: {t:e} s is out of range: allowed [0, {end_time:e}] s \
-             (0 to the scene's end_time)"
-        )));
+/// Writes the next snapshot of the run into `--vtk-dir` (if given) and
+/// rewrites the collection `particles.pvd`, so that it is whole even when
+/// a run stops early.
+fn write_vtk(sim: &Simulation, host: &mut RunHost) -> Result<(), Error> {
+    if let Some(dir) = &host.vtk_dir {
+        let name = format!("particles_{:04}.vtu", host.vtk_written.len());
+        sim.snapshot().write_vtu(&dir.join(&name))?;
+        host.vtk_written.push((sim.time(), name));
+        meshless_impact::write_pvd(&dir.join("particles.pvd"), &host.vtk_written)?;
     }
-    let mut sorted = times.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    Ok(sorted)
+    Ok(())
+}
+
+/// Writes the checkpoint of `--checkpoint`: the run and `host`.
+fn save_checkpoint(sim: &Simulation, host: &RunHost) -> Result<(), Error> {
+    let Some(path) = &host.checkpoint else {
+        return Ok(());
+    };
+    let value = serde_json::to_value(host).map_err(|e| Error::io(path, e))?;
+    meshless_impact::checkpoint::save(path, sim, &value)
 }
 
 /// What the two columns of references mean, printed under a table that

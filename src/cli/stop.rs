@@ -12,6 +12,10 @@ pub(crate) enum Stop {
     /// One or more failures, one line each: printed as `error: ...` on
     /// stderr, exit status 1.
     Failed(Vec<String>),
+    /// A run stopped by SIGTERM or SIGINT once its checkpoint and outputs
+    /// are written: the lines are printed on stderr as they are, exit
+    /// status [`super::signals::INTERRUPTED`].
+    Interrupted(Vec<String>),
 }
 
 impl Stop {
