@@ -138,8 +138,8 @@ pub(crate) fn calibrate(a: CalibrateArgs) -> Result<(), Stop> {
     }
     let material = material_file(&result, &a);
     let path = a.out.join("material.toml");
-    if let Err(e) = std::fs::write(&path, material) {
-        failures.push(format!("--out: {}", Error::io(&path, e)));
+    if let Err(e) = meshless_impact::files::write_whole_bytes(&path, material.as_bytes()) {
+        failures.push(format!("--out: {e}"));
     }
     if let Err(e) = figure(&a.out.join("fit.svg"), &result) {
         failures.push(format!("--out: {e}"));

@@ -4,18 +4,18 @@
 use super::stop::Stop;
 use meshless_impact::{Error, Simulation};
 use std::fs::{File, OpenOptions};
-use std::io::{ErrorKind, Write};
+use std::io::ErrorKind;
 use std::path::Path;
 
-/// The rod's outline as CSV (`z_m,r_m`, one row per point of the mantle's
+/// The rod's outline as CSV, written whole (`z_m,r_m`, one row per point of the mantle's
 /// generator, from the impact face up).
-pub(crate) fn write_profile(path: &std::path::Path, sim: &Simulation) -> std::io::Result<()> {
+pub(crate) fn write_profile(path: &std::path::Path, sim: &Simulation) -> Result<(), Error> {
     use std::fmt::Write as _;
     let mut text = String::from("z_m,r_m\n");
     for [z, r] in sim.rod_profile().unwrap_or_default() {
         let _ = writeln!(text, "{z:e},{r:e}");
     }
-    std::fs::write(path, text)
+    meshless_impact::files::write_whole_bytes(path, text.as_bytes())
 }
 
 /// Checks before a run that `path`, given to `option`, can be written: its
@@ -65,18 +65,20 @@ pub(crate) fn check_output_dir(option: &str, dir: &Path, file: &str) -> Result<(
     check_output_file(option, &dir.join(file))
 }
 
-/// Writes a CSV file of `header` and `records`.
+/// Writes a CSV file of `header` and `records`, whole.
 pub(crate) fn write_csv_records(
     out: &Path,
     header: &[&str],
     records: &[Vec<String>],
 ) -> Result<(), Error> {
-    let mut w = csv::Writer::from_path(out).map_err(|e| Error::io(out, e))?;
-    w.write_record(header).map_err(|e| Error::io(out, e))?;
-    for rec in records {
-        w.write_record(rec).map_err(|e| Error::io(out, e))?;
-    }
-    w.flush().map_err(|e| Error::io(out, e))
+    meshless_impact::files::write_whole(out, |o| {
+        let mut w = csv::Writer::from_writer(o);
+        w.write_record(header)?;
+        for rec in records {
+            w.write_record(rec)?;
+        }
+        w.flush()
+    })
 }
 
 /// Final values of a run as a JSON object: every observable by name, plus
@@ -131,9 +133,10 @@ pub(crate) fn final_json(
     serde_json::Value::Object(m)
 }
 
-/// Writes a JSON value to a file, pretty-printed.
+/// Writes a JSON value to a file, pretty-printed, whole.
 pub(crate) fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), Error> {
-    let mut f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    serde_json::to_writer_pretty(&mut f, value).map_err(|e| Error::io(path, e))?;
-    writeln!(f).map_err(|e| Error::io(path, e))
+    meshless_impact::files::write_whole(path, |f| {
+        serde_json::to_writer_pretty(&mut *f, value)?;
+        writeln!(f)
+    })
 }

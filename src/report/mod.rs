@@ -115,13 +115,14 @@ impl Table {
     /// Writes `DIR/<name>.csv`.
     pub fn write_csv(&self, dir: &Path) -> Result<()> {
         let path = dir.join(format!("{}.csv", self.name));
-        let mut w = csv::Writer::from_path(&path).map_err(|e| Error::io(&path, e))?;
-        w.write_record(&self.header)
-            .map_err(|e| Error::io(&path, e))?;
-        for r in &self.rows {
-            w.write_record(r).map_err(|e| Error::io(&path, e))?;
-        }
-        w.flush().map_err(|e| Error::io(&path, e))
+        meshless_impact::files::write_whole(&path, |o| {
+            let mut w = csv::Writer::from_writer(o);
+            w.write_record(&self.header)?;
+            for r in &self.rows {
+                w.write_record(r)?;
+            }
+            w.flush()
+        })
     }
 
     /// The table in Markdown, with a link to its CSV file.
@@ -295,7 +296,7 @@ pub fn generate(opts: &ReportOptions) -> Result<Report> {
     let wall_s = start.elapsed().as_secs_f64();
     let _ = writeln!(doc.text, "---\n\nWhole report: {wall_s:.1} s wall time.");
     let index = dir.join("index.md");
-    std::fs::write(&index, &doc.text).map_err(|e| Error::io(&index, e))?;
+    meshless_impact::files::write_whole_bytes(&index, doc.text.as_bytes())?;
     doc.files.push("index.md".into());
     Ok(Report {
         files: doc.files,

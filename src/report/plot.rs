@@ -127,12 +127,24 @@ pub fn lines(path: &Path, ax: Axes, series: &[Series]) -> Result<()> {
 /// Draws charts side by side into one SVG file: each its axes and series.
 pub fn panels(path: &Path, charts: &[(Axes, &[Series])]) -> Result<()> {
     let n = charts.len().max(1);
-    let root = SVGBackend::new(path, (SIZE.0 * n as u32, SIZE.1)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    for (area, (ax, series)) in root.split_evenly((1, n)).iter().zip(charts) {
-        chart(path, area, *ax, series)?;
+    svg_file(path, (SIZE.0 * n as u32, SIZE.1), |root| {
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        for (area, (ax, series)) in root.split_evenly((1, n)).iter().zip(charts) {
+            chart(path, area, *ax, series)?;
+        }
+        root.present().map_err(|e| plot_err(path, e))
+    })
+}
+
+/// Draws an SVG picture of `size` pixels with `draw` and writes it to
+/// `path` whole ([`meshless_impact::files::write_whole`]).
+fn svg_file(path: &Path, size: (u32, u32), draw: impl FnOnce(&Area) -> Result<()>) -> Result<()> {
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        draw(&root)?;
     }
-    root.present().map_err(|e| plot_err(path, e))
+    meshless_impact::files::write_whole_bytes(path, text.as_bytes())
 }
 
 /// The drawing area of one chart.
@@ -299,67 +311,68 @@ pub fn plane(
     let width = 420u32;
     let height =
         ((width as f64 - 90.0) * (y1 - y0) / (x1 - x0).max(1e-9) + 80.0).clamp(300.0, 900.0) as u32;
-    let root = SVGBackend::new(path, (width + 110, height)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    let (left, right) = root.split_horizontally(width);
-    let mut chart = ChartBuilder::on(&left)
-        .caption(frame.title, ("sans-serif", 16))
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(45)
-        .build_cartesian_2d(x0..x1, y0..y1)
+    svg_file(path, (width + 110, height), |root| {
+        root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+        let (left, right) = root.split_horizontally(width);
+        let mut chart = ChartBuilder::on(&left)
+            .caption(frame.title, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(45)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| plot_err(path, e))?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .disable_y_mesh()
+            .x_desc(frame.x)
+            .y_desc(frame.y)
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+        let inside = |p: &(f64, f64)| p.0 >= x0 && p.0 <= x1 && p.1 >= y0 && p.1 <= y1;
+        chart
+            .draw_series(
+                grey.iter()
+                    .filter(|p| inside(p))
+                    .map(|p| Circle::new(*p, 2, RGBColor(170, 170, 170).filled())),
+            )
+            .map_err(|e| plot_err(path, e))?;
+        let c = |v: f64| ViridisRGB::get_color_normalized(v, v0, v1);
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .zip(values)
+                    .filter(|(p, _)| inside(p))
+                    .map(|(p, &v)| Circle::new(*p, 2, c(v).filled())),
+            )
+            .map_err(|e| plot_err(path, e))?;
+        // Colour bar.
+        let mut bar = ChartBuilder::on(&right)
+            .margin_top(40)
+            .margin_bottom(45)
+            .margin_right(50)
+            .y_label_area_size(0)
+            .right_y_label_area_size(45)
+            .build_cartesian_2d(0.0..1.0, v0..v1)
+            .map_err(|e| plot_err(path, e))?;
+        let fmt = |v: &f64| super::sig(*v, 3);
+        bar.configure_mesh()
+            .disable_x_mesh()
+            .disable_y_mesh()
+            .disable_x_axis()
+            .y_labels(8)
+            .y_label_style(("sans-serif", 12))
+            .y_label_formatter(&fmt)
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+        let n = 64;
+        bar.draw_series((0..n).map(|k| {
+            let a = v0 + (v1 - v0) * k as f64 / n as f64;
+            let b = v0 + (v1 - v0) * (k + 1) as f64 / n as f64;
+            Rectangle::new([(0.0, a), (1.0, b)], c(0.5 * (a + b)).filled())
+        }))
         .map_err(|e| plot_err(path, e))?;
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .disable_y_mesh()
-        .x_desc(frame.x)
-        .y_desc(frame.y)
-        .draw()
-        .map_err(|e| plot_err(path, e))?;
-    let inside = |p: &(f64, f64)| p.0 >= x0 && p.0 <= x1 && p.1 >= y0 && p.1 <= y1;
-    chart
-        .draw_series(
-            grey.iter()
-                .filter(|p| inside(p))
-                .map(|p| Circle::new(*p, 2, RGBColor(170, 170, 170).filled())),
-        )
-        .map_err(|e| plot_err(path, e))?;
-    let c = |v: f64| ViridisRGB::get_color_normalized(v, v0, v1);
-    chart
-        .draw_series(
-            points
-                .iter()
-                .zip(values)
-                .filter(|(p, _)| inside(p))
-                .map(|(p, &v)| Circle::new(*p, 2, c(v).filled())),
-        )
-        .map_err(|e| plot_err(path, e))?;
-    // Colour bar.
-    let mut bar = ChartBuilder::on(&right)
-        .margin_top(40)
-        .margin_bottom(45)
-        .margin_right(50)
-        .y_label_area_size(0)
-        .right_y_label_area_size(45)
-        .build_cartesian_2d(0.0..1.0, v0..v1)
-        .map_err(|e| plot_err(path, e))?;
-    let fmt = |v: &f64| super::sig(*v, 3);
-    bar.configure_mesh()
-        .disable_x_mesh()
-        .disable_y_mesh()
-        .disable_x_axis()
-        .y_labels(8)
-        .y_label_style(("sans-serif", 12))
-        .y_label_formatter(&fmt)
-        .draw()
-        .map_err(|e| plot_err(path, e))?;
-    let n = 64;
-    bar.draw_series((0..n).map(|k| {
-        let a = v0 + (v1 - v0) * k as f64 / n as f64;
-        let b = v0 + (v1 - v0) * (k + 1) as f64 / n as f64;
-        Rectangle::new([(0.0, a), (1.0, b)], c(0.5 * (a + b)).filled())
-    }))
-    .map_err(|e| plot_err(path, e))?;
-    root.present().map_err(|e| plot_err(path, e))
+        root.present().map_err(|e| plot_err(path, e))
+    })
 }

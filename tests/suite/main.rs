@@ -10,6 +10,7 @@
 
 mod calibrate;
 mod capi;
+mod checkpoint;
 mod cli;
 mod common;
 mod golden;

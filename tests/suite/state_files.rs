@@ -14,18 +14,18 @@ use std::path::{Path, PathBuf};
 
 /// One committed state: the scene it is a run of, the time it was saved
 /// at, and the time the test runs both copies to.
-struct Case {
-    file: &'static str,
-    scene: &'static str,
-    sets: &'static [(&'static str, f64)],
-    saved_at: f64,
-    until: f64,
+pub(crate) struct Case {
+    pub(crate) file: &'static str,
+    pub(crate) scene: &'static str,
+    pub(crate) sets: &'static [(&'static str, f64)],
+    pub(crate) saved_at: f64,
+    pub(crate) until: f64,
 }
 
 /// One small run of each solver: axisymmetric MSPH (`taylor`), the Noh
 /// solver, the 3-D MLPG solver (`taylor3d`, and `penetration`: two bodies,
 /// quarter model, the ceramic's damage state) and the plate-impact solver.
-const CASES: &[Case] = &[
+pub(crate) const CASES: &[Case] = &[
     Case {
         file: "taylor.json",
         scene: "taylor",
@@ -76,7 +76,7 @@ fn folder(layout: &str) -> PathBuf {
 }
 
 /// The scene of a case.
-fn scene(case: &Case) -> Scene {
+pub(crate) fn scene(case: &Case) -> Scene {
     let mut scene = Scene::builtin(case.scene).unwrap();
     for (k, v) in case.sets {
         scene.set(k, *v).unwrap();

@@ -54,10 +54,10 @@ fn read(path: &Path) -> Result<String, String> {
 }
 
 /// Writes a zip with fixed timestamps, so the archive depends only on its
-/// contents.
+/// contents; the file is written whole (an FMU half written is never
+/// there: `meshless_impact::files::write_whole`).
 fn write_zip(path: &Path, entries: &[(String, &[u8])]) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut zip = zip::ZipWriter::new(file);
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
     let options = SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .last_modified_time(zip::DateTime::default())
@@ -67,9 +67,11 @@ fn write_zip(path: &Path, entries: &[(String, &[u8])]) -> Result<(), String> {
             .map_err(|e| format!("{name}: {e}"))?;
         zip.write_all(data).map_err(|e| format!("{name}: {e}"))?;
     }
-    zip.finish()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok(())
+    let bytes = zip
+        .finish()
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .into_inner();
+    meshless_impact::files::write_whole_bytes(path, &bytes).map_err(|e| e.to_string())
 }
 
 /// `documentation/index.html` of `fmu`: the template `fmu/index.html` with

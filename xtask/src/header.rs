@@ -21,7 +21,8 @@ pub fn run() -> Result<(), String> {
     let text = String::from_utf8(text).map_err(|e| format!("cbindgen's output: {e}"))?;
     let out = root.join("include/meshless_impact.h");
     std::fs::create_dir_all(root.join("include")).map_err(|e| e.to_string())?;
-    std::fs::write(&out, expand_header(&text)).map_err(|e| format!("{}: {e}", out.display()))?;
+    meshless_impact::files::write_whole_bytes(&out, expand_header(&text).as_bytes())
+        .map_err(|e| e.to_string())?;
     println!("wrote {}", out.display());
     Ok(())
 }

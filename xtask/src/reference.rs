@@ -29,7 +29,8 @@ pub fn run() -> Result<(), String> {
     }
     for (name, text) in &files {
         let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        meshless_impact::files::write_whole_bytes(&path, text.as_bytes())
+            .map_err(|e| e.to_string())?;
     }
     println!("wrote {} files to {}", files.len(), dir.display());
     Ok(())
