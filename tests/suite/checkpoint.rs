@@ -364,12 +364,15 @@ fn bad_checkpoints_are_refused_by_name_before_the_run_starts() {
     };
     let mut flipped = good.clone();
     flipped[good.len() / 2] ^= 0x04;
+    // The same content under a newer checkpoint format's first line, its
+    // frame made whole again.
     let newer = {
-        let text = String::from_utf8(good[..good.len() - 47].to_vec())
-            .unwrap()
-            .replacen("checkpoint 1\n", "checkpoint 7\n", 1);
-        let crc = crc32fast::hash(text.as_bytes());
-        format!("{text}\nend crc32={crc:08x} bytes={:020}\n", text.len())
+        let content = &good[..good.len() - 47];
+        let mut b = b"meshless-impact checkpoint 7".to_vec();
+        b.extend(&content[b"meshless-impact checkpoint 1".len()..]);
+        let (crc, len) = (crc32fast::hash(&b), b.len());
+        b.extend(format!("\nend crc32={crc:08x} bytes={len:020}\n").bytes());
+        b
     };
     let cases: Vec<(PathBuf, Vec<String>, &str, &str)> = vec![
         (
@@ -385,7 +388,7 @@ fn bad_checkpoints_are_refused_by_name_before_the_run_starts() {
             "CheckpointCorrupted",
         ),
         (
-            write("newer.ckpt", newer.as_bytes()),
+            write("newer.ckpt", &newer),
             vec![],
             "is of a newer format: it is of checkpoint format 7",
             "CheckpointNewerFormat",
