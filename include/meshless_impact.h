@@ -124,6 +124,12 @@ typedef enum {
      */
     MI_MEMORY_BUDGET = 16,
     /**
+     * A file given as a checkpoint (`mi_sim_checkpoint_load`) that cannot
+     * be continued: not a checkpoint, truncated, corrupted (a checksum or
+     * length that disagrees), of a newer format; the message says which.
+     */
+    MI_BAD_CHECKPOINT = 17,
+    /**
      * The run stopped: an MSPH moment matrix was singular (too few or
      * collinear neighbours).
      */
@@ -698,6 +704,40 @@ mi_result mi_sim_state_save(mi_sim *sim, uint8_t *buf, size_t len, size_t *neede
  * `len` bytes.
  */
 mi_result mi_sim_state_load(mi_sim *sim, const uint8_t *buf, size_t len);
+
+/**
+ * Writes the whole run (state, histories, scene) to the checkpoint file
+ * `path` (UTF-8): the file that `meshless-impact run --restart FILE`,
+ * Python's `Simulation.load` and `mi_sim_checkpoint_load` continue, to
+ * the bits of the run that was never stopped. The file is written whole:
+ * a temporary file in the same folder is flushed to the disk and renamed
+ * over `path`, so that a kill during the write leaves the previous
+ * checkpoint. For checkpoints every N steps or seconds, call it between
+ * `mi_sim_step`s. Codes: `MI_IO` (the folder is missing or not
+ * writable), and the stops of `mi_sim_state_save`.
+ *
+ * # Safety
+ * `sim` must be NULL or a live handle; `path` NULL or a NUL-terminated
+ * string.
+ */
+mi_result mi_sim_checkpoint_save(mi_sim *sim, const char *path);
+
+/**
+ * Replaces the run by the one saved in the checkpoint file `path`
+ * (`mi_sim_checkpoint_save`, or the program's `--checkpoint`), of the
+ * same scene kind; it continues from there. A file that cannot be
+ * continued is `MI_BAD_CHECKPOINT`, and the message
+ * (`mi_sim_last_error`) says which fault: not a checkpoint, truncated,
+ * corrupted (its CRC-32 or length disagrees), of a newer format; a
+ * checkpoint of another scene kind, or whose state is not one its scene
+ * reaches, is `MI_INVALID_STATE`; an unreadable file `MI_IO`. On failure
+ * the handle keeps its run.
+ *
+ * # Safety
+ * `sim` must be NULL or a live handle; `path` NULL or a NUL-terminated
+ * string.
+ */
+mi_result mi_sim_checkpoint_load(mi_sim *sim, const char *path);
 
 #ifdef __cplusplus
 }  // extern "C"

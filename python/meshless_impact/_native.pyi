@@ -89,6 +89,16 @@ class Simulation:
         """One particle field now, shaped (nodes,) or (nodes, components)."""
     def positions(self) -> npt.NDArray[np.float64]:
         """The nodes' positions, shaped (nodes, 2) (R, Z) or (nodes, 3)."""
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Writes the whole run to the checkpoint file ``path``, whole (a
+        temporary file renamed over it): what :meth:`load` and
+        ``meshless-impact run --restart`` continue."""
+    @staticmethod
+    def load(path: Union[str, "os.PathLike[str]"], *, threads: Optional[int] = None) -> "Simulation":
+        """The run saved in the checkpoint file ``path`` (by :meth:`save` or
+        ``meshless-impact run --checkpoint``); a bad file raises the subclass
+        of :class:`~meshless_impact.errors.BadCheckpoint` that names its
+        fault."""
     def save_state(self) -> bytes:
         """The complete state of the run (solver, history, scene)."""
     def load_state(self, state: bytes) -> None:

@@ -366,6 +366,22 @@ fn drive_loop(sim: &mut Core, until: Option<f64>, progress: Option<&Py<PyAny>>) 
     }
 }
 
+/// The thread pool of `threads` (None: the global pool).
+fn pool_of(threads: Option<usize>) -> PyResult<Option<Arc<rayon::ThreadPool>>> {
+    match threads {
+        None => Ok(None),
+        Some(0) => Err(PyValueError::new_err(
+            "parameter `threads` = 0 is out of range: allowed [1, inf) or None (the global pool)",
+        )),
+        Some(n) => Ok(Some(Arc::new(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| PyValueError::new_err(format!("threads = {n}: {e}")))?,
+        ))),
+    }
+}
+
 #[pymethods]
 impl Simulation {
     /// See `meshless_impact.Simulation`.
@@ -393,20 +409,7 @@ impl Simulation {
             };
             let params = kwargs(params)?;
             let scene = build_scene(scene, &choices, &params)?.map_err(|e| raise(py, &e))?;
-            let pool = match threads {
-                None => None,
-                Some(0) => {
-                    return Err(PyValueError::new_err(
-                        "parameter `threads` = 0 is out of range: allowed [1, inf) or None (the global pool)",
-                    ));
-                }
-                Some(n) => Some(Arc::new(
-                    rayon::ThreadPoolBuilder::new()
-                        .num_threads(n)
-                        .build()
-                        .map_err(|e| PyValueError::new_err(format!("threads = {n}: {e}")))?,
-                )),
-            };
+            let pool = pool_of(threads)?;
             // The setup (lattice, neighbours) can take a while in 3-D.
             let sim = py.detach(|| Core::new(scene)).map_err(|e| raise(py, &e))?;
             Ok(Simulation {
@@ -592,6 +595,38 @@ impl Simulation {
         guard(py, || {
             self.sim.check_savable().map_err(|e| raise(py, &e))?;
             Ok(PyBytes::new(py, &self.sim.serialize_state()))
+        })
+    }
+
+    /// Writes the whole run to the checkpoint file `path`, whole (a
+    /// temporary file renamed over it): what `meshless-impact run --restart`
+    /// and `Simulation.load` continue.
+    fn save(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+        self.check(py)?;
+        guard(py, || {
+            let sim = &self.sim;
+            py.detach(|| meshless_impact::checkpoint::save(&path, sim, &Default::default()))
+                .map_err(|e| raise(py, &e))
+        })
+    }
+
+    /// The run saved in the checkpoint file `path` (by `save`, or by the
+    /// program's `--checkpoint`), to go on with; a bad file raises the
+    /// subclass of `BadCheckpoint` that names its fault.
+    #[staticmethod]
+    #[pyo3(signature = (path, *, threads=None))]
+    fn load(py: Python<'_>, path: std::path::PathBuf, threads: Option<usize>) -> PyResult<Self> {
+        guard(py, || {
+            let pool = pool_of(threads)?;
+            let (sim, _) = py
+                .detach(|| meshless_impact::checkpoint::load(&path))
+                .map_err(|e| raise(py, &e))?;
+            Ok(Simulation {
+                sim,
+                stopped: None,
+                pool,
+                poisoned: false,
+            })
         })
     }
 

@@ -2,6 +2,8 @@
 JSON and CSV bit for bit, and its fields the C ABI's, for `taylor`,
 `taylor3d` and `penetration` (coarse, short runs)."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -96,6 +98,33 @@ def test_saved_state_continues_with_the_same_bits():
     b.run()
     assert a.observables() == b.observables()
     assert np.array_equal(bits(a.field("velocity")), bits(b.field("velocity")))
+
+
+def test_a_checkpoint_file_continues_with_the_same_bits_and_meets_the_cli(tmp_path):
+    params = CASES["taylor"]
+    a = mi.Simulation("taylor", **params)
+    a.advance_to(6e-6)
+    path = tmp_path / "run.ckpt"
+    a.save(path)
+    assert [p.name for p in tmp_path.iterdir()] == ["run.ckpt"], "no temporary file left"
+    b = mi.Simulation.load(path, threads=1)
+    assert b.time == a.time and b.steps == a.steps and b.params() == a.params()
+    a.run()
+    b.run()
+    assert a.observables() == b.observables()
+    assert np.array_equal(bits(a.field("velocity")), bits(b.field("velocity")))
+    # The program continues a checkpoint that Python wrote, to the same end.
+    from conftest import cli
+    out = tmp_path / "out.json"
+    cli("run", "--restart", str(path), "--json", str(out), "-q")
+    final = json.loads(out.read_text())
+    assert all(final[k] == v for k, v in a.observables().items())
+    # A bad file raises the class of its fault.
+    path.write_bytes(path.read_bytes()[:1000])
+    with pytest.raises(mi.errors.CheckpointTruncated, match="run.ckpt is truncated"):
+        mi.Simulation.load(path)
+    with pytest.raises(mi.errors.NotACheckpoint):
+        mi.Simulation.load(out)
 
 
 def test_progress_true_shows_a_line_and_changes_nothing(capfd):

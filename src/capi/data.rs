@@ -436,3 +436,67 @@ pub unsafe extern "C" fn mi_sim_state_load(
         Ok(())
     })
 }
+
+/// Writes the whole run (state, histories, scene) to the checkpoint file
+/// `path` (UTF-8): the file that `meshless-impact run --restart FILE`,
+/// Python's `Simulation.load` and `mi_sim_checkpoint_load` continue, to
+/// the bits of the run that was never stopped. The file is written whole:
+/// a temporary file in the same folder is flushed to the disk and renamed
+/// over `path`, so that a kill during the write leaves the previous
+/// checkpoint. For checkpoints every N steps or seconds, call it between
+/// `mi_sim_step`s. Codes: `MI_IO` (the folder is missing or not
+/// writable), and the stops of `mi_sim_state_save`.
+///
+/// # Safety
+/// `sim` must be NULL or a live handle; `path` NULL or a NUL-terminated
+/// string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mi_sim_checkpoint_save(
+    sim: *mut mi_sim,
+    path: *const c_char,
+) -> mi_result {
+    with_sim(sim, |s| {
+        // SAFETY: forwarded contract on `path`.
+        let p = unsafe { text(path, "path") }?;
+        let sim = s.sim()?;
+        crate::checkpoint::save(std::path::Path::new(p), sim, &serde_json::Value::Null)?;
+        Ok(())
+    })
+}
+
+/// Replaces the run by the one saved in the checkpoint file `path`
+/// (`mi_sim_checkpoint_save`, or the program's `--checkpoint`), of the
+/// same scene kind; it continues from there. A file that cannot be
+/// continued is `MI_BAD_CHECKPOINT`, and the message
+/// (`mi_sim_last_error`) says which fault: not a checkpoint, truncated,
+/// corrupted (its CRC-32 or length disagrees), of a newer format; a
+/// checkpoint of another scene kind, or whose state is not one its scene
+/// reaches, is `MI_INVALID_STATE`; an unreadable file `MI_IO`. On failure
+/// the handle keeps its run.
+///
+/// # Safety
+/// `sim` must be NULL or a live handle; `path` NULL or a NUL-terminated
+/// string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mi_sim_checkpoint_load(
+    sim: *mut mi_sim,
+    path: *const c_char,
+) -> mi_result {
+    with_sim(sim, |s| {
+        // SAFETY: forwarded contract on `path`.
+        let p = unsafe { text(path, "path") }?;
+        let (restored, _) = crate::checkpoint::load(std::path::Path::new(p))?;
+        if restored.kind() != s.kind() {
+            return Err(Fail::new(
+                mi_result::MI_INVALID_STATE,
+                format!(
+                    "the checkpoint {p} is of scene kind `{}`, the handle of `{}`",
+                    restored.kind(),
+                    s.kind()
+                ),
+            ));
+        }
+        s.restore(restored);
+        Ok(())
+    })
+}
