@@ -19,7 +19,11 @@
 #   read, the FMU state; about a minute and 4 GB), whose figures are in
 #   BENCHMARKS.md;
 # - the seed's penetration case at the default 6 nodes across (about 90 s),
-#   its residual velocity within 10 % of the seed's.
+#   its residual velocity within 10 % of the seed's;
+# - kill at random (scripts/kill_restart.py, about 10 s): the penetration
+#   case killed 20 times and sent SIGTERM once, restarted each time, ends
+#   on the uninterrupted run's outputs byte for byte, every file whole
+#   after every kill.
 # Every step runs even when an earlier one fails; the failed steps are
 # listed at the end and the exit status is 1 if any failed.
 set -uo pipefail
@@ -40,6 +44,8 @@ step cargo test --profile "$profile" --test boundary -- --ignored --nocapture
 step cargo test --profile "$profile" --test suite mlpg_solver::the_staggered_wilkins_bar_under_refinement -- --ignored --nocapture
 step cargo test --profile "$profile" --test suite mlpg_solver::the_wilkins_bar_in_3d_meets_its_references_on_the_staggered_lattice -- --ignored --nocapture
 step cargo test --profile "$profile" --test suite mlpg_solver::conforming_gradients_bring_the_wilkins_bar_to_the_axisymmetric_solver -- --ignored --nocapture
+step cargo build --profile "$profile" --bin meshless-impact
+step python3 scripts/kill_restart.py "target/$profile/meshless-impact"
 if [ ${#failed[@]} -gt 0 ]; then
   echo "== failed:"
   printf '  %s\n' "${failed[@]}"

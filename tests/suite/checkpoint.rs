@@ -7,28 +7,17 @@
 //! the run starts; the checkpoints committed under `tests/data/checkpoints/`
 //! load and continue.
 
-use crate::common::{bits, pvd_datasets};
+use crate::common::{self, bin, bits, pvd_datasets, stderr};
 use crate::state_files::{CASES, Case};
 use meshless_impact::Simulation;
 use meshless_impact::files::ABORT_BEFORE_RENAME;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::{Duration, Instant};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
-}
 
 /// A fresh, empty scratch folder for one test.
 fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mi-ckpt-{}-{test}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
+    common::scratch("ckpt", test)
 }
 
 /// The program's arguments for a run of `case` to its `until`.

@@ -1,13 +1,9 @@
 //! The command-line program: errors, outputs and the documented JSON keys.
 
-use crate::common;
+use crate::common::{self, bin, stderr};
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
-}
+use std::process::Output;
 
 /// A short Taylor run: a few milliseconds.
 const SMALL_RUN: [&str; 5] = [
@@ -30,14 +26,7 @@ const SMALL_SWEEP: [&str; 6] = [
 
 /// A fresh, empty scratch directory for one test.
 fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mi-cli-{}-{test}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
+    common::scratch("cli", test)
 }
 
 /// Asserts that `out` failed with exit status 1 and an error on stderr that

@@ -149,3 +149,21 @@ pub fn bits(s: &Simulation) -> Vec<u64> {
     v.extend(&s.history().values);
     v.iter().map(|x| x.to_bits()).collect()
 }
+
+/// The program, to run with arguments.
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
+}
+
+/// A fresh, empty scratch folder for one test of the file `file`.
+pub fn scratch(file: &str, test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("mi-{file}-{}-{test}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A process's stderr as text.
+pub fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
