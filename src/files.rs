@@ -34,11 +34,21 @@ pub fn partial_path(path: &Path) -> PathBuf {
 /// Writes `path` whole: `write` fills a temporary file in the same folder
 /// (buffered), which is flushed to the disk and renamed over `path`. On any
 /// failure the old `path` is untouched and the temporary file is removed;
-/// the error names `path`.
+/// the error names `path`. A link is followed (its target is replaced); a
+/// path that is not a regular file (`/dev/stdout`, a pipe) is written in
+/// place, as it cannot be replaced.
 pub fn write_whole(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
+    // A file that is not a regular one (a pipe, a terminal, /dev/stdout,
+    // /dev/null) cannot be replaced: it is written in place. A link is
+    // followed, so that its target is the file replaced.
+    let path = &match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => return write_in_place(path, write),
+        Ok(_) => std::fs::canonicalize(path).map_err(|e| Error::io(path, e))?,
+        Err(_) => path.to_path_buf(),
+    };
     let tmp = partial_path(path);
     let written = (|| -> std::io::Result<()> {
         let file = std::fs::File::create(&tmp)?;
@@ -64,6 +74,20 @@ pub fn write_whole(
     Ok(())
 }
 
+/// Writes a file that is not a regular one (a pipe, a device) in place.
+fn write_in_place(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
+    let done = (|| -> std::io::Result<()> {
+        let file = std::fs::OpenOptions::new().write(true).open(path)?;
+        let mut w = std::io::BufWriter::new(file);
+        write(&mut w)?;
+        w.flush()
+    })();
+    done.map_err(|e| Error::io(path, e))
+}
+
 /// [`write_whole`] of bytes.
 pub fn write_whole_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
     write_whole(path, |w| w.write_all(bytes))
@@ -85,6 +109,7 @@ fn sync_folder(path: &Path) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::os::unix::fs::FileTypeExt as _;
 
     fn folder(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("mi-files-{name}-{}", std::process::id()));
@@ -113,6 +138,41 @@ mod tests {
         write_whole_bytes(&path, b"new\n").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new\n");
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_link_is_followed_and_a_pipe_written_in_place() {
+        let dir = folder("link");
+        let target = dir.join("target.json");
+        write_whole_bytes(&target, b"old").unwrap();
+        let link = dir.join("link.json");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        write_whole_bytes(&link, b"new").unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        // A named pipe (as /dev/stdout is to a pipe) is written in place,
+        // and stays a pipe.
+        let fifo = dir.join("pipe");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        write_whole_bytes(&fifo, b"through").unwrap();
+        assert_eq!(reader.join().unwrap(), b"through");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
         let _ = std::fs::remove_dir_all(&dir);
     }
 

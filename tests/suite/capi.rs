@@ -109,6 +109,7 @@ fn result_codes_are_fixed() {
         (MI_SPACING_COLLAPSE, 26, "MI_SPACING_COLLAPSE"),
         (MI_COMPRESSION_LIMIT, 27, "MI_COMPRESSION_LIMIT"),
         (MI_PANIC, 30, "MI_PANIC"),
+        (MI_BAD_CHECKPOINT, 17, "MI_BAD_CHECKPOINT"),
     ];
     for (code, value, name) in fixed {
         assert_eq!(code as i32, value, "{name}");
@@ -118,7 +119,7 @@ fn result_codes_are_fixed() {
         let d = unsafe { CStr::from_ptr(mi_result_description(value)) };
         assert!(!d.to_bytes().is_empty());
     }
-    let n = unsafe { CStr::from_ptr(mi_result_name(17)) };
+    let n = unsafe { CStr::from_ptr(mi_result_name(18)) };
     assert_eq!(n.to_str().unwrap(), "MI_UNKNOWN_RESULT");
 }
 
@@ -698,6 +699,15 @@ fn every_error_code_is_produced() {
             &s.error(),
             "invalid",
         );
+        let not_one = std::env::temp_dir().join(format!("mi-capi-{}.ckpt", std::process::id()));
+        std::fs::write(&not_one, b"{\"format\": 2}").unwrap();
+        check(
+            mi_sim_checkpoint_load(s.0, c(not_one.to_str().unwrap()).as_ptr()),
+            MI_BAD_CHECKPOINT,
+            &s.error(),
+            "is not a checkpoint",
+        );
+        std::fs::remove_file(&not_one).ok();
         let mut small = [0.0; 2];
         check(
             mi_sim_observables(s.0, small.as_mut_ptr(), 2, null_mut()),
