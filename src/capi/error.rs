@@ -302,6 +302,6 @@ mod tests {
             assert!(name.ends_with('\0') && desc.ends_with('\0'));
             assert_eq!(format!("{code:?}\0"), *name);
         }
-        assert_eq!(RESULTS.len(), 26);
+        assert_eq!(RESULTS.len(), 27);
     }
 }
