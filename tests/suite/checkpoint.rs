@@ -273,6 +273,34 @@ fn sigterm_and_sigkill_restart_to_the_same_bits() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A second SIGTERM ends the run at once, with the shell's status of a
+/// process the signal ended (128 + 15), while the first is still finishing
+/// its step (a step of an 8-across penetration run takes some hundredths of
+/// a second here; the second signal follows the first by 5 ms).
+#[test]
+fn a_second_signal_ends_the_run_at_once() {
+    let dir = scratch("second");
+    let ckpt = dir.join("run.ckpt");
+    let child = bin()
+        .args(["run", "penetration", "-q", "--set", "particles_radial=8"])
+        .arg("--checkpoint")
+        .arg(&ckpt)
+        .args(["--checkpoint-steps", "1"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for(&ckpt);
+    signal(child.id(), "-TERM");
+    std::thread::sleep(Duration::from_millis(5));
+    signal(child.id(), "-TERM");
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(128 + 15), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a second signal ends the run at once"));
+    // The checkpoint there is whole.
+    meshless_impact::checkpoint::load(&ckpt).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A process stopped between the write of an output and its rename (the
 /// worst moment of a kill) leaves the old file as it was, whole: the
 /// results, the history, and the checkpoint, which still loads.
