@@ -154,8 +154,10 @@ pub struct HugoniotElasticLimit {
 }
 
 /// A JH-2 model ready to step points: the constants, checked, with their
-/// Hugoniot elastic limit. Built by [`JohnsonHolmquist::model`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Hugoniot elastic limit. Built by [`JohnsonHolmquist::model`]. Saved as
+/// its constants, and checked and derived again when read back.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "JohnsonHolmquist", into = "JohnsonHolmquist")]
 pub struct Jh2 {
     constants: JohnsonHolmquist,
     limit: HugoniotElasticLimit,
@@ -325,7 +327,39 @@ impl JohnsonHolmquist {
     }
 }
 
+impl TryFrom<JohnsonHolmquist> for Jh2 {
+    type Error = Error;
+    fn try_from(c: JohnsonHolmquist) -> Result<Jh2> {
+        c.model()
+    }
+}
+
+impl From<Jh2> for JohnsonHolmquist {
+    fn from(m: Jh2) -> JohnsonHolmquist {
+        m.constants
+    }
+}
+
 impl Jh2 {
+    /// The longitudinal (uniaxial-strain) tangent modulus at density `rho`
+    /// (Pa): `rho / rho0 dP/dmu + 4/3 G`, the tangent of the pressure
+    /// polynomial (`K1` in tension) with the shear stiffness of the
+    /// hypoelastic deviator; the bulking pressure adds no stiffness. Its
+    /// `sqrt(M / rho)` is the elastic wave speed.
+    pub fn longitudinal_modulus(&self, rho: f64) -> f64 {
+        let c = &self.constants;
+        let mu = rho / c.density - 1.0;
+        let [k1, k2, k3] = c.k;
+        let tangent = if mu > 0.0 {
+            k1 + mu * (2.0 * k2 + 3.0 * mu * k3)
+        } else {
+            k1
+        };
+        // A negative K2 or K3 may turn the tangent down at large mu: keep
+        // the wave speed positive with the shear part at least.
+        (rho / c.density * tangent).max(0.0) + 4.0 / 3.0 * c.shear_modulus
+    }
+
     /// The constants.
     pub fn constants(&self) -> &JohnsonHolmquist {
         &self.constants

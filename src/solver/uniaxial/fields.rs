@@ -86,6 +86,14 @@ impl PlateImpact {
                 .iter()
                 .map(|p| m.crack_density(p.crack_size))
                 .fold(0.0, f64::max),
+            // JH-2: its damage D in place of the crack density.
+            Layer::Jh2(_) => self.state.cells[self.setup.flyer_cells..]
+                .iter()
+                .map(|s| match s {
+                    CellState::Jh2(p) => p.damage,
+                    _ => 0.0,
+                })
+                .fold(0.0, f64::max),
             Layer::Solid(_) => 0.0,
         };
         let [kinetic, internal, contact] = self.energies();
@@ -111,6 +119,12 @@ impl PlateImpact {
         let cells = 0..self.state.cells.len();
         let ceramic = |c: usize| match (&self.state.cells[c], self.layer(c)) {
             (CellState::Ceramic(p), Layer::Ceramic(m)) => Some((p, m)),
+            _ => None,
+        };
+        // A JH-2 cell's damage D, which it reports in place of the crack
+        // density (log10 D) and, fully fractured (D = 1), as pulverized.
+        let jh2_damage = |c: usize| match &self.state.cells[c] {
+            CellState::Jh2(p) => Some(p.damage),
             _ => None,
         };
         let values: Vec<f64> = match name {
@@ -141,6 +155,7 @@ impl PlateImpact {
                 .map(|s| match s {
                     CellState::Ceramic(p) => p.pressure,
                     CellState::Solid(p, _) => p.pressure,
+                    CellState::Jh2(p) => p.pressure,
                 })
                 .collect(),
             "plastic_strain" => self
@@ -150,6 +165,7 @@ impl PlateImpact {
                 .map(|s| match s {
                     CellState::Ceramic(p) => p.plastic_strain,
                     CellState::Solid(p, _) => p.plastic_strain,
+                    CellState::Jh2(p) => p.plastic_strain,
                 })
                 .collect(),
             "crack_size" => cells
@@ -157,6 +173,9 @@ impl PlateImpact {
                 .collect(),
             "log10_crack_density" => cells
                 .map(|c| {
+                    if let Some(d) = jh2_damage(c) {
+                        return d.log10().max(LOG10_NO_CRACKS);
+                    }
                     ceramic(c).map_or(LOG10_NO_CRACKS, |(p, m)| {
                         m.crack_density(p.crack_size).log10().max(LOG10_NO_CRACKS)
                     })
@@ -167,6 +186,9 @@ impl PlateImpact {
                 .collect(),
             "pulverized" => cells
                 .map(|c| {
+                    if let Some(d) = jh2_damage(c) {
+                        return f64::from(u8::from(d >= 1.0));
+                    }
                     ceramic(c).map_or(0.0, |(p, _)| f64::from(u8::from(p.pulverized.is_some())))
                 })
                 .collect(),

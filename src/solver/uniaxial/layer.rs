@@ -1,6 +1,7 @@
 //! The plates' materials and the state of a cell's material point.
 
 use crate::error::{Error, Result};
+use crate::material::johnson_holmquist::{Jh2, Jh2Point};
 use crate::material::rajendran_grove::{CeramicPoint, RajendranGrove};
 use crate::material::tensor::Full;
 use crate::material::{Material, Point, PointState};
@@ -12,6 +13,9 @@ pub enum Layer {
     Ceramic(RajendranGrove),
     /// A material of the shared material code (metals).
     Solid(Material),
+    /// The Johnson-Holmquist ceramic (JH-2), stepped at its point by
+    /// [`Jh2::step`] (it keeps its own density and takes no energy).
+    Jh2(Jh2),
 }
 
 impl Layer {
@@ -19,6 +23,7 @@ impl Layer {
     pub fn density(&self) -> Result<f64> {
         match self {
             Layer::Ceramic(c) => Ok(c.density),
+            Layer::Jh2(j) => Ok(j.constants().density),
             Layer::Solid(m) => m.eos.reference_density().ok_or_else(|| {
                 Error::Inconsistent(
                     "a plate needs an equation of state with a reference density".into(),
@@ -31,12 +36,14 @@ impl Layer {
         match self {
             Layer::Ceramic(c) => c.validate(),
             Layer::Solid(m) => m.validate(),
+            Layer::Jh2(j) => j.constants().validate(),
         }
     }
 
     pub(super) fn initial_state(&self) -> CellState {
         match self {
             Layer::Ceramic(c) => CellState::Ceramic(c.initial_point()),
+            Layer::Jh2(j) => CellState::Jh2(j.initial_point()),
             Layer::Solid(m) => CellState::Solid(
                 Point {
                     deviator: [0.0; 6],
@@ -58,6 +65,7 @@ impl Layer {
             (Layer::Solid(m), CellState::Solid(p, _)) => {
                 (m.longitudinal_modulus(rho, p.pressure) / rho).sqrt()
             }
+            (Layer::Jh2(j), CellState::Jh2(_)) => (j.longitudinal_modulus(rho) / rho).sqrt(),
             _ => unreachable!("a cell's state matches its layer"),
         }
     }
@@ -66,11 +74,13 @@ impl Layer {
     /// ([`Material::update_with_energy`]). A ceramic plate's has placeholder
     /// thermal constants (specific heat 1 J/(kg K), reference temperature
     /// 0 K, no plastic heating): its cells keep their specific internal
-    /// energy, which the ceramic's update takes, and no temperature.
-    pub(super) fn material(&self) -> Material {
+    /// energy, which the ceramic's update takes, and no temperature. A JH-2
+    /// plate has none (`None`): its cells are stepped by [`Jh2::step`].
+    pub(super) fn material(&self) -> Option<Material> {
         match self {
-            Layer::Ceramic(c) => Material::ceramic(*c, 1.0, 0.0, 0.0),
-            Layer::Solid(m) => *m,
+            Layer::Ceramic(c) => Some(Material::ceramic(*c, 1.0, 0.0, 0.0)),
+            Layer::Solid(m) => Some(*m),
+            Layer::Jh2(_) => None,
         }
     }
 
@@ -84,6 +94,7 @@ impl Layer {
                 c.porosity_factor(c.initial_porosity) * c.shear_modulus,
             ),
             Layer::Solid(m) => (m.longitudinal_modulus(rho, 0.0), m.shear_modulus),
+            Layer::Jh2(j) => (j.longitudinal_modulus(rho), j.constants().shear_modulus),
         };
         Ok((
             (longitudinal / rho).sqrt(),
@@ -99,6 +110,7 @@ impl Layer {
 pub(super) enum CellState {
     Ceramic(CeramicPoint),
     Solid(Point<Full>, #[serde(skip)] PointState),
+    Jh2(Jh2Point),
 }
 
 impl CellState {
@@ -116,6 +128,15 @@ impl CellState {
                 PointState::with_ceramic(p.vars()),
             ),
             CellState::Solid(p, s) => (*p, *s),
+            CellState::Jh2(p) => (
+                Point {
+                    deviator: p.deviator,
+                    pressure: p.pressure,
+                    plastic_strain: p.plastic_strain,
+                    temperature: 0.0,
+                },
+                PointState::default(),
+            ),
         }
     }
 
@@ -132,6 +153,7 @@ impl CellState {
                 *p = new;
                 *s = state;
             }
+            CellState::Jh2(_) => unreachable!("a JH-2 point is stepped by its model"),
         }
     }
 }

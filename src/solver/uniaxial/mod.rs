@@ -361,7 +361,7 @@ impl PlateImpact {
             .iter()
             .filter_map(|s| match s {
                 CellState::Ceramic(p) => Some(*p),
-                CellState::Solid(..) => None,
+                CellState::Solid(..) | CellState::Jh2(_) => None,
             })
             .collect()
     }

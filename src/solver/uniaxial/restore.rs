@@ -69,6 +69,16 @@ impl PlateImpact {
                             .chain(&p.elastic_strain)
                             .all(|x| x.is_finite())
                 }
+                (CellState::Jh2(p), Layer::Jh2(_)) => {
+                    p.pressure.is_finite()
+                        && p.plastic_strain.is_finite()
+                        && p.plastic_strain >= 0.0
+                        && (0.0..=1.0).contains(&p.damage)
+                        && p.bulking.is_finite()
+                        && p.density.is_finite()
+                        && p.density > 0.0
+                        && p.deviator.iter().all(|x| x.is_finite())
+                }
                 (CellState::Solid(p, _), Layer::Solid(_)) => {
                     p.pressure.is_finite()
                         && p.plastic_strain.is_finite()

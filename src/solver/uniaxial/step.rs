@@ -1,6 +1,6 @@
 //! The central-difference step of the plates and its stable size.
 
-use super::layer::Layer;
+use super::layer::{CellState, Layer};
 use super::{LOST_CONTACT, PlateImpact};
 use crate::error::{Error, Result};
 use crate::material::Loading;
@@ -94,11 +94,34 @@ impl PlateImpact {
             };
             let k = usize::from(c >= self.setup.flyer_cells);
             let layer = self.setup.layers[k];
+            let material = if let Layer::Jh2(j) = layer {
+                let CellState::Jh2(p) = &mut self.state.cells[c] else {
+                    unreachable!("a cell's state matches its layer")
+                };
+                let before = *p;
+                j.step(p, &load.rate, dt);
+                // The first target cell pulled below the tensile limit of
+                // its damage at the start of the step (its trial pressure
+                // `P(mu) + dP` there; it fractured in tension, or, already
+                // fractured, carries no tension): the spall.
+                let mu = p.density / j.constants().density - 1.0;
+                if self.state.spall.is_none()
+                    && k == 1
+                    && j.constants().eos_pressure(mu) + before.bulking
+                        < j.tensile_limit(before.damage)
+                {
+                    let depth = (c - self.setup.flyer_cells) as f64;
+                    self.state.spall =
+                        Some(((depth + 0.5) * self.setup.length0[c], self.state.clock.time));
+                }
+                p.deviator[0] - p.pressure
+            } else {
             let (old, mut point_state) = self.state.cells[c].point();
+            let material_k = materials[k].expect("a ceramic or a metal has a material");
             let new = match layer {
                 // The ceramic's porous pressure takes the cell's specific
                 // internal energy.
-                Layer::Ceramic(_) => materials[k].update_with_energy(
+                Layer::Ceramic(_) => material_k.update_with_energy(
                     &load,
                     &old,
                     self.state.specific_energy[c],
@@ -106,7 +129,8 @@ impl PlateImpact {
                 ),
                 // A metal's pressure is at its temperature, as in the other
                 // solvers.
-                Layer::Solid(_) => materials[k].update(&load, &old, &mut point_state),
+                Layer::Solid(_) => material_k.update(&load, &old, &mut point_state),
+                Layer::Jh2(_) => unreachable!("stepped above"),
             }
             .map_err(|e| Error::CompressionLimit {
                 particle: c,
@@ -130,7 +154,8 @@ impl PlateImpact {
                 self.state.spall =
                     Some(((depth + 0.5) * self.setup.length0[c], self.state.clock.time));
             }
-            let material = new.deviator[0] - new.pressure;
+            new.deviator[0] - new.pressure
+            };
             let q = if d < 0.0 {
                 let c_l = layer.wave_speed(rho, &self.state.cells[c]);
                 let (cq, cl) = VISCOSITY;
