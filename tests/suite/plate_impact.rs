@@ -258,3 +258,129 @@ fn a_spall_signal_mid_way_through_the_target() {
         s("max_damage")
     );
 }
+
+/// The value of `flyer_material` and `target_material` that is the JH-2
+/// ceramic of the `jh_` block: after the ceramic and the metal presets.
+fn jh2_level() -> f64 {
+    (meshless_impact::materials::PRESETS.len() + 1) as f64
+}
+
+/// The JH-2 model of the scene's defaults: the example ceramic of Johnson
+/// & Holmquist (1994) as commonly quoted (`JohnsonHolmquist::example_ceramic`),
+/// the cap on the fractured strength aside (the scene's 1e10 for none).
+fn jh2_example() -> meshless_impact::materials::Jh2 {
+    meshless_impact::materials::JohnsonHolmquist {
+        sfmax: 1.0e10,
+        ..meshless_impact::materials::JohnsonHolmquist::example_ceramic()
+    }
+    .model()
+    .unwrap()
+}
+
+/// A JH-2 flyer (2 mm) on a JH-2 target (8 mm) at `speed`, through the
+/// scene, to 1.3 us (the elastic wave crosses the target in 0.97 us).
+fn jh2_run(speed: f64) -> meshless_impact::Simulation {
+    scene_run(&[
+        ("flyer_material", jh2_level()),
+        ("target_material", jh2_level()),
+        ("impact_speed", speed),
+        ("target_thickness", 8e-3),
+        ("cell", 2e-5),
+        ("end_time", 1.3e-6),
+    ])
+}
+
+/// The example JH-2 ceramic struck by itself at 1000 m/s, far above the
+/// HEL (the symmetric impact reaches the HEL at about 183 m/s): the
+/// precursor is the elastic wave to the HEL. Its `precursor_stress`
+/// (rho0 c_L u / 2) is the model's HEL, 2.79 GPa, within 2 %; its
+/// free-surface velocity is twice the particle velocity of an elastic
+/// shock to the HEL, `2 sqrt(HEL eps_HEL / rho0)` with `eps_HEL = mu_HEL /
+/// (1 + mu_HEL)`, within 2 %; the energy error stays under the 1 % the
+/// other plate-impact runs hold.
+#[test]
+fn jh2_precursor_at_the_hel() {
+    let sim = jh2_run(1000.0);
+    let j = jh2_example();
+    let c = j.constants();
+    let o = |name: &str| sim.observable(name).unwrap();
+    let mu = j.limit().mu;
+    let expected_u = 2.0 * (c.hel * mu / (1.0 + mu) / c.density).sqrt();
+    eprintln!(
+        "JH-2 at 1000 m/s: precursor_stress {:.4e} Pa against HEL {:.4e} Pa; precursor {:.2} m/s \
+         against {expected_u:.2} m/s; max_damage {}, spall_depth {}, energy error {:.2e}",
+        o("precursor_stress"),
+        c.hel,
+        o("precursor_velocity"),
+        o("max_damage"),
+        o("spall_depth"),
+        o("energy_error")
+    );
+    assert!(
+        (o("precursor_stress") / c.hel - 1.0).abs() < 0.02,
+        "{}",
+        o("precursor_stress")
+    );
+    assert!(
+        (o("precursor_velocity") / expected_u - 1.0).abs() < 0.02,
+        "{} {expected_u}",
+        o("precursor_velocity")
+    );
+    // Behind the elastic wave the target yields and its impact face is
+    // damaged.
+    assert!(o("max_damage") > 0.0);
+    assert!(o("energy_error").is_finite() && o("energy_error") < 0.01);
+}
+
+/// Below the HEL (100 m/s): the wave is elastic, its stress `rho0 c_L v /
+/// 2` with `c_L = sqrt((K1 + 4/3 G) / rho0)` (1.524 GPa for the example
+/// ceramic), within 2 %, and the free surface moves at the impact speed
+/// (the wave doubles the particle velocity v / 2), within 2 %.
+#[test]
+fn jh2_elastic_wave_below_the_hel() {
+    let v = 100.0;
+    let sim = jh2_run(v);
+    let c = *jh2_example().constants();
+    let c_l = ((c.k[0] + 4.0 / 3.0 * c.shear_modulus) / c.density).sqrt();
+    let expected = 0.5 * c.density * c_l * v;
+    let o = |name: &str| sim.observable(name).unwrap();
+    eprintln!(
+        "JH-2 at 100 m/s: precursor_stress {:.4e} Pa against rho0 c_L v / 2 = {expected:.4e} Pa; \
+         precursor {:.2} m/s, peak {:.2} m/s; energy error {:.2e}",
+        o("precursor_stress"),
+        o("precursor_velocity"),
+        o("peak_velocity"),
+        o("energy_error")
+    );
+    assert!(
+        (o("precursor_stress") / expected - 1.0).abs() < 0.02,
+        "{} {expected}",
+        o("precursor_stress")
+    );
+    assert!(
+        (o("precursor_velocity") / v - 1.0).abs() < 0.02,
+        "{}",
+        o("precursor_velocity")
+    );
+    assert!(o("energy_error").is_finite() && o("energy_error") < 0.01);
+}
+
+/// A JH-2 run to the scene's default end time (2 us, so that the release
+/// waves meet in the target) with a metal flyer: it finishes, with a
+/// finite energy error under 1 %.
+#[test]
+fn jh2_target_under_a_metal_flyer_conserves_energy() {
+    let sim = scene_run(&[
+        ("flyer_material", 1.0),
+        ("target_material", jh2_level()),
+        ("impact_speed", 500.0),
+    ]);
+    let o = |name: &str| sim.observable(name).unwrap();
+    eprintln!(
+        "steel on JH-2 at 500 m/s: energy error {:.2e}, max_damage {}, spall_depth {}",
+        o("energy_error"),
+        o("max_damage"),
+        o("spall_depth")
+    );
+    assert!(o("energy_error").is_finite() && o("energy_error") < 0.01);
+}
