@@ -251,12 +251,15 @@ impl PlateImpact {
     /// Records the free surface's velocity and reads it.
     fn record(&mut self) {
         let u = *self.state.v.last().expect("nodes");
+        // A JH-2 target's precursor ramps on after its elastic front: read
+        // at its knee.
+        let knee = matches!(self.setup.layers[1], Layer::Jh2(_));
         if self.pipe.keep_history {
             self.pipe.free_surface.push((self.state.clock.time, u));
         }
         self.state
             .reading
-            .read(self.state.clock.time, u, self.setup.impact_speed);
+            .read(self.state.clock.time, u, self.setup.impact_speed, knee);
     }
 
     /// Runs until `end_time` (s) from now on: [`PlateImpact::finished`]

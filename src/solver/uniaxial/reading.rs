@@ -27,19 +27,39 @@ pub struct FreeSurfaceReading {
     pub phase: u8,
     /// The velocity read at the step before (m/s).
     pub last: f64,
+    /// The largest rise of the velocity in one step since the arrival
+    /// (m/s), for the knee of a ramped precursor ([`KNEE`]).
+    #[serde(default)]
+    pub steepest: f64,
 }
+
+/// A precursor read at its knee ends where the velocity's rise in one step
+/// falls below this fraction of the steepest rise of the front so far. A
+/// JH-2 target's strength grows with pressure, so above the HEL its
+/// free-surface velocity does not stop rising after the elastic front: it
+/// ramps on until the plastic wave (for the example ceramic struck at
+/// 1000 m/s, from 183 to 225 m/s over 0.2 us, at about a twentieth of the
+/// front's rate), and the elastic precursor is the knee at the top of the
+/// front.
+pub const KNEE: f64 = 0.1;
 
 impl FreeSurfaceReading {
     /// Reads the free-surface velocity `u` (m/s) at time `time` (s) of a run
-    /// at `impact_speed` (m/s).
-    pub(super) fn read(&mut self, time: f64, u: f64, impact_speed: f64) {
+    /// at `impact_speed` (m/s). With `knee` (a JH-2 target) the precursor
+    /// ends also where the rise slows to [`KNEE`] of its steepest.
+    pub(super) fn read(&mut self, time: f64, u: f64, impact_speed: f64, knee: bool) {
         let r = self;
         if r.arrival.is_none() {
             if u > 0.01 * impact_speed.abs() {
                 r.arrival = Some(time);
             }
-        } else if r.precursor.is_none() && u < r.last {
+        } else if r.precursor.is_none()
+            && (u < r.last || (knee && u - r.last < KNEE * r.steepest))
+        {
             r.precursor = Some(r.last);
+        }
+        if knee && r.arrival.is_some() {
+            r.steepest = r.steepest.max(u - r.last);
         }
         r.last = u;
         let slack = 0.05 * impact_speed.abs();

@@ -106,6 +106,8 @@ impl PlateImpact {
         let r = self.state.reading;
         let finite = r.peak.is_finite()
             && r.pullback_minimum.is_finite()
+            && r.steepest.is_finite()
+            && r.steepest >= 0.0
             && r.last.abs() <= bound
             && r.phase <= 2
             && r.arrival
