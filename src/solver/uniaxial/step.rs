@@ -100,13 +100,15 @@ impl PlateImpact {
                 };
                 let before = *p;
                 j.step(p, &load.rate, dt);
-                // The first target cell pulled below the tensile limit of
-                // its damage at the start of the step (its trial pressure
-                // `P(mu) + dP` there; it fractured in tension, or, already
-                // fractured, carries no tension): the spall.
+                // The first target cell not yet fully fractured that was
+                // pulled below the tensile limit of its damage at the start
+                // of the step (its trial pressure `P(mu) + dP` there): it
+                // fractured in tension, the spall. A cell already crushed
+                // to D = 1 in compression and pulled apart does not count.
                 let mu = p.density / j.constants().density - 1.0;
                 if self.state.spall.is_none()
                     && k == 1
+                    && before.damage < 1.0
                     && j.constants().eos_pressure(mu) + before.bulking
                         < j.tensile_limit(before.damage)
                 {
