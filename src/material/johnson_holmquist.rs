@@ -3,8 +3,9 @@
 //! constitutive model for brittle materials", AIP Conf. Proc. 309, pp.
 //! 981-984 (cited below as JH94), in the form of LS-DYNA's
 //! `*MAT_JOHNSON_HOLMQUIST_CERAMICS` (`*MAT_110`, LS-DYNA Keyword User's
-//! Manual, Volume II; cited as MAT_110). A point model only: nothing here is
-//! wired into a material, a scene or a solver yet.
+//! Manual, Volume II; cited as MAT_110). A point model; the plate-impact
+//! solver steps it as the plate material `Layer::Jh2` (the `plate_impact`
+//! scene's level `jh2`, constants under `jh_`).
 //!
 //! The model, with the sources read for each part (the paper itself was not
 //! at hand; its equations are those every secondary source below repeats):

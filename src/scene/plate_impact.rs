@@ -2,7 +2,10 @@
 //! uniaxial strain ([`crate::PlateImpact`], `src/solver/uniaxial/mod.rs`), the
 //! experiment that ceramic models are calibrated with. Either plate is the
 //! Rajendran-Grove ceramic (the `plate_` block, defaults AD85 as in
-//! `penetration`) or one of the metal presets ([`crate::Preset`]). The
+//! `penetration`), one of the metal presets ([`crate::Preset`]), or the
+//! Johnson-Holmquist ceramic JH-2 (level `jh2`, the `jh_` block, defaults
+//! the example ceramic of Johnson & Holmquist 1994; its precursor is read
+//! at the knee of its ramped free-surface velocity). The
 //! target's free-surface velocity is read as an experimenter reads a VISAR
 //! record: the elastic precursor gives the Hugoniot elastic limit
 //! `rho0 c_L u / 2`, and the pullback after the peak gives the spall
