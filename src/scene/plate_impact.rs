@@ -22,8 +22,8 @@ use super::row::{FmuIdentity, SceneRow, no_variants};
 use crate::budget::MemoryPerNode;
 use crate::error::{Error, Result};
 use crate::material::Damage;
-use crate::material::johnson_holmquist::{Failure, Jh2, JohnsonHolmquist};
 use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
+use crate::material::johnson_holmquist::{Failure, Jh2, JohnsonHolmquist};
 use crate::material::presets::Preset;
 use crate::observe::PLATE_IMPACT_OBSERVABLES;
 use crate::solver::uniaxial::{Layer, PlateImpact};
@@ -377,7 +377,9 @@ fn jh2(s: &Scene) -> Result<Jh2> {
         Error::OutOfRange { name, value, range } => Error::OutOfRange {
             name: match name.as_str() {
                 "hel" => "jh_hel (no compression up to mu = 1 reaches it)".to_string(),
-                "p_hel" => "P_HEL derived from jh_hel, jh_shear_modulus and jh_k1..jh_k3".to_string(),
+                "p_hel" => {
+                    "P_HEL derived from jh_hel, jh_shear_modulus and jh_k1..jh_k3".to_string()
+                }
                 n if n.starts_with("jh_") => n.to_string(),
                 n => format!("jh_{n}"),
             },
@@ -439,7 +441,10 @@ mod tests {
     #[test]
     fn the_jh2_block_is_the_example_ceramic() {
         let mut s = Scene::builtin("plate_impact").unwrap();
-        let level = LAYER_MATERIALS.iter().position(|l| l.name == JH2_LEVEL).unwrap() as f64;
+        let level = LAYER_MATERIALS
+            .iter()
+            .position(|l| l.name == JH2_LEVEL)
+            .unwrap() as f64;
         s.set("flyer_material", level).unwrap();
         s.set("target_material", level).unwrap();
         let Layer::Jh2(j) = layer(level, &s).unwrap() else {

@@ -53,8 +53,7 @@ impl FreeSurfaceReading {
             if u > 0.01 * impact_speed.abs() {
                 r.arrival = Some(time);
             }
-        } else if r.precursor.is_none()
-            && (u < r.last || (knee && u - r.last < KNEE * r.steepest))
+        } else if r.precursor.is_none() && (u < r.last || (knee && u - r.last < KNEE * r.steepest))
         {
             r.precursor = Some(r.last);
         }

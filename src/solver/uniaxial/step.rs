@@ -118,45 +118,45 @@ impl PlateImpact {
                 }
                 p.deviator[0] - p.pressure
             } else {
-            let (old, mut point_state) = self.state.cells[c].point();
-            let material_k = materials[k].expect("a ceramic or a metal has a material");
-            let new = match layer {
-                // The ceramic's porous pressure takes the cell's specific
-                // internal energy.
-                Layer::Ceramic(_) => material_k.update_with_energy(
-                    &load,
-                    &old,
-                    self.state.specific_energy[c],
-                    &mut point_state,
-                ),
-                // A metal's pressure is at its temperature, as in the other
-                // solvers.
-                Layer::Solid(_) => material_k.update(&load, &old, &mut point_state),
-                Layer::Jh2(_) => unreachable!("stepped above"),
-            }
-            .map_err(|e| Error::CompressionLimit {
-                particle: c,
-                time: self.state.clock.time,
-                compression: e.compression,
-                limit: e.limit,
-            })?;
-            self.state.cells[c].set(new, point_state);
-            // The first target cell pulverized in tension (its elastic
-            // volumetric strain at pulverization, which the pulverized
-            // state keeps, an expansion): the spall.
-            if self.state.spall.is_none()
-                && k == 1
-                && matches!(layer, Layer::Ceramic(_))
-                && point_state
-                    .ceramic()
-                    .and_then(|v| v.pulverized)
-                    .is_some_and(|z| z.volumetric_strain > 0.0)
-            {
-                let depth = (c - self.setup.flyer_cells) as f64;
-                self.state.spall =
-                    Some(((depth + 0.5) * self.setup.length0[c], self.state.clock.time));
-            }
-            new.deviator[0] - new.pressure
+                let (old, mut point_state) = self.state.cells[c].point();
+                let material_k = materials[k].expect("a ceramic or a metal has a material");
+                let new = match layer {
+                    // The ceramic's porous pressure takes the cell's specific
+                    // internal energy.
+                    Layer::Ceramic(_) => material_k.update_with_energy(
+                        &load,
+                        &old,
+                        self.state.specific_energy[c],
+                        &mut point_state,
+                    ),
+                    // A metal's pressure is at its temperature, as in the other
+                    // solvers.
+                    Layer::Solid(_) => material_k.update(&load, &old, &mut point_state),
+                    Layer::Jh2(_) => unreachable!("stepped above"),
+                }
+                .map_err(|e| Error::CompressionLimit {
+                    particle: c,
+                    time: self.state.clock.time,
+                    compression: e.compression,
+                    limit: e.limit,
+                })?;
+                self.state.cells[c].set(new, point_state);
+                // The first target cell pulverized in tension (its elastic
+                // volumetric strain at pulverization, which the pulverized
+                // state keeps, an expansion): the spall.
+                if self.state.spall.is_none()
+                    && k == 1
+                    && matches!(layer, Layer::Ceramic(_))
+                    && point_state
+                        .ceramic()
+                        .and_then(|v| v.pulverized)
+                        .is_some_and(|z| z.volumetric_strain > 0.0)
+                {
+                    let depth = (c - self.setup.flyer_cells) as f64;
+                    self.state.spall =
+                        Some(((depth + 0.5) * self.setup.length0[c], self.state.clock.time));
+                }
+                new.deviator[0] - new.pressure
             };
             let q = if d < 0.0 {
                 let c_l = layer.wave_speed(rho, &self.state.cells[c]);
