@@ -141,7 +141,7 @@ pub mod materials {
     pub use crate::material::eos::LinearEos;
     pub use crate::material::ideal_gas::IdealGas;
     pub use crate::material::johnson_cook::JohnsonCook;
-    pub use crate::material::johnson_holmquist::{Jh2, Jh2Point, JohnsonHolmquist};
+    pub use crate::material::johnson_holmquist::{Failure, Jh2, Jh2Point, JohnsonHolmquist};
     pub use crate::material::mie_gruneisen::{CompressionLimit, MieGruneisen};
     pub use crate::material::presets::{PRESETS, Preset};
     pub use crate::material::rajendran_grove::{CeramicPoint, Pulverized, RajendranGrove};

@@ -28,7 +28,7 @@ pub struct FreeSurfaceReading {
     /// The velocity read at the step before (m/s).
     pub last: f64,
     /// The largest rise of the velocity in one step since the arrival
-    /// (m/s), for the knee of a ramped precursor ([`KNEE`]).
+    /// (m/s), for the knee of a ramped precursor (`KNEE`).
     #[serde(default)]
     pub steepest: f64,
 }
