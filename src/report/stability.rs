@@ -214,7 +214,7 @@ fn cases_plate_impact() -> Vec<Def> {
         def(
             "plate_impact_invalid_material",
             p,
-            vec![("target_material", 7.0)],
+            vec![("target_material", 99.0)],
         ),
         def(
             "plate_impact_invalid_thickness",

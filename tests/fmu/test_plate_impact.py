@@ -70,7 +70,7 @@ def test_fmu_state_rolls_back_and_moves_between_instances(tmp_path_factory):
 def test_bad_values_are_refused_with_their_names():
     for m, make in ((fmu(), slave3), (fmu("_fmi2"), slave2)):
         for name, value, needle in [
-            ("flyer_material", 7, "parameter `flyer_material` = 7 is out of range"),
+            ("flyer_material", 99, "parameter `flyer_material` = 99 is out of range"),
             ("target_thickness", -0.001, "parameter `target_thickness` = -0.001 is out of range"),
             ("impact_speed", float("nan"), "parameter `impact_speed` = NaN is out of range"),
         ]:
