@@ -7,7 +7,7 @@
 //! the run starts; the checkpoints committed under `tests/data/checkpoints/`
 //! load and continue.
 
-use crate::common::{self, bin, bits, pvd_datasets, stderr};
+use crate::common::{self, bin, pvd_datasets, stderr};
 use crate::state_files::{CASES, Case};
 use meshless_impact::Simulation;
 use meshless_impact::files::ABORT_BEFORE_RENAME;
@@ -471,15 +471,10 @@ fn committed(format: &str) -> PathBuf {
 fn committed_checkpoints_load_and_continue_to_the_same_bits() {
     for case in CASES {
         let path = committed("v1").join(case.file.replace(".json", ".ckpt"));
-        let (mut back, host) = meshless_impact::checkpoint::load(&path)
+        let (back, host) = meshless_impact::checkpoint::load(&path)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert!(host.is_null(), "{}", case.file);
-        let mut whole = Simulation::new(crate::state_files::scene(case)).unwrap();
-        whole.advance_to(case.saved_at).unwrap();
-        assert_eq!(bits(&back), bits(&whole), "{}: as saved", case.file);
-        back.advance_to(case.until).unwrap();
-        whole.advance_to(case.until).unwrap();
-        assert_eq!(bits(&back), bits(&whole), "{}: continued", case.file);
+        crate::state_files::assert_continues(back, case);
     }
 }
 

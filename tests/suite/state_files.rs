@@ -98,20 +98,27 @@ fn states_of_every_format_load_and_continue_to_the_same_bits() {
         let (format, case) = case;
         let path = folder(format).join(case.file);
         let bytes = std::fs::read(&path).unwrap();
-        let mut back = Simulation::deserialize_state(&bytes)
+        let back = Simulation::deserialize_state(&bytes)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let mut whole = Simulation::new(scene(case)).unwrap();
-        whole.advance_to(case.saved_at).unwrap();
-        assert_eq!(bits(&back), bits(&whole), "{}: as saved", case.file);
-        back.advance_to(case.until).unwrap();
-        whole.advance_to(case.until).unwrap();
-        assert!(
-            whole.steps() > 0 && back.time() >= case.until,
-            "{}",
-            case.file
-        );
-        assert_eq!(bits(&back), bits(&whole), "{}: continued", case.file);
+        assert_continues(back, case);
     }
+}
+
+/// Asserts that `back`, a run of `case` restored at its `saved_at`, is the
+/// uninterrupted run at that time bit for bit, and goes on to its bits at
+/// `until`.
+pub(crate) fn assert_continues(mut back: Simulation, case: &Case) {
+    let mut whole = Simulation::new(scene(case)).unwrap();
+    whole.advance_to(case.saved_at).unwrap();
+    assert_eq!(bits(&back), bits(&whole), "{}: as saved", case.file);
+    back.advance_to(case.until).unwrap();
+    whole.advance_to(case.until).unwrap();
+    assert!(
+        whole.steps() > 0 && back.time() >= case.until,
+        "{}",
+        case.file
+    );
+    assert_eq!(bits(&back), bits(&whole), "{}: continued", case.file);
 }
 
 /// Writes the states of [`CASES`] into the folder `MI_RECORD_STATES` (run
