@@ -20,6 +20,7 @@ use crate::material::Damage;
 use crate::material::Material;
 use crate::material::rajendran_grove::RajendranGrove;
 use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
+use crate::solver::mlpg3d::failure::PlateNodes;
 use crate::solver::mlpg3d::{Body, Energies, MLPG_FIELDS, Mlpg3d, RodSetup};
 
 /// What a penetration run adds to its projectile's [`RodSetup`] (which
@@ -315,10 +316,43 @@ impl Penetration {
         (damaged / total, pulverized / total, max)
     }
 
+    /// The plate's failure modes ([`super::failure`]):
+    /// `(cone_half_angle, radial_crack_count, comminuted_radius)`; zeros
+    /// for a plate without damage. The radial cracks are counted at the
+    /// projectile's diameter from the axis (at most 0.8 of the plate's
+    /// radius).
+    pub fn failure_modes(&self) -> (f64, f64, f64) {
+        let Some(c) = self.ceramic() else {
+            return (0.0, 0.0, 0.0);
+        };
+        let at = self.run.reference();
+        let plate: Vec<usize> = self.nodes(1).collect();
+        let reference: Vec<[f64; 3]> = plate.iter().map(|&i| at[i]).collect();
+        let (gamma, pulverized): (Vec<f64>, Vec<bool>) =
+            self.plate_damage().iter().map(|&(g, p, _)| (g, p)).unzip();
+        let rod = self.run.setup();
+        let nodes = PlateNodes {
+            reference: &reference,
+            gamma: &gamma,
+            pulverized: &pulverized,
+            damaged: c.damaged_threshold(),
+            thickness: self.setup.plate.length,
+            spacing: rod.cylinder.radius / rod.rings as f64,
+            quarter: rod.quarter,
+        };
+        let radius = (2.0 * rod.cylinder.radius).min(0.8 * self.setup.plate.radius);
+        (
+            nodes.cone_half_angle(),
+            nodes.radial_crack_count(radius),
+            nodes.comminuted_radius(),
+        )
+    }
+
     /// Current values of [`PENETRATION_OBSERVABLES`], in that order.
     pub fn observables(&self) -> Vec<f64> {
         let e = self.energies();
         let (damaged, pulverized, max) = self.damage();
+        let (cone, cracks, comminuted) = self.failure_modes();
         let values = vec![
             self.projectile_velocity(),
             self.projectile_extent(),
@@ -333,6 +367,9 @@ impl Penetration {
             e.smoothing,
             e.error,
             self.outcome() as u8 as f64,
+            cone,
+            cracks,
+            comminuted,
         ];
         debug_assert_eq!(values.len(), PENETRATION_OBSERVABLES.len());
         values
