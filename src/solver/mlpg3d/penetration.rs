@@ -416,6 +416,7 @@ impl Penetration {
             "porosity" => damage()
                 .map(|(_, v, _)| v.map_or(0.0, |v| v.porosity))
                 .collect(),
+            "place_at_impact" => self.run.reference().iter().flatten().copied().collect(),
             _ => return self.run.field(name),
         })
     }
@@ -425,8 +426,10 @@ impl Penetration {
 /// body of each node (0 projectile, 1 plate), the crack density γ, the
 /// pulverized flag, the porosity, the node mass, and, so that partial
 /// damage shows, log10 γ (floored at [`crate::LOG10_NO_CRACKS`],
-/// its value at the projectile's nodes) and the crack radius a (m; 0 at
-/// the projectile's nodes).
+/// its value at the projectile's nodes), the crack radius a (m; 0 at
+/// the projectile's nodes), and the place at impact of the material each
+/// node is on (m; the plate's rear face is the nodes whose `z0` is the
+/// plate's `-thickness`).
 pub const PENETRATION_FIELDS: &[FieldSpec] = &{
     const fn scalar(
         name: &'static str,
@@ -447,8 +450,9 @@ pub const PENETRATION_FIELDS: &[FieldSpec] = &{
         scalar("mass", "kg", &["m"]),
         scalar("log10_damage", "1", &["log10_gamma"]),
         scalar("crack_size", "m", &["a"]),
+        scalar("place_at_impact", "m", &["x0", "y0", "z0"]),
     ];
-    let mut out = [own[0]; MLPG_FIELDS.len() + 7];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 8];
     let mut i = 0;
     while i < out.len() {
         out[i] = if i < MLPG_FIELDS.len() {
