@@ -92,6 +92,41 @@ pub struct History {
 }
 
 impl History {
+    /// A history saved before some of the scene's observables existed
+    /// (those added after the others, at the end of the list): when its
+    /// names are the first of `specs`' names, the later ones are added as
+    /// columns that read 0 in every record so far (they were not recorded
+    /// then; the records after a restart hold their values). Returns the
+    /// names added; a history of other names is left as it is (and refused
+    /// by the check of a restored run).
+    pub(crate) fn adopt_later_observables(&mut self, specs: &[ObservableSpec]) -> Vec<String> {
+        let (had, now) = (self.names.len(), specs.len());
+        if had >= now
+            || specs[..had]
+                .iter()
+                .zip(&self.names)
+                .any(|(s, n)| s.name != n)
+        {
+            return Vec::new();
+        }
+        let rows = self.times.len();
+        if self.values.len() != rows * had {
+            return Vec::new();
+        }
+        let mut values = Vec::with_capacity(rows * now);
+        for row in self.values.chunks(had.max(1)).take(rows) {
+            values.extend_from_slice(&row[..had]);
+            values.extend(std::iter::repeat_n(0.0, now - had));
+        }
+        if had == 0 {
+            values = vec![0.0; rows * now];
+        }
+        self.values = values;
+        let added: Vec<String> = specs[had..].iter().map(|s| s.name.to_string()).collect();
+        self.names.extend(added.iter().cloned());
+        added
+    }
+
     /// An empty history for these observables.
     pub fn new(specs: &[ObservableSpec]) -> Self {
         History {

@@ -267,9 +267,7 @@ impl Penetration {
             .map(|i| {
                 let vars = points.get(i).and_then(|p| p.ceramic());
                 match (c, vars) {
-                    (Some(c), Some(v)) => {
-                        (c.crack_density(v.crack_size), v.pulverized.is_some(), m[i])
-                    }
+                    (Some(c), Some(v)) => (v.crack_density(c), v.pulverized.is_some(), m[i]),
                     (Some(c), None) => (c.crack_density(c.initial_crack_size), false, m[i]),
                     _ => (0.0, false, m[i]),
                 }
@@ -391,14 +389,14 @@ impl Penetration {
             "mass" => self.run.masses().to_vec(),
             "damage" => damage()
                 .map(|(c, v, g)| match (c, v) {
-                    (Some(c), Some(v)) if g == 1 => c.crack_density(v.crack_size),
+                    (Some(c), Some(v)) if g == 1 => v.crack_density(c),
                     _ => 0.0,
                 })
                 .collect(),
             "log10_damage" => damage()
                 .map(|(c, v, g)| match (c, v) {
-                    (Some(c), Some(v)) if g == 1 => c
-                        .crack_density(v.crack_size)
+                    (Some(c), Some(v)) if g == 1 => v
+                        .crack_density(c)
                         .log10()
                         .max(crate::observe::LOG10_NO_CRACKS),
                     _ => crate::observe::LOG10_NO_CRACKS,
