@@ -451,7 +451,9 @@ fn a_state_saved_after_a_stop_loads_back() {
 /// `plate_impact` and, as a quarter model at 3 across, in `penetration`.
 #[test]
 fn runs_of_the_new_ceramics_saved_mid_way_resume_to_the_same_bits() {
-    let cases: [(&str, &[(&str, f64)], f64, f64); 3] = [
+    /// A scene, its settings, the time it is saved at and the time it runs to.
+    type Case<'a> = (&'a str, &'a [(&'a str, f64)], f64, f64);
+    let cases: [Case; 3] = [
         (
             "plate_impact",
             &[
