@@ -47,7 +47,7 @@
 //! principal-stress fracture models. A split plane opens and closes
 //! without memory of its opening beyond the crack size.
 
-use super::tensor::Full;
+use super::tensor::{Full, matrix};
 use std::f64::consts::PI;
 
 /// The tensile cracks of a point: the three planes' normals and their crack
@@ -78,11 +78,6 @@ pub struct CrackPlanes {
     pub critical_density: f64,
     /// Friction coefficient of a closed crack (1).
     pub friction: f64,
-}
-
-/// The 3x3 matrix of a [`Full`] tensor.
-fn matrix(s: &Full) -> [[f64; 3]; 3] {
-    [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]]
 }
 
 /// The [`Full`] tensor of a symmetric 3x3 matrix.
