@@ -145,6 +145,7 @@ pub mod materials {
     pub use crate::material::mie_gruneisen::{CompressionLimit, MieGruneisen};
     pub use crate::material::presets::{PRESETS, Preset};
     pub use crate::material::rajendran_grove::{CeramicPoint, Pulverized, RajendranGrove};
+    pub use crate::material::tensile_cracks::{CrackPlanes, TensileCracks};
     pub use crate::material::{Damage, Eos, Material, Strength};
 }
 

@@ -92,6 +92,41 @@ pub struct History {
 }
 
 impl History {
+    /// A history saved before some of the scene's observables existed
+    /// (those added after the others, at the end of the list): when its
+    /// names are the first of `specs`' names, the later ones are added as
+    /// columns that read 0 in every record so far (they were not recorded
+    /// then; the records after a restart hold their values). Returns the
+    /// names added; a history of other names is left as it is (and refused
+    /// by the check of a restored run).
+    pub(crate) fn adopt_later_observables(&mut self, specs: &[ObservableSpec]) -> Vec<String> {
+        let (had, now) = (self.names.len(), specs.len());
+        if had >= now
+            || specs[..had]
+                .iter()
+                .zip(&self.names)
+                .any(|(s, n)| s.name != n)
+        {
+            return Vec::new();
+        }
+        let rows = self.times.len();
+        if self.values.len() != rows * had {
+            return Vec::new();
+        }
+        let mut values = Vec::with_capacity(rows * now);
+        for row in self.values.chunks(had.max(1)).take(rows) {
+            values.extend_from_slice(&row[..had]);
+            values.extend(std::iter::repeat_n(0.0, now - had));
+        }
+        if had == 0 {
+            values = vec![0.0; rows * now];
+        }
+        self.values = values;
+        let added: Vec<String> = specs[had..].iter().map(|s| s.name.to_string()).collect();
+        self.names.extend(added.iter().cloned());
+        added
+    }
+
     /// An empty history for these observables.
     pub fn new(specs: &[ObservableSpec]) -> Self {
         History {
@@ -357,6 +392,9 @@ observables! {
     smoothing_dissipation: "J", "kinetic energy removed by the velocity smoothing toward the MLS approximation";
     energy_error: "1", "|kinetic + internal + dissipated - initial| / initial";
     shot_outcome: "1", "what the shot has come to, decided by the state (README, \"Ballistic limit\"): 0 undecided, 1 perforated (the projectile wholly past the plate's original back face and faster along the flight than the intact plate around the hole), 2 stopped (not perforated, and no faster than the plate's centre of mass)";
+    cone_half_angle: "deg", "half-angle from the axis of the plate's fracture cone: in each layer of nodes through the thickness (at the material's place at impact), the outer radius of the rings about the axis in which at least half the nodes are damaged (as damaged_fraction counts them), fitted as a straight line of the depth from the struck to the rear face; 0 with fewer than two layers damaged or a front at one radius through the thickness (a cylinder, a plate damaged to its rim); negative for a crater, wider at the struck face (methods/penetration.md, \"Failure modes\")";
+    radial_crack_count: "1", "radial cracks on the plate's rear face: in the ring of one node spacing either side of the projectile's diameter from the axis, sectors of about one spacing of arc (at least 16, the quarter model mirrored into the whole plate) are cracked when at least half their nodes are damaged; the count of runs of cracked sectors around the circle, 0 when none or all are (a damaged ring is no radial crack)";
+    comminuted_radius: "m", "radius of the comminuted zone under the projectile: the outer radius of the rings about the axis (at the material's place at impact, over the whole thickness) in which at least half the plate nodes are pulverized; 0 when the ring at the axis is not";
 }
 
 /// The log10 crack-density field's value where there are no cracks (a

@@ -506,7 +506,12 @@ impl Simulation {
         let invalid = |e: String| Error::InvalidState(e);
         crate::state_format::upgrade(&mut saved)
             .map_err(|e| invalid(format!("the state cannot be read: {e}")))?;
-        let sim: Simulation = serde_json::from_value(saved).map_err(|e| invalid(e.to_string()))?;
+        let mut sim: Simulation =
+            serde_json::from_value(saved).map_err(|e| invalid(e.to_string()))?;
+        // A state saved before the scene's later observables were (the
+        // failure modes of `penetration`, 2026-11-29) reads them as 0
+        // before the restart.
+        sim.history.adopt_later_observables(sim.observable_specs());
         sim.check_restored()
             .map_err(|e| Error::InvalidState(format!("the state is not valid: {e}")))?;
         Ok(sim)

@@ -15,8 +15,9 @@ pub enum FmiVersion {
     Fmi2,
 }
 
-/// SI base-unit exponents (kg, m, s, K) of every unit string used in the
-/// tables; `None` for a unit this generator does not know.
+/// SI base-unit exponents (kg, m, s, K, rad) of every unit string used in
+/// the tables; `None` for a unit this generator does not know. A degree is
+/// the radian with the factor of [`unit_factor`].
 pub fn base_units(unit: &str) -> Option<&'static [(&'static str, i32)]> {
     Some(match unit {
         "1" => &[],
@@ -31,8 +32,15 @@ pub fn base_units(unit: &str) -> Option<&'static [(&'static str, i32)]> {
         "J" => &[("kg", 1), ("m", 2), ("s", -2)],
         "J/m2" => &[("kg", 1), ("s", -2)],
         "J/(kg.K)" => &[("m", 2), ("s", -2), ("K", -1)],
+        "deg" => &[("rad", 1)],
         _ => return None,
     })
+}
+
+/// The factor of a unit to its base units, where it is not 1: the degree,
+/// pi / 180 rad.
+pub fn unit_factor(unit: &str) -> Option<f64> {
+    (unit == "deg").then_some(std::f64::consts::PI / 180.0)
 }
 
 /// Units of the tables that FMI's `BaseUnit` cannot express, its exponents
@@ -171,7 +179,10 @@ pub fn model_description(fmu: Fmu, version: FmiVersion) -> Result<String, String
     for u in &units {
         match base_units(u) {
             Some(exps) => {
-                let attrs: String = exps.iter().map(|(b, e)| format!(" {b}=\"{e}\"")).collect();
+                let mut attrs: String = exps.iter().map(|(b, e)| format!(" {b}=\"{e}\"")).collect();
+                if let Some(f) = unit_factor(u) {
+                    attrs.push_str(&format!(" factor=\"{f:?}\""));
+                }
                 writeln!(
                     x,
                     "    <Unit name=\"{}\">\n      <BaseUnit{attrs}/>\n    </Unit>",

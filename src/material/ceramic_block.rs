@@ -41,6 +41,15 @@
 //! limit between 700 and 800 m/s, so it stays the default until the growth
 //! and pulverized constants are fitted with a0.
 //!
+//! *A third set, `ad85_planes`* (issue 68, opt-in): the seed's constants
+//! with tensile crack planes ([`crate::materials::TensileCracks`]) from flaws
+//! of `plate_tensile_flaw_size` = [`PLANES_FLAW_SIZE`] = 188 µm, the penny
+//! crack that opens at the tensile strength of the weakest engineering
+//! alumina. Its plate cracks in tension and still holds compression
+//! (VALIDATION.md, the rows "Tensile crack planes"); it is not the default while
+//! its spall strength lies above the measured band and the plate shows
+//! no cone or discrete radial cracks.
+//!
 //! The thermal constants, which the seed does not give:
 //!
 //! - `plate_specific_heat` = 880 J/(kg K): a room-temperature value of
@@ -85,22 +94,49 @@ const AD85: RajendranGrove = RajendranGrove::ad85();
 pub const SPALL_CRACK_SIZE: f64 = 1.0e-4;
 
 /// The levels of `plate_ceramic`: the sets of constants by name. Each sets
-/// `plate_crack_size`; the first is the default.
+/// `plate_crack_size` and `plate_tensile_flaw_size`; the first is the
+/// default.
 pub const CERAMICS: &[Level] = &[
     Level {
         name: "ad85_seed",
         description: "AD85 alumina exactly as seed 004's Table 1 prints it (a0 = 0.58 um), the default: \
                       the seed's penetration case as printed",
-        sets: &[("plate_crack_size", AD85.initial_crack_size)],
+        sets: &[
+            ("plate_crack_size", AD85.initial_crack_size),
+            ("plate_tensile_flaw_size", 0.0),
+        ],
     },
     Level {
         name: "ad85_spall",
         description: "AD85 with the initial crack size a0 = 100 um, the smallest round a0 whose \
                       plate-impact target spalls at every flyer speed from 100 to 500 m/s \
                       (in the ballistic case its plate pulverizes to the rim)",
-        sets: &[("plate_crack_size", SPALL_CRACK_SIZE)],
+        sets: &[
+            ("plate_crack_size", SPALL_CRACK_SIZE),
+            ("plate_tensile_flaw_size", 0.0),
+        ],
+    },
+    Level {
+        name: "ad85_planes",
+        description: "AD85 as the seed prints it (a0 = 0.58 um for the cracks that slide in compression) \
+                      with tensile crack planes from flaws of a_t = 188 um, the penny crack that opens at \
+                      210 MPa, the tensile strength of the weakest engineering alumina (opt-in, issue 68)",
+        sets: &[
+            ("plate_crack_size", AD85.initial_crack_size),
+            ("plate_tensile_flaw_size", PLANES_FLAW_SIZE),
+        ],
     },
 ];
+
+/// The tensile flaw size a_t (m) of `ad85_planes`, 188 µm: the radius of
+/// the penny crack that opens under a normal tension of 210 MPa with the
+/// seed's K_IC = 3.25 MPa m^1/2, `a_t = (pi / 4) (K_IC / sigma_t)^2`. 210 MPa
+/// is the ultimate tensile strength of 93-95 % alumina (ASTM D2442 Type II),
+/// the lowest of the engineering aluminas that MakeItFrom.com lists after
+/// Shackelford & Doremus, *Ceramic and Glass Materials* (Springer 2008),
+/// whose range is 210-290 MPa; AD85 (85 % alumina) is weaker than any of
+/// them, so 210 MPa is an upper bound of its static tensile strength.
+pub const PLANES_FLAW_SIZE: f64 = 188e-6;
 
 /// Specific heat of the default plate (J/(kg K)): engineering alumina (see
 /// the module documentation for the source).
@@ -111,14 +147,15 @@ const ALUMINA_SPECIFIC_HEAT: f64 = 880.0;
 /// the order of seed 004's Table 1, then the thermal constants and the
 /// initial temperature. Defaults: AD85 ([`RajendranGrove::ad85`]), 880
 /// J/(kg K), Taylor-Quinney 1, 293 K.
-pub const PLATE_CERAMIC: [ParamSpec; 25] = [
+pub const PLATE_CERAMIC: [ParamSpec; 26] = [
     levels_spec(
         "plate_ceramic",
         0,
         CERAMICS,
         "the ceramic's set of constants, which sets plate_crack_size (a value set by hand overrides it): \
          0 = ad85_seed (the default: the seed's Table 1 as printed, a0 = 0.58 um), \
-         1 = ad85_spall (a0 = 100 um, the smallest round a0 whose plate-impact target spalls; README)",
+         1 = ad85_spall (a0 = 100 um, the smallest round a0 whose plate-impact target spalls; README), \
+         2 = ad85_planes (the seed's a0 with tensile crack planes from flaws of a_t = 188 um)",
     ),
     row(
         "plate_density",
@@ -268,6 +305,14 @@ pub const PLATE_CERAMIC: [ParamSpec; 25] = [
         "crack density N0* a^3 at which the ceramic pulverizes (section 4.3)",
     ),
     row(
+        "plate_tensile_flaw_size",
+        "m",
+        AD85.tensile_flaw_size,
+        Range::closed(0.0, 0.01),
+        "initial radius a_t of the flaws that open in tension, on three crack planes of each point \
+         (0 = none, the seed's model: its isotropic cracks open in tension too)",
+    ),
+    row(
         "plate_specific_heat",
         "J/(kg.K)",
         ALUMINA_SPECIFIC_HEAT,
@@ -339,6 +384,7 @@ fn build(v: impl Fn(&str) -> Result<f64>) -> Result<Material> {
         pulverized_cohesion: v("plate_pulverized_cohesion")?,
         pulverized_friction: v("plate_pulverized_friction")?,
         critical_damage: v("plate_critical_damage")?,
+        tensile_flaw_size: v("plate_tensile_flaw_size")?,
     };
     Ok(Material::ceramic(
         rg,
@@ -416,7 +462,7 @@ mod tests {
     /// that a0.
     #[test]
     fn defaults_are_the_seed_ad85() {
-        let table1: [(&str, f64); 25] = [
+        let table1: [(&str, f64); 26] = [
             ("plate_ceramic", 0.0),
             ("plate_density", 3.42e3),
             ("plate_shear_modulus", 88.0e9),
@@ -439,6 +485,7 @@ mod tests {
             ("plate_pulverized_cohesion", 0.1e9),
             ("plate_pulverized_friction", 0.1),
             ("plate_critical_damage", 0.75),
+            ("plate_tensile_flaw_size", 0.0),
             ("plate_specific_heat", 880.0),
             ("plate_taylor_quinney", 1.0),
             ("plate_initial_temperature", 293.0),
@@ -456,11 +503,33 @@ mod tests {
             serde_json::to_string(&m).unwrap(),
             serde_json::to_string(&want).unwrap()
         );
-        // The default level sets the default a0; the spall set its own.
-        assert_eq!(CERAMICS[0].sets, &[("plate_crack_size", 0.58e-6)]);
+        // The default level sets the default a0 and no tensile flaws; the
+        // spall set its own a0; the planes set the seed's a0 and a_t.
+        assert_eq!(
+            CERAMICS[0].sets,
+            &[
+                ("plate_crack_size", 0.58e-6),
+                ("plate_tensile_flaw_size", 0.0)
+            ]
+        );
         let spall = &CERAMICS[1];
         assert_eq!(spall.name, "ad85_spall");
-        assert_eq!(spall.sets, &[("plate_crack_size", 100e-6)]);
+        assert_eq!(
+            spall.sets,
+            &[
+                ("plate_crack_size", 100e-6),
+                ("plate_tensile_flaw_size", 0.0)
+            ]
+        );
+        let planes = &CERAMICS[2];
+        assert_eq!(planes.name, "ad85_planes");
+        assert_eq!(
+            planes.sets,
+            &[
+                ("plate_crack_size", 0.58e-6),
+                ("plate_tensile_flaw_size", 188e-6)
+            ]
+        );
         let chosen = RajendranGrove {
             initial_crack_size: 100e-6,
             ..RajendranGrove::ad85()
@@ -610,7 +679,7 @@ mod tests {
         const CHOICE: MaterialChoice = MaterialChoice::BILINEAR_LINEAR;
         const N: usize = BEFORE.len() + block_len(CHOICE) + PLATE_CERAMIC.len();
         const TABLE: [ParamSpec; N] = compose::<N>(&BEFORE, CHOICE, &PLATE_CERAMIC);
-        assert_eq!(N, 1 + 8 + 25);
+        assert_eq!(N, 1 + 8 + 26);
         assert_eq!(TABLE[0].name, "impact_speed");
         assert_eq!(TABLE[1].name, "density");
         assert_eq!(&TABLE[9..], &PLATE_CERAMIC[..]);

@@ -28,6 +28,7 @@ pub mod mie_gruneisen;
 pub mod presets;
 pub mod rajendran_grove;
 mod state;
+pub mod tensile_cracks;
 pub mod tensor;
 
 use crate::error::Result;
@@ -277,11 +278,18 @@ impl Material {
     /// The longitudinal modulus of a point in state `state` at density
     /// `rho` and pressure `p`: [`Material::longitudinal_modulus`], but for
     /// a ceramic at the point's own porosity, with the shear modulus of the
-    /// uncracked porous solid (cracks only soften it, so the wave speed is
-    /// bounded from above, as a stable time step needs).
+    /// uncracked porous solid and the density of its matrix (cracks only
+    /// soften it, so the wave speed is bounded from above, as a stable
+    /// time step needs).
     pub fn wave_modulus(&self, rho: f64, p: f64, state: &PointState) -> f64 {
         match (&self.damage, &state.damage) {
-            (Damage::RajendranGrove(c), Some(v)) => c.longitudinal_modulus(rho, v.porosity),
+            // The matrix's density: the point's, less its tensile cracks'
+            // openings (a point whose cracks have opened is stiffer than its
+            // density says once they close).
+            (Damage::RajendranGrove(c), Some(v)) => {
+                let opened: f64 = v.tensile.map_or(0.0, |t| t.opening.iter().sum());
+                c.longitudinal_modulus(rho * (1.0 + opened), v.porosity)
+            }
             _ => self.longitudinal_modulus(rho, p),
         }
     }

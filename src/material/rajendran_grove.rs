@@ -73,6 +73,7 @@
 
 use super::Loading;
 use super::mie_gruneisen::check;
+use super::tensile_cracks::{CrackPlanes, TensileCracks};
 use super::tensor::{Full, SymTensor, radial_return};
 use crate::error::Result;
 use crate::params::Range;
@@ -115,6 +116,14 @@ pub struct RajendranGrove {
     pub pulverized_friction: f64,
     /// Crack density at pulverization (1), section 4.3.
     pub critical_damage: f64,
+    /// Initial radius `a_t` of the flaws that open in tension (m), on three
+    /// planes of their own ([`TensileCracks`]); 0, the seed's
+    /// model, for none: the isotropic cracks then open in tension too.
+    /// Not written when 0, so that a setup of the seed's model keeps the
+    /// JSON, and the digest, it had before the planes were (saved states
+    /// and checkpoints of it still load).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tensile_flaw_size: f64,
 }
 
 impl RajendranGrove {
@@ -130,10 +139,12 @@ impl RajendranGrove {
     /// density. (A plate whose initial cracks already pass 1 % of
     /// pulverization, as those of `plate_ceramic = ad85_spall` (a0 =
     /// 100 µm, γ0 = 0.0183) do, would otherwise count as damaged before the
-    /// impact.)
+    /// impact; so would the tensile planes' flaws, `N0 a_t^3`, which count
+    /// the same way.)
     pub fn damaged_threshold(&self) -> f64 {
         (Self::DAMAGED_AT * self.critical_damage)
             .max(2.0 * self.crack_density(self.initial_crack_size))
+            .max(2.0 * self.crack_density(self.tensile_flaw_size))
     }
 
     /// AD85 alumina, seed 004 Table 1 (with the reference strain rate of
@@ -161,6 +172,7 @@ impl RajendranGrove {
             pulverized_cohesion: 0.1e9,
             pulverized_friction: 0.1,
             critical_damage: 0.75,
+            tensile_flaw_size: 0.0,
         }
     }
 
@@ -194,6 +206,7 @@ impl RajendranGrove {
             check(name, v, Range::open_closed(0.0, 10.0))?;
         }
         check("fracture_toughness", self.fracture_toughness, positive)?;
+        check("tensile_flaw_size", self.tensile_flaw_size, non_negative)?;
         check(
             "pulverized_cohesion",
             self.pulverized_cohesion,
@@ -289,6 +302,19 @@ impl RajendranGrove {
         self.c1 * (1.0 + self.c3 * r.ln())
     }
 
+    /// The tensile crack planes of the constants, when `tensile_flaw_size`
+    /// is set.
+    pub fn crack_planes(&self) -> Option<CrackPlanes> {
+        (self.tensile_flaw_size > 0.0).then(|| CrackPlanes {
+            nu: self.poisson_ratio(),
+            youngs_modulus: self.youngs_modulus(),
+            flaw_density: self.flaw_density,
+            flaw_size: self.tensile_flaw_size,
+            critical_density: self.critical_damage,
+            friction: self.friction,
+        })
+    }
+
     /// The crack-density factors of the matrix's Poisson ratio.
     pub(crate) fn crack_factors(&self) -> CrackFactors {
         CrackFactors::of(self.poisson_ratio())
@@ -382,6 +408,7 @@ impl RajendranGrove {
             crack_size: self.initial_crack_size,
             porosity: self.initial_porosity,
             pulverized: None,
+            tensile: None,
         }
     }
 
@@ -411,6 +438,14 @@ impl RajendranGrove {
         if let Some(frozen) = point.pulverized {
             return self.update_pulverized(load, frozen, point);
         }
+        // The matrix's density: the point's, less the volume that its
+        // tensile cracks' openings take.
+        let opened: f64 = point.tensile.map_or(0.0, |c| c.opening.iter().sum());
+        let matrix_load = Loading::<Full> {
+            density: load.density * (1.0 + opened),
+            ..*load
+        };
+        let load = &matrix_load;
         let f_old = point.porosity;
         let gamma = self.crack_density(point.crack_size);
         let eta_trial = self.matrix_compression(load.density, f_old);
@@ -478,8 +513,32 @@ impl RajendranGrove {
         point.plastic_strain += work / ((1.0 - f) * y);
         // Crack growth at the new stress, and pulverization.
         let open = self.matrix_compression(load.density, f) < 0.0;
-        let gs = self.release_rate(point.crack_size, f, p, &s, open);
-        point.crack_size += self.growth_speed(gs, open) * load.dt;
+        let planes = self.crack_planes();
+        // With tensile planes, the isotropic cracks grow only when closed
+        // (sliding); the planes carry the cracking in tension.
+        if planes.is_none() || !open {
+            let gs = self.release_rate(point.crack_size, f, p, &s, open);
+            point.crack_size += self.growth_speed(gs, open) * load.dt;
+        }
+        if let Some(planes) = planes {
+            let sigma = stress_of(p, &s);
+            point.tensile = planes.step(
+                point.tensile,
+                &sigma,
+                &load.spin,
+                load.dt,
+                self.critical_release_rate(),
+                |g| self.growth_speed(g, true),
+            );
+            if let Some(cracks) = &mut point.tensile {
+                let (opening, carried) = planes.open(cracks, &sigma, k_bar, g_eff);
+                cracks.opening = opening;
+                let (pc, dev) = split_stress(&carried);
+                point.elastic_strain = dev.scaled(0.5 / g_eff);
+                point.pressure = pc;
+                point.deviator = dev;
+            }
+        }
         let mut gamma = self.crack_density(point.crack_size);
         if gamma >= self.critical_damage {
             // The step that crosses the critical density pulverizes the
@@ -552,6 +611,9 @@ pub struct CeramicPoint {
     pub porosity: f64,
     /// The frozen state once pulverized.
     pub pulverized: Option<Pulverized>,
+    /// The tensile cracks, once a tensile flaw has grown.
+    #[serde(default)]
+    pub tensile: Option<TensileCracks>,
 }
 
 /// The variables of a point of Rajendran-Grove material that a solver's
@@ -568,6 +630,25 @@ pub struct CeramicVars {
     pub porosity: f64,
     /// The frozen state once pulverized.
     pub pulverized: Option<Pulverized>,
+    /// The tensile cracks, once a tensile flaw has grown (none in states
+    /// saved before they were). Always written: the FMUs' binary states
+    /// (postcard) cannot skip a field.
+    #[serde(default)]
+    pub tensile: Option<TensileCracks>,
+}
+
+impl CeramicVars {
+    /// The point's crack density: its isotropic cracks' `N0 a^3`, or the
+    /// largest of its tensile planes' `N0 a_k^3` where that is larger (the
+    /// crack density the damage observables and fields read).
+    pub fn crack_density(&self, m: &RajendranGrove) -> f64 {
+        let planes = self.tensile.map_or(0.0, |c| {
+            c.size
+                .iter()
+                .fold(0.0, |g, &a| f64::max(g, m.crack_density(a)))
+        });
+        m.crack_density(self.crack_size).max(planes)
+    }
 }
 
 impl CeramicPoint {
@@ -588,6 +669,7 @@ impl CeramicPoint {
             crack_size: vars.crack_size,
             porosity: vars.porosity,
             pulverized: vars.pulverized,
+            tensile: vars.tensile,
         }
     }
 
@@ -598,6 +680,7 @@ impl CeramicPoint {
             crack_size: self.crack_size,
             porosity: self.porosity,
             pulverized: self.pulverized,
+            tensile: self.tensile,
         }
     }
 }
@@ -635,6 +718,31 @@ impl CrackFactors {
             shear_closed: 32.0 * (1.0 - nu) / (15.0 * (2.0 - nu)),
         }
     }
+}
+
+/// The stress `-p I + s` (tension positive) of pressure `p` and deviator
+/// `s`.
+fn stress_of(p: f64, s: &Full) -> Full {
+    let mut sigma = *s;
+    for x in sigma.iter_mut().take(3) {
+        *x -= p;
+    }
+    sigma
+}
+
+/// Whether a constant is zero (serde's `skip_serializing_if`).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// The pressure and deviator `(p, s)` of a stress (tension positive).
+fn split_stress(sigma: &Full) -> (f64, Full) {
+    let p = -(sigma[0] + sigma[1] + sigma[2]) / 3.0;
+    let mut s = *sigma;
+    for x in s.iter_mut().take(3) {
+        *x += p;
+    }
+    (p, s)
 }
 
 /// The equivalent strain rate `sqrt(2/3 D':D')`.
@@ -1230,5 +1338,140 @@ mod tests {
         }
         assert_eq!(path.point.pressure, 0.0);
         assert_eq!(path.point.deviator, [0.0; 6]);
+    }
+}
+
+#[cfg(test)]
+mod tensile_plane_tests {
+    use super::*;
+
+    /// Work per unit volume done on a point over a strain path given as
+    /// rates per step, by the trapezoid of its stresses (as the solvers
+    /// count it), and its final stress.
+    fn cycle(m: &RajendranGrove, rates: &[Full], dt: f64) -> (f64, Full, CeramicPoint) {
+        let mut point = m.initial_point();
+        let mut log_volume = 0.0;
+        let mut work = 0.0;
+        let mut old = stress_of(point.pressure, &point.deviator);
+        for d in rates {
+            log_volume += (d[0] + d[1] + d[2]) * dt;
+            let load = Loading::<Full> {
+                dt,
+                rate: *d,
+                spin: [0.0; 3],
+                density: m.density * (-log_volume).exp(),
+            };
+            m.update(&load, 0.0, &mut point);
+            let new = stress_of(point.pressure, &point.deviator);
+            let mid: Full = std::array::from_fn(|k| 0.5 * (old[k] + new[k]));
+            work += mid.double_dot(d) * dt;
+            old = new;
+        }
+        (work, old, point)
+    }
+
+    #[test]
+    fn a_strain_cycle_creates_no_energy() {
+        let m = RajendranGrove {
+            tensile_flaw_size: 188e-6,
+            ..RajendranGrove::ad85()
+        };
+        let dt = 1e-9;
+        for lateral in [0.0, -0.3, 0.5] {
+            // Stretch along x (and y by `lateral` of it), hold, then return.
+            let rate = [1e4, lateral * 1e4, 0.0, 0.0, 0.0, 0.0];
+            let back = rate.map(|x| -x);
+            let mut rates = vec![rate; 400];
+            rates.extend(vec![[0.0; 6]; 100]);
+            rates.extend(vec![back; 400]);
+            rates.extend(vec![[0.0; 6]; 100]);
+            let (work, stress, point) = cycle(&m, &rates, dt);
+            eprintln!(
+                "lateral {lateral}: work {work:e} J/m3, final stress {stress:?}, cracks {:?}",
+                point.tensile
+            );
+            assert!(work >= -1e-6 * 1e3, "lateral {lateral}: {work}");
+        }
+        // Stretch, compress past the start, return; and a shear loop.
+        let paths: Vec<Vec<Full>> = vec![
+            [
+                vec![[1e4, 0.0, 0.0, 0.0, 0.0, 0.0]; 400],
+                vec![[-1e4, 0.0, 0.0, 0.0, 0.0, 0.0]; 800],
+                vec![[1e4, 0.0, 0.0, 0.0, 0.0, 0.0]; 400],
+            ]
+            .concat(),
+            [
+                vec![[1e4, 0.0, 0.0, 1e4, 0.0, 0.0]; 400],
+                vec![[0.0, 0.0, 0.0, -1e4, 0.0, 0.0]; 400],
+                vec![[-1e4, 0.0, 0.0, -1e4, 0.0, 0.0]; 400],
+                vec![[0.0, 0.0, 0.0, 1e4, 0.0, 0.0]; 400],
+            ]
+            .concat(),
+            [
+                vec![[1e4, 0.0, -4e3, 0.0, 0.0, 0.0]; 300],
+                vec![[-1e4, 0.0, 0.0, 0.0, 5e3, 0.0]; 600],
+                vec![[1e4, 0.0, 4e3, 0.0, -5e3, 0.0]; 300],
+            ]
+            .concat(),
+        ];
+        for (k, rates) in paths.iter().enumerate() {
+            let (work, stress, point) = cycle(&m, rates, dt);
+            eprintln!(
+                "path {k}: work {work:e} J/m3, final stress {stress:?}, cracks {:?}",
+                point.tensile
+            );
+            assert!(work >= -1e-3, "path {k}: {work}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tensile_onset_tests {
+    use super::*;
+
+    /// A point pulled in uniaxial strain opens its first tensile plane,
+    /// normal to the pull, where the axial stress reaches the penny crack's
+    /// `K_IC sqrt(pi / (4 a_t))` (the lateral stresses lie in the plane);
+    /// with no tensile flaws (the seed's model) the same pull grows no
+    /// crack until 5.67 GPa.
+    #[test]
+    fn the_first_plane_opens_at_the_penny_crack_stress() {
+        for a_t in [50e-6, 188e-6] {
+            let m = RajendranGrove {
+                tensile_flaw_size: a_t,
+                ..RajendranGrove::ad85()
+            };
+            let closed_form = m.fracture_toughness * (PI / (4.0 * a_t)).sqrt();
+            let mut point = m.initial_point();
+            let (dt, rate) = (1e-10, 1e4);
+            let mut log_volume = 0.0;
+            let mut last = 0.0;
+            let mut onset = None;
+            for _ in 0..200_000 {
+                log_volume += rate * dt;
+                let load = Loading::<Full> {
+                    dt,
+                    rate: [rate, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    spin: [0.0; 3],
+                    density: m.density * (-log_volume).exp(),
+                };
+                m.update(&load, 0.0, &mut point);
+                if let Some(c) = point.tensile {
+                    assert!((c.normals[0][0].abs() - 1.0).abs() < 1e-12, "{c:?}");
+                    onset = Some(last);
+                    break;
+                }
+                last = point.deviator[0] - point.pressure;
+            }
+            let onset = onset.expect("the plane opens");
+            println!(
+                "a_t = {a_t:e} m: opens after {:.5} GPa, closed form {:.5} GPa",
+                onset * 1e-9,
+                closed_form * 1e-9
+            );
+            // One step of the pull moves the stress by rho c_L^2 rate dt,
+            // about 0.4 MPa.
+            assert!(onset <= closed_form && onset > closed_form - 1e6);
+        }
     }
 }

@@ -62,6 +62,14 @@ impl PointState {
     pub fn is_pulverized(&self) -> bool {
         self.ceramic().is_some_and(|v| v.pulverized.is_some())
     }
+
+    /// Whether the point is a ceramic whose tensile cracks stand open (any
+    /// opening above zero): its matrix density is not its density.
+    pub fn has_open_cracks(&self) -> bool {
+        self.ceramic()
+            .and_then(|v| v.tensile)
+            .is_some_and(|t| t.opening.iter().any(|&e| e > 0.0))
+    }
 }
 
 /// Per-particle state of a material's models, owned next to the material:
@@ -154,6 +162,14 @@ fn physical(v: &CeramicVars) -> bool {
                 && p.shear_modulus.is_finite()
                 && p.shear_modulus > 0.0
                 && p.volumetric_strain.is_finite()
+        })
+        && v.tensile.is_none_or(|t| {
+            // Unit normals, crack radii above zero, openings not below.
+            t.normals
+                .iter()
+                .all(|n| ((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-9)
+                && t.size.iter().all(|a| a.is_finite() && *a > 0.0)
+                && t.opening.iter().all(|e| e.is_finite() && *e >= 0.0)
         })
 }
 

@@ -112,7 +112,7 @@ impl SymTensor for Axisymmetric {
 }
 
 /// The 3x3 matrix of 3-D components.
-fn matrix(s: &Full) -> [[f64; 3]; 3] {
+pub(crate) fn matrix(s: &Full) -> [[f64; 3]; 3] {
     [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]]
 }
 

@@ -18,41 +18,12 @@ const TIMES: [f64; 4] = [4e-6, 8e-6, 12e-6, 20e-6];
 /// within a few projectile radii of the axis.
 const HALF_WIDTH: f64 = 20e-3;
 
+/// Half-width of the rear-face pictures (m): the whole plate's radius,
+/// where radial cracks run to.
+const RADIAL_HALF_WIDTH: f64 = 40e-3;
+
 /// Critical crack density of pulverization (the top of the colour scale).
 const PULVERIZED: f64 = 0.75;
-
-/// The half-angle from the axis (degrees) of the cone the damaged plate
-/// nodes fill (`points` (x, z) in m of the slice, `gamma` their crack
-/// densities, `damaged` the crack density past which a node counts as
-/// damaged, as the observable `damaged_fraction` counts it): the reach of
-/// the damaged zone around the hole in the plate's back layer (z within
-/// half a spacing of `-thickness`) less that in its top layer (z within
-/// half a spacing of 0), over the thickness. A layer's reach is the
-/// distance from the axis of the last node of the unbroken run of damaged
-/// nodes that starts at the layer's innermost node, so that damage apart
-/// from the hole (rings where the waves reflected from the rim meet) does
-/// not count as the cone. `None` when either layer's innermost node is
-/// intact, or the layer is empty.
-fn cone_half_angle(
-    points: &[(f64, f64)],
-    gamma: &[f64],
-    damaged: f64,
-    thickness: f64,
-    spacing: f64,
-) -> Option<f64> {
-    let reach = |z0: f64| {
-        let mut layer: Vec<(f64, bool)> = points
-            .iter()
-            .zip(gamma)
-            .filter(|((_, z), _)| (z - z0).abs() < 0.5 * spacing)
-            .map(|((x, _), g)| (x.abs(), *g >= damaged))
-            .collect();
-        layer.sort_by(|a, b| a.0.total_cmp(&b.0));
-        layer.iter().take_while(|(_, d)| *d).last().map(|(x, _)| *x)
-    };
-    let (top, back) = (reach(0.0)?, reach(-thickness)?);
-    Some(((back - top) / thickness).atan().to_degrees())
-}
 
 pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
     // The scene's default (6 across) in the full plan; 4 across (7463
@@ -129,6 +100,8 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
             "damaged_fraction",
             "pulverized_fraction",
             "cone_half_angle_deg",
+            "radial_crack_count",
+            "comminuted_radius_mm",
             "energy_error",
         ],
     );
@@ -153,14 +126,23 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
         ..RajendranGrove::ad85()
     };
     let gamma0 = ceramic.crack_density(ceramic.initial_crack_size);
-    let damaged = ceramic.damaged_threshold();
     let scale = (gamma0.log10().floor(), PULVERIZED.log10());
     let mut slices = Vec::new();
     for snap in &run.snapshots {
         let body = &snap.field("body").expect("penetration field").data;
         let gamma = &snap.field("damage").expect("penetration field").data;
+        let place = &snap
+            .field("place_at_impact")
+            .expect("penetration field")
+            .data;
         let (mut plate, mut values, mut projectile) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut rear, mut rear_values) = (Vec::new(), Vec::new());
         for (i, p) in snap.positions.iter().enumerate() {
+            let z0 = place[3 * i + 2];
+            if body[i] != 0.0 && (z0 + thickness).abs() < 0.5 * spacing {
+                rear.push((place[3 * i], place[3 * i + 1]));
+                rear_values.push(gamma[i]);
+            }
             if p[1].abs() >= 0.5 * spacing {
                 continue;
             }
@@ -171,7 +153,6 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
                 values.push(gamma[i]);
             }
         }
-        let cone = cone_half_angle(&plate, &values, damaged, thickness, spacing);
         let t = snap.time;
         zones.push(vec![
             sig(t * 1e6, 4),
@@ -179,37 +160,43 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
             sig(at(t, "hole_radius") * 1e3, 4),
             sig(at(t, "damaged_fraction"), 3),
             sig(at(t, "pulverized_fraction"), 3),
-            cone.map_or("none".into(), |a| sig(a, 3)),
+            sig(at(t, "cone_half_angle"), 3),
+            sig(at(t, "radial_crack_count"), 3),
+            sig(at(t, "comminuted_radius") * 1e3, 3),
             sig(at(t, "energy_error"), 3),
         ]);
-        slices.push((t, plate, values, projectile));
+        slices.push((t, plate, values, projectile, rear, rear_values));
     }
     doc.para(&format!(
         "log10 of the crack density γ of the plate in the slice |y| < {:.2} mm through the \
          axis (x, z in mm; the plate's top face at z = 0), the projectile grey, from the \
          plate's initial γ0 = {} (log10 {:.0}) to γ = {PULVERIZED}, pulverized, so that \
-         partial damage shows. The table's cone half-angle is measured from the axis: the \
-         reach of the damaged zone (γ ≥ {}: 1 % of pulverization and twice γ0) around the \
-         hole, the unbroken run of damaged nodes from the layer's innermost one, in the back \
-         layer less that in the top layer, over the thickness (\"none\" when a layer's \
-         innermost node is intact); damage apart from the hole does not count. \
-         the classical ceramic-armour models put it at 60-70° (Florence's a + 2h gives \
-         63°). The fields at each time, `log10_damage` and `crack_size` among them, are in \
+         partial damage shows; beside each, the plate's rear face at the material's place at \
+         impact (x0, y0 in mm), where radial cracks show. The table gives the observables of \
+         the failure modes at each time (docs/methods/penetration.md, \"Failure modes\"): \
+         `cone_half_angle` from the axis, fitted to the damage front of the layers from the \
+         struck to the rear face (the classical ceramic-armour models put it at 60-70°; \
+         Florence's a + 2h gives 63°; 0 where no front runs through the thickness, negative \
+         for a crater), `radial_crack_count` on the rear face at the projectile's diameter, \
+         and `comminuted_radius`, the pulverized zone about the axis. \
+         The fields at each time, `log10_damage` and `crack_size` among them, are in \
          the VTK snapshots of `meshless-impact run penetration --vtk-dir DIR --vtk-times \
          4e-6,8e-6,12e-6`.",
         0.5e3 * spacing,
         sig(gamma0, 3),
         scale.0,
-        sig(damaged, 3),
     ));
-    for (time, plate, gamma, projectile) in &slices {
+    let log10 = |gamma: &[f64]| -> Vec<f64> {
+        gamma
+            .iter()
+            .map(|g| g.max(1e-300).log10().max(scale.0))
+            .collect()
+    };
+    for (time, plate, gamma, projectile, rear, rear_gamma) in &slices {
         let mm = |q: &(f64, f64)| (q.0 * 1e3, q.1 * 1e3);
         let plate: Vec<(f64, f64)> = plate.iter().map(mm).collect();
         let projectile: Vec<(f64, f64)> = projectile.iter().map(mm).collect();
-        let values: Vec<f64> = gamma
-            .iter()
-            .map(|g| g.max(1e-300).log10().max(scale.0))
-            .collect();
+        let values = log10(gamma);
         let zs = plate.iter().chain(&projectile).map(|q| q.1);
         let (z0, z1) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| {
             (a.min(z), b.max(z))
@@ -231,6 +218,25 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
             &plate,
             &values,
             &projectile,
+        )?;
+        doc.image(&file, &title);
+        let rear: Vec<(f64, f64)> = rear.iter().map(mm).collect();
+        let file = format!("penetration_rear_{label}.svg");
+        let title = format!("Rear face, t = {:.1} µs: log10 crack density", time * 1e6);
+        let r = RADIAL_HALF_WIDTH * 1e3;
+        plot::plane(
+            &doc.dir.join(&file),
+            &Plane {
+                title: &title,
+                x: "x0 (mm)",
+                y: "y0 (mm)",
+                xs: (-r, r),
+                ys: (-r, r),
+                values: scale,
+            },
+            &rear,
+            &log10(rear_gamma),
+            &[],
         )?;
         doc.image(&file, &title);
     }
@@ -359,32 +365,4 @@ pub(super) fn ballistic_limit(plan: &Plan, doc: &mut Doc) -> Result<()> {
         ),
         &[Series::markers("shots", curve)],
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::cone_half_angle;
-
-    /// A slice with a damaged cone from 5 mm (top) to 15 mm (back) across
-    /// a 5 mm plate, plus a damaged ring at 30 mm in both layers that the
-    /// measure must not count: atan(10 / 5) = 63.4 degrees.
-    #[test]
-    fn the_cone_is_the_damaged_run_around_the_hole() {
-        let (h, t) = (1e-3, 5e-3);
-        let mut points = Vec::new();
-        let mut gamma = Vec::new();
-        for (z, edge) in [(0.0, 5e-3), (-t, 15e-3)] {
-            for k in 1..=40 {
-                let x = k as f64 * h;
-                points.push((x, z));
-                let ring = (x - 30e-3).abs() < 1.5e-3;
-                gamma.push(if x <= edge + 1e-9 || ring { 0.75 } else { 1e-5 });
-            }
-        }
-        let a = cone_half_angle(&points, &gamma, 0.0075, t, h).unwrap();
-        assert!((a - (2.0f64).atan().to_degrees()).abs() < 1e-9, "{a}");
-        // An intact innermost node in the top layer: no cone.
-        gamma[0] = 1e-5;
-        assert_eq!(cone_half_angle(&points, &gamma, 0.0075, t, h), None);
-    }
 }

@@ -444,3 +444,58 @@ fn a_state_saved_after_a_stop_loads_back() {
     let back = Simulation::deserialize_state(&sim.serialize_state()).unwrap();
     assert_eq!(back.time(), sim.time());
 }
+
+/// Runs with the ceramics of issue 68 saved mid-way resume to the bits of
+/// the whole run: the JH-2 plate (its damage and bulking) and a plate with
+/// tensile crack planes (their frames, crack sizes and openings), in
+/// `plate_impact` and, as a quarter model at 3 across, in `penetration`.
+#[test]
+fn runs_of_the_new_ceramics_saved_mid_way_resume_to_the_same_bits() {
+    /// A scene, its settings, the time it is saved at and the time it runs to.
+    type Case<'a> = (&'a str, &'a [(&'a str, f64)], f64, f64);
+    let cases: [Case; 3] = [
+        (
+            "plate_impact",
+            &[
+                ("flyer_material", 7.0),
+                ("target_material", 7.0),
+                ("impact_speed", 1000.0),
+            ],
+            0.5e-6,
+            1.2e-6,
+        ),
+        (
+            "plate_impact",
+            &[("plate_ceramic", 2.0), ("impact_speed", 200.0)],
+            0.9e-6,
+            2.0e-6,
+        ),
+        (
+            "penetration",
+            &[
+                ("plate_ceramic", 2.0),
+                ("particles_radial", 3.0),
+                ("symmetry", 1.0),
+            ],
+            4e-6,
+            6e-6,
+        ),
+    ];
+    for (name, sets, saved_at, until) in cases {
+        let (mut sim, state) = saved(name, sets, saved_at);
+        let bytes = serde_json::to_vec(&state).unwrap();
+        let mut back = Simulation::deserialize_state(&bytes).unwrap();
+        assert_eq!(bits(&back), bits(&sim), "{name} {sets:?}: as saved");
+        sim.advance_to(until).unwrap();
+        back.advance_to(until).unwrap();
+        assert_eq!(bits(&back), bits(&sim), "{name} {sets:?}: continued");
+        // The state held what the new models keep.
+        let text = String::from_utf8(bytes).unwrap();
+        let kept = if sets.iter().any(|(k, _)| *k == "plate_ceramic") {
+            "\"opening\""
+        } else {
+            "\"bulking\""
+        };
+        assert!(text.contains(kept), "{name}: {kept}");
+    }
+}

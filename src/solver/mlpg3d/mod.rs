@@ -75,6 +75,7 @@
 //!   restored run; `util.rs`: small shared helpers.
 
 pub mod contact;
+pub mod failure;
 mod geometry;
 mod motion;
 mod observe;

@@ -44,6 +44,12 @@ impl Mlpg3d {
         &self.state.pos
     }
 
+    /// The place at impact of the material each node is on (m), carried
+    /// along when a node shifts.
+    pub fn reference(&self) -> &[[f64; 3]] {
+        &self.state.reference
+    }
+
     /// Node velocities (m/s).
     pub fn velocities(&self) -> &[[f64; 3]] {
         &self.state.vel

@@ -20,6 +20,7 @@ use crate::material::Damage;
 use crate::material::Material;
 use crate::material::rajendran_grove::RajendranGrove;
 use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
+use crate::solver::mlpg3d::failure::PlateNodes;
 use crate::solver::mlpg3d::{Body, Energies, MLPG_FIELDS, Mlpg3d, RodSetup};
 
 /// What a penetration run adds to its projectile's [`RodSetup`] (which
@@ -266,9 +267,7 @@ impl Penetration {
             .map(|i| {
                 let vars = points.get(i).and_then(|p| p.ceramic());
                 match (c, vars) {
-                    (Some(c), Some(v)) => {
-                        (c.crack_density(v.crack_size), v.pulverized.is_some(), m[i])
-                    }
+                    (Some(c), Some(v)) => (v.crack_density(c), v.pulverized.is_some(), m[i]),
                     (Some(c), None) => (c.crack_density(c.initial_crack_size), false, m[i]),
                     _ => (0.0, false, m[i]),
                 }
@@ -315,10 +314,43 @@ impl Penetration {
         (damaged / total, pulverized / total, max)
     }
 
+    /// The plate's failure modes ([`super::failure`]):
+    /// `(cone_half_angle, radial_crack_count, comminuted_radius)`; zeros
+    /// for a plate without damage. The radial cracks are counted at the
+    /// projectile's diameter from the axis (at most 0.8 of the plate's
+    /// radius).
+    pub fn failure_modes(&self) -> (f64, f64, f64) {
+        let Some(c) = self.ceramic() else {
+            return (0.0, 0.0, 0.0);
+        };
+        let at = self.run.reference();
+        let plate: Vec<usize> = self.nodes(1).collect();
+        let reference: Vec<[f64; 3]> = plate.iter().map(|&i| at[i]).collect();
+        let (gamma, pulverized): (Vec<f64>, Vec<bool>) =
+            self.plate_damage().iter().map(|&(g, p, _)| (g, p)).unzip();
+        let rod = self.run.setup();
+        let nodes = PlateNodes {
+            reference: &reference,
+            gamma: &gamma,
+            pulverized: &pulverized,
+            damaged: c.damaged_threshold(),
+            thickness: self.setup.plate.length,
+            spacing: rod.cylinder.radius / rod.rings as f64,
+            quarter: rod.quarter,
+        };
+        let radius = (2.0 * rod.cylinder.radius).min(0.8 * self.setup.plate.radius);
+        (
+            nodes.cone_half_angle(),
+            nodes.radial_crack_count(radius),
+            nodes.comminuted_radius(),
+        )
+    }
+
     /// Current values of [`PENETRATION_OBSERVABLES`], in that order.
     pub fn observables(&self) -> Vec<f64> {
         let e = self.energies();
         let (damaged, pulverized, max) = self.damage();
+        let (cone, cracks, comminuted) = self.failure_modes();
         let values = vec![
             self.projectile_velocity(),
             self.projectile_extent(),
@@ -333,6 +365,9 @@ impl Penetration {
             e.smoothing,
             e.error,
             self.outcome() as u8 as f64,
+            cone,
+            cracks,
+            comminuted,
         ];
         debug_assert_eq!(values.len(), PENETRATION_OBSERVABLES.len());
         values
@@ -354,14 +389,14 @@ impl Penetration {
             "mass" => self.run.masses().to_vec(),
             "damage" => damage()
                 .map(|(c, v, g)| match (c, v) {
-                    (Some(c), Some(v)) if g == 1 => c.crack_density(v.crack_size),
+                    (Some(c), Some(v)) if g == 1 => v.crack_density(c),
                     _ => 0.0,
                 })
                 .collect(),
             "log10_damage" => damage()
                 .map(|(c, v, g)| match (c, v) {
-                    (Some(c), Some(v)) if g == 1 => c
-                        .crack_density(v.crack_size)
+                    (Some(c), Some(v)) if g == 1 => v
+                        .crack_density(c)
                         .log10()
                         .max(crate::observe::LOG10_NO_CRACKS),
                     _ => crate::observe::LOG10_NO_CRACKS,
@@ -379,6 +414,7 @@ impl Penetration {
             "porosity" => damage()
                 .map(|(_, v, _)| v.map_or(0.0, |v| v.porosity))
                 .collect(),
+            "place_at_impact" => self.run.reference().iter().flatten().copied().collect(),
             _ => return self.run.field(name),
         })
     }
@@ -388,8 +424,10 @@ impl Penetration {
 /// body of each node (0 projectile, 1 plate), the crack density γ, the
 /// pulverized flag, the porosity, the node mass, and, so that partial
 /// damage shows, log10 γ (floored at [`crate::LOG10_NO_CRACKS`],
-/// its value at the projectile's nodes) and the crack radius a (m; 0 at
-/// the projectile's nodes).
+/// its value at the projectile's nodes), the crack radius a (m; 0 at
+/// the projectile's nodes), and the place at impact of the material each
+/// node is on (m; the plate's rear face is the nodes whose `z0` is the
+/// plate's `-thickness`).
 pub const PENETRATION_FIELDS: &[FieldSpec] = &{
     const fn scalar(
         name: &'static str,
@@ -410,8 +448,9 @@ pub const PENETRATION_FIELDS: &[FieldSpec] = &{
         scalar("mass", "kg", &["m"]),
         scalar("log10_damage", "1", &["log10_gamma"]),
         scalar("crack_size", "m", &["a"]),
+        scalar("place_at_impact", "m", &["x0", "y0", "z0"]),
     ];
-    let mut out = [own[0]; MLPG_FIELDS.len() + 7];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 8];
     let mut i = 0;
     while i < out.len() {
         out[i] = if i < MLPG_FIELDS.len() {

@@ -84,7 +84,7 @@ impl PlateImpact {
             Layer::Ceramic(m) => self
                 .target_ceramic()
                 .iter()
-                .map(|p| m.crack_density(p.crack_size))
+                .map(|p| p.vars().crack_density(m))
                 .fold(0.0, f64::max),
             // JH-2: its damage D in place of the crack density.
             Layer::Jh2(_) => self.state.cells[self.setup.flyer_cells..]
@@ -177,7 +177,7 @@ impl PlateImpact {
                         return d.log10().max(LOG10_NO_CRACKS);
                     }
                     ceramic(c).map_or(LOG10_NO_CRACKS, |(p, m)| {
-                        m.crack_density(p.crack_size).log10().max(LOG10_NO_CRACKS)
+                        p.vars().crack_density(m).log10().max(LOG10_NO_CRACKS)
                     })
                 })
                 .collect(),

@@ -143,14 +143,23 @@ impl PlateImpact {
                 self.state.cells[c].set(new, point_state);
                 // The first target cell pulverized in tension (its elastic
                 // volumetric strain at pulverization, which the pulverized
-                // state keeps, an expansion): the spall.
+                // state keeps, an expansion), or with a tensile crack plane
+                // split: the spall.
+                let split = |m: &crate::material::rajendran_grove::RajendranGrove| {
+                    let planes = m.crack_planes();
+                    point_state
+                        .ceramic()
+                        .and_then(|v| v.tensile.zip(planes))
+                        .is_some_and(|(c, p)| c.size.iter().any(|&a| a >= p.split_size()))
+                };
                 if self.state.spall.is_none()
                     && k == 1
                     && matches!(layer, Layer::Ceramic(_))
-                    && point_state
+                    && (point_state
                         .ceramic()
                         .and_then(|v| v.pulverized)
                         .is_some_and(|z| z.volumetric_strain > 0.0)
+                        || matches!(layer, Layer::Ceramic(m) if split(&m)))
                 {
                     let depth = (c - self.setup.flyer_cells) as f64;
                     self.state.spall =

@@ -1,0 +1,588 @@
+//! Cracks that open in tension, on three planes of a point (issue 68): the
+//! Rajendran-Grove ceramic's tension in a smeared-crack form.
+//!
+//! The seed's model (`super::rajendran_grove`) has one crack radius per
+//! point for cracks of every orientation, opened and grown by the same flaw
+//! size in tension and in compression. With the seed's flaws (0.58 µm) a
+//! plate never cracks in tension below its HEL; with flaws large enough to
+//! spall (100 µm) the same isotropic cracks pulverize the plate wherever
+//! any tension passes, and pulverized ceramic holds no compression either.
+//! Here, when the constant `tensile_flaw_size` is set, tension is carried
+//! by cracks of their own:
+//!
+//! - **Flaws.** Each point has flaws of radius `a_t` (the largest flaws,
+//!   which open first in tension; `tensile_flaw_size`) on every plane. The
+//!   seed's flaws (`a0`, with the density `N0`) stay the isotropic cracks
+//!   that slide under compression.
+//! - **Planes.** The first time a flaw would grow (the largest principal
+//!   stress tensile, with a release rate past `G_c`), the point fixes three
+//!   planes: the normals are the principal directions of that moment. They
+//!   turn with the material's spin afterwards.
+//! - **Growth.** The crack on plane `k` grows by eq. (24) with the opening
+//!   constants `(n1+, n2+)` while the normal stress on its plane is
+//!   tensile, at the release rate of aligned penny cracks (Kachanov 1992:
+//!   normal compliance `B_n = 16 (1 - nu^2) / (3 E)`, shear `B_t = 32 (1 -
+//!   nu^2) / (3 (2 - nu) E)`): `G = (3 a / 2 pi) (B_n sigma_n^2 + B_t
+//!   tau^2) / 2`, which in pure tension is Sneddon's `4 (1 - nu^2)
+//!   sigma_n^2 a / (pi E)`, so a plane opens at `sigma_n = K_IC sqrt(pi / (4
+//!   a_t))` (the penny crack under normal tension). The stress that drives
+//!   it is the stress of the point without the plane's cracks (the
+//!   effective stress).
+//! - **Softening.** With the crack density `gamma_k = N0 a_k^3` of plane `k`
+//!   (the seed's flaw density), the plane's tensile normal stress is
+//!   carried at `1 / (1 + c_n gamma_k)` of the uncracked value, and the
+//!   shear stresses on it at `1 / (1 + c_s gamma_k)` (`c_n = 16 (1 -
+//!   nu^2) / 3`, `c_s = 16 (1 - nu) / (3 (2 - nu))`: the same compliances
+//!   added in series). A normal stress in compression crosses the plane
+//!   whole (the crack is closed), and its shear is held by friction up to
+//!   `mu |sigma_n|`. At the critical crack density the plane has *split*:
+//!   it carries no tension and no shear beyond friction.
+//! - The point's isotropic cracks then grow only under compression (matrix
+//!   compression `eta >= 0`), as sliding cracks; in tension the planes
+//!   carry the cracking.
+//!
+//! The softening acts on the stress that the point returns to the solver
+//! (its elastic strain and pressure state are the uncracked ones): a
+//! smeared crack as a stress projection, the form of the hydrocodes'
+//! principal-stress fracture models. A split plane opens and closes
+//! without memory of its opening beyond the crack size.
+
+use super::tensor::{Full, matrix};
+use std::f64::consts::PI;
+
+/// The tensile cracks of a point: the three planes' normals and their crack
+/// radii.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TensileCracks {
+    /// The unit normals of the three planes (orthonormal, right-handed).
+    pub normals: [[f64; 3]; 3],
+    /// The crack radius on each plane (m).
+    pub size: [f64; 3],
+    /// The opening of each plane's cracks, as a normal strain (1): the
+    /// share of the point's stretch across the plane that its cracks take.
+    pub opening: [f64; 3],
+}
+
+/// What the tensile cracks need from the material's constants.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CrackPlanes {
+    /// Poisson's ratio of the matrix.
+    pub nu: f64,
+    /// Young's modulus of the matrix (Pa).
+    pub youngs_modulus: f64,
+    /// Flaws per unit volume `N0` (1/m3).
+    pub flaw_density: f64,
+    /// Initial radius of the tensile flaws `a_t` (m).
+    pub flaw_size: f64,
+    /// Crack density at which a plane has split (1).
+    pub critical_density: f64,
+    /// Friction coefficient of a closed crack (1).
+    pub friction: f64,
+}
+
+/// The [`Full`] tensor of a symmetric 3x3 matrix.
+fn full(m: &[[f64; 3]; 3]) -> Full {
+    [m[0][0], m[1][1], m[2][2], m[0][1], m[1][2], m[2][0]]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn apply(m: &[[f64; 3]; 3], v: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| dot(&m[i], v))
+}
+
+/// The components `Q^T S Q` of the symmetric matrix `s` in the frame whose
+/// axes are `normals`.
+fn rotate_in(s: &[[f64; 3]; 3], normals: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let sn: [[f64; 3]; 3] = std::array::from_fn(|j| apply(s, &normals[j]));
+    std::array::from_fn(|i| std::array::from_fn(|j| dot(&normals[i], &sn[j])))
+}
+
+/// The matrix `Q S' Q^T` of the frame components `s` back in the axes.
+fn rotate_out(s: &[[f64; 3]; 3], normals: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|a| {
+        std::array::from_fn(|b| {
+            let mut sum = 0.0;
+            for (i, ni) in normals.iter().enumerate() {
+                for (j, nj) in normals.iter().enumerate() {
+                    sum += ni[a] * s[i][j] * nj[b];
+                }
+            }
+            sum
+        })
+    })
+}
+
+/// The eigenvalues and unit eigenvectors of a symmetric 3x3 matrix by
+/// cyclic Jacobi rotations, largest eigenvalue first; the vectors a
+/// right-handed frame.
+pub fn principal(s: &[[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+    let mut m = *s;
+    // Columns of v are the eigenvectors.
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _ in 0..50 {
+        let off = m[0][1].powi(2) + m[1][2].powi(2) + m[0][2].powi(2);
+        let diag = m[0][0].powi(2) + m[1][1].powi(2) + m[2][2].powi(2);
+        if off <= 1e-32 * diag || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0, 1), (1, 2), (0, 2)] {
+            if m[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (m[q][q] - m[p][p]) / (2.0 * m[p][q]);
+            let t = if theta == 0.0 {
+                1.0
+            } else {
+                theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
+            };
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            for row in m.iter_mut() {
+                let (a, b) = (row[p], row[q]);
+                row[p] = c * a - s * b;
+                row[q] = s * a + c * b;
+            }
+            for k in 0..3 {
+                let (a, b) = (m[p][k], m[q][k]);
+                m[p][k] = c * a - s * b;
+                m[q][k] = s * a + c * b;
+            }
+            for row in v.iter_mut() {
+                let (a, b) = (row[p], row[q]);
+                row[p] = c * a - s * b;
+                row[q] = s * a + c * b;
+            }
+        }
+    }
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| m[b][b].total_cmp(&m[a][a]));
+    let values = order.map(|k| m[k][k]);
+    let mut vectors = order.map(|k| [v[0][k], v[1][k], v[2][k]]);
+    // Right-handed: the third is the cross product of the first two.
+    let [a, b, _] = vectors;
+    vectors[2] = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    (values, vectors)
+}
+
+impl CrackPlanes {
+    /// Normal compliance factor `c_n = 16 (1 - nu^2) / 3` of aligned penny
+    /// cracks.
+    pub fn normal_factor(&self) -> f64 {
+        16.0 * (1.0 - self.nu * self.nu) / 3.0
+    }
+
+    /// Shear compliance factor `c_s = 16 (1 - nu) / (3 (2 - nu))` of
+    /// aligned penny cracks (their shear compliance over the matrix's
+    /// `1 / (2 G)`).
+    pub fn shear_factor(&self) -> f64 {
+        16.0 * (1.0 - self.nu) / (3.0 * (2.0 - self.nu))
+    }
+
+    /// The crack radius at which a plane has split (m).
+    pub fn split_size(&self) -> f64 {
+        (self.critical_density / self.flaw_density).cbrt()
+    }
+
+    /// The release rate (J/m2) of a crack of radius `a` on a plane with
+    /// normal stress `sn` (tension positive) and resolved shear `tau`:
+    /// `(3 a / 2 pi) (B_n sn^2 + B_t tau^2) / 2`, zero when the plane is
+    /// in compression.
+    pub fn release_rate(&self, a: f64, sn: f64, tau: f64) -> f64 {
+        if sn <= 0.0 {
+            return 0.0;
+        }
+        let e = self.youngs_modulus;
+        let bn = 16.0 * (1.0 - self.nu * self.nu) / (3.0 * e);
+        let bt = bn * 2.0 / (2.0 - self.nu);
+        3.0 * a / (2.0 * PI) * 0.5 * (bn * sn * sn + bt * tau * tau)
+    }
+
+    /// The normal stress at which a plane of flaws `a` opens under pure
+    /// tension with critical release rate `gc`: `sqrt(gc pi E / (4 (1 -
+    /// nu^2) a))`, the penny crack's `K_IC sqrt(pi / (4 a))`.
+    pub fn opening_stress(&self, a: f64, gc: f64) -> f64 {
+        (gc * PI * self.youngs_modulus / (4.0 * (1.0 - self.nu * self.nu) * a)).sqrt()
+    }
+
+    /// The frame components of the stress `sigma` (tension positive) on the
+    /// three planes: the normal stresses and the resolved shear magnitudes.
+    fn tractions(normals: &[[f64; 3]; 3], sigma: &[[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
+        let s = rotate_in(sigma, normals);
+        let normal = [s[0][0], s[1][1], s[2][2]];
+        let shear = std::array::from_fn(|k| {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            (s[k][i] * s[k][i] + s[k][j] * s[k][j]).sqrt()
+        });
+        (normal, shear)
+    }
+
+    /// One step of the tensile cracks of a point under the effective stress
+    /// `sigma` (tension positive, XX YY ZZ XY YZ ZX), with spin `spin` (`W_XY, W_YZ,
+    /// W_ZX`) over `dt`: the planes turn with the spin, are fixed at the
+    /// first growth, and grow by `speed(release_rate, open = true)`.
+    /// Returns the new cracks (`None` while no flaw has grown).
+    pub fn step(
+        &self,
+        cracks: Option<TensileCracks>,
+        sigma: &Full,
+        spin: &[f64; 3],
+        dt: f64,
+        gc: f64,
+        speed: impl Fn(f64) -> f64,
+    ) -> Option<TensileCracks> {
+        let s = matrix(sigma);
+        let mut cracks = match cracks {
+            Some(mut c) => {
+                let w = [
+                    [0.0, spin[0], -spin[2]],
+                    [-spin[0], 0.0, spin[1]],
+                    [spin[2], -spin[1], 0.0],
+                ];
+                for n in c.normals.iter_mut() {
+                    let wn = apply(&w, n);
+                    for (x, d) in n.iter_mut().zip(wn) {
+                        *x += dt * d;
+                    }
+                }
+                c.normals = orthonormal(c.normals);
+                c
+            }
+            None => {
+                let (values, vectors) = principal(&s);
+                if values[0] <= 0.0 || self.release_rate(self.flaw_size, values[0], 0.0) <= gc {
+                    return None;
+                }
+                TensileCracks {
+                    normals: vectors,
+                    size: [self.flaw_size; 3],
+                    opening: [0.0; 3],
+                }
+            }
+        };
+        let (normal, shear) = Self::tractions(&cracks.normals, &s);
+        let split = self.split_size();
+        for k in 0..3 {
+            let a = cracks.size[k];
+            if a >= split {
+                continue;
+            }
+            let g = self.release_rate(a, normal[k], shear[k]);
+            cracks.size[k] = (a + speed(g) * dt).min(split);
+        }
+        Some(cracks)
+    }
+
+    /// The openings of the planes of `cracks` and the stress that the point
+    /// carries, when the stress of its elastic strain with the openings of
+    /// the start of the step is `sigma` (tension positive), in a solid of
+    /// bulk modulus `k` and shear modulus `g`. A plane's cracks open in
+    /// tension with the compliance of aligned penny cracks, `e = B_n gamma
+    /// sigma_n` (Kachanov 1992), without limit once split, and never below
+    /// zero: with `M = lambda + 2 G delta` the stiffness between the normal
+    /// strains and stresses in the planes' frame, the open planes solve
+    /// `M (e - e_old) + e / (B_n gamma) = sigma_nn`; a plane whose opening
+    /// would fall below zero is shut (`e = 0`, its normal stress whatever
+    /// the others leave, a compression crossing it whole). The shear
+    /// stresses on a split plane slip beyond friction, `mu |sigma_n|` in
+    /// compression and none in tension; a plane not yet split carries its
+    /// shear whole.
+    /// Returns the new openings and the carried stress, which is the
+    /// stress of the point's elastic strain from then on (the slip is not
+    /// elastic).
+    pub fn open(&self, cracks: &TensileCracks, sigma: &Full, k: f64, g: f64) -> ([f64; 3], Full) {
+        let mut s = rotate_in(&matrix(sigma), &cracks.normals);
+        let split = self.split_size();
+        let bn = 16.0 * (1.0 - self.nu * self.nu) / (3.0 * self.youngs_modulus);
+        // Each plane's normal stiffness 1 / (B_n gamma), 0 once split.
+        let stiffness: [f64; 3] = std::array::from_fn(|k| {
+            let a = cracks.size[k];
+            if a >= split {
+                0.0
+            } else {
+                1.0 / (bn * self.flaw_density * a * a * a)
+            }
+        });
+        let lambda = k - 2.0 / 3.0 * g;
+        let m = |i: usize, j: usize| lambda + if i == j { 2.0 * g } else { 0.0 };
+        let old = cracks.opening;
+        let normal0 = [s[0][0], s[1][1], s[2][2]];
+        // The stress with openings e: sigma_nn - M (e - e_old).
+        let stress = |e: &[f64; 3], i: usize| {
+            normal0[i] - (0..3).map(|j| m(i, j) * (e[j] - old[j])).sum::<f64>()
+        };
+        let mut active: [bool; 3] = [true; 3];
+        let mut e = [0.0; 3];
+        for _ in 0..4 {
+            // The open set's system (M + diag(stiffness)) e = rhs.
+            let idx: Vec<usize> = (0..3).filter(|&i| active[i]).collect();
+            let mut a = [[0.0; 3]; 3];
+            let mut rhs = [0.0; 3];
+            for (r, &i) in idx.iter().enumerate() {
+                for (c, &j) in idx.iter().enumerate() {
+                    a[r][c] = m(i, j) + if i == j { stiffness[i] } else { 0.0 };
+                }
+                // The shut planes keep e = 0.
+                rhs[r] = normal0[i]
+                    + (0..3)
+                        .filter(|&j| active[j])
+                        .map(|j| m(i, j) * old[j])
+                        .sum::<f64>()
+                    + (0..3)
+                        .filter(|&j| !active[j])
+                        .map(|j| m(i, j) * old[j])
+                        .sum::<f64>();
+            }
+            let x = solve_small(&a, &rhs, idx.len());
+            e = [0.0; 3];
+            for (r, &i) in idx.iter().enumerate() {
+                e[i] = x[r];
+            }
+            let mut changed = false;
+            for i in 0..3 {
+                if active[i] && e[i] < 0.0 {
+                    active[i] = false;
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        for i in 0..3 {
+            e[i] = e[i].max(0.0);
+            s[i][i] = stress(&e, i);
+        }
+        // A shear component lies on two planes: a split one lets it slip
+        // beyond friction, `mu |sigma_n|` in compression, none in tension.
+        for (i, j) in [(0, 1), (1, 2), (0, 2)] {
+            let mut t = s[i][j];
+            for p in [i, j] {
+                if cracks.size[p] >= split {
+                    let held = self.friction * (-s[p][p]).max(0.0);
+                    t = t.clamp(-held, held);
+                }
+            }
+            s[i][j] = t;
+            s[j][i] = t;
+        }
+        (e, full(&rotate_out(&s, &cracks.normals)))
+    }
+}
+
+/// The solution of the leading `n` x `n` block of `a x = b` (`n` up to 3),
+/// by Cramer's rule.
+fn solve_small(a: &[[f64; 3]; 3], b: &[f64; 3], n: usize) -> [f64; 3] {
+    match n {
+        0 => [0.0; 3],
+        1 => [b[0] / a[0][0], 0.0, 0.0],
+        2 => {
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            [
+                (b[0] * a[1][1] - a[0][1] * b[1]) / det,
+                (a[0][0] * b[1] - b[0] * a[1][0]) / det,
+                0.0,
+            ]
+        }
+        _ => {
+            let det3 = |m: &[[f64; 3]; 3]| {
+                m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                    - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                    + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+            };
+            let det = det3(a);
+            std::array::from_fn(|c| {
+                let mut m = *a;
+                for r in 0..3 {
+                    m[r][c] = b[r];
+                }
+                det3(&m) / det
+            })
+        }
+    }
+}
+
+/// The frame `n` made orthonormal again (Gram-Schmidt on the first two, the
+/// third their cross product).
+fn orthonormal(n: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let unit = |v: [f64; 3]| {
+        let l = dot(&v, &v).sqrt();
+        v.map(|x| x / l)
+    };
+    let a = unit(n[0]);
+    let d = dot(&a, &n[1]);
+    let b = unit(std::array::from_fn(|i| n[1][i] - d * a[i]));
+    let c = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    [a, b, c]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const K: f64 = 150e9;
+    const G: f64 = 80e9;
+
+    fn planes() -> CrackPlanes {
+        CrackPlanes {
+            nu: 0.25,
+            youngs_modulus: 220e9,
+            flaw_density: 1.83e10,
+            flaw_size: 50e-6,
+            critical_density: 0.75,
+            friction: 0.72,
+        }
+    }
+
+    /// The eigen-decomposition reproduces the matrix and sorts the values.
+    #[test]
+    fn principal_frame() {
+        let s = [[3.0, 1.0, 0.5], [1.0, -2.0, 0.25], [0.5, 0.25, 1.0]];
+        let (w, v) = principal(&s);
+        assert!(w[0] >= w[1] && w[1] >= w[2]);
+        let back = rotate_out(&[[w[0], 0.0, 0.0], [0.0, w[1], 0.0], [0.0, 0.0, w[2]]], &v);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((back[i][j] - s[i][j]).abs() < 1e-12, "{back:?}");
+            }
+        }
+        // Trace and right-handedness.
+        assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-12);
+        let c = [
+            v[0][1] * v[1][2] - v[0][2] * v[1][1],
+            v[0][2] * v[1][0] - v[0][0] * v[1][2],
+            v[0][0] * v[1][1] - v[0][1] * v[1][0],
+        ];
+        assert!((dot(&c, &v[2]) - 1.0).abs() < 1e-12);
+    }
+
+    /// Sneddon's penny crack: in pure tension the release rate is
+    /// `4 (1 - nu^2) sigma^2 a / (pi E)`, and the opening stress
+    /// `K_IC sqrt(pi / (4 a))`.
+    #[test]
+    fn penny_crack_in_tension() {
+        let p = planes();
+        let (sn, a) = (0.3e9, 50e-6);
+        let sneddon = 4.0 * (1.0 - p.nu * p.nu) * sn * sn * a / (PI * p.youngs_modulus);
+        assert!((p.release_rate(a, sn, 0.0) / sneddon - 1.0).abs() < 1e-14);
+        let k_ic: f64 = 3.25e6;
+        let gc = k_ic * k_ic * (1.0 - p.nu * p.nu) / p.youngs_modulus;
+        let onset = p.opening_stress(a, gc);
+        assert!((onset / (k_ic * (PI / (4.0 * a)).sqrt()) - 1.0).abs() < 1e-14);
+        assert_eq!(p.release_rate(a, -sn, 1e9), 0.0);
+    }
+
+    /// No plane forms below the opening stress; above it the planes are
+    /// the principal directions and the plane under tension grows.
+    #[test]
+    fn planes_form_at_the_opening_stress() {
+        let p = planes();
+        let gc = 44.7;
+        let onset = p.opening_stress(p.flaw_size, gc);
+        let pull = |s: f64| [0.0, s, 0.0, 0.0, 0.0, 0.0];
+        assert_eq!(
+            p.step(None, &pull(0.99 * onset), &[0.0; 3], 1e-9, gc, |_| 1000.0),
+            None
+        );
+        let grow = |g: f64| if g > gc { 1000.0 } else { 0.0 };
+        let c = p
+            .step(None, &pull(1.01 * onset), &[0.0; 3], 1e-9, gc, grow)
+            .unwrap();
+        assert!((c.normals[0][1].abs() - 1.0).abs() < 1e-12, "{c:?}");
+        assert!((c.size[0] - (p.flaw_size + 1e-6)).abs() < 1e-15);
+        // The other two planes carry no tension: they do not grow.
+        assert_eq!(c.size[1], p.flaw_size);
+        assert_eq!(c.size[2], p.flaw_size);
+    }
+
+    /// A split plane carries no tension across it and keeps the stresses
+    /// along it; in compression it carries the normal stress whole and its
+    /// shear up to friction.
+    #[test]
+    fn a_split_plane_carries_compression_only() {
+        let p = planes();
+        let c = TensileCracks {
+            normals: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            size: [p.split_size(), p.flaw_size, p.flaw_size],
+            opening: [0.0; 3],
+        };
+        let sigma = [2e8, 1e8, -5e7, 3e7, 0.0, 0.0];
+        let carried = p.open(&c, &sigma, K, G).1;
+        assert!(carried[0].abs() < 1e-6, "{carried:?}");
+        assert_eq!(carried[3], 0.0);
+        // The difference is the cracks' opening (Hooke's law inverted):
+        // along x whatever frees the split plane, along y the compliance
+        // of the y plane's flaws, `B_n gamma sigma_yy` (Kachanov), none
+        // along z, where the plane is in compression.
+        let (e, nu) = (
+            9.0 * K * G / (3.0 * K + G),
+            (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G)),
+        );
+        let d: [f64; 3] = std::array::from_fn(|i| sigma[i] - carried[i]);
+        let strain = |i: usize| (d[i] - nu * (d[(i + 1) % 3] + d[(i + 2) % 3])) / e;
+        let gamma = p.flaw_density * p.flaw_size.powi(3);
+        let bn = 16.0 * (1.0 - p.nu * p.nu) / (3.0 * p.youngs_modulus);
+        assert!(strain(2).abs() < 1e-18, "{}", strain(2));
+        assert!((strain(1) / (bn * gamma * carried[1]) - 1.0).abs() < 1e-9);
+        assert!(strain(0) > 0.0);
+        // The openings take their Poisson share out of the stress along z.
+        let lambda = K - 2.0 / 3.0 * G;
+        assert!((carried[2] - (-5e7 - lambda * (strain(0) + strain(1)))).abs() < 1e-6);
+        // Compression across the split plane: whole; shear up to mu |sn|.
+        let sigma = [-2e8, 0.0, 0.0, 3e8, 0.0, 0.0];
+        let carried = p.open(&c, &sigma, K, G).1;
+        assert!((carried[0] + 2e8).abs() < 1e-6);
+        assert!((carried[3] - 0.72 * 2e8).abs() < 1e-6, "{carried:?}");
+        // A frame turned about z by 30 degrees gives the same in its axes.
+        let (sa, ca) = (0.5f64, 0.75f64.sqrt());
+        let turned = TensileCracks {
+            normals: [[ca, sa, 0.0], [-sa, ca, 0.0], [0.0, 0.0, 1.0]],
+            ..c
+        };
+        let sigma_axes = full(&rotate_out(
+            &matrix(&[2e8, 1e8, -5e7, 3e7, 0.0, 0.0]),
+            &turned.normals,
+        ));
+        let back = matrix(&p.open(&turned, &sigma_axes, K, G).1);
+        let inframe = full(&rotate_in(&back, &turned.normals));
+        let unturned = p.open(&c, &[2e8, 1e8, -5e7, 3e7, 0.0, 0.0], K, G).1;
+        for (a, b) in inframe.iter().zip(unturned) {
+            assert!((a - b).abs() < 1e-6, "{inframe:?} {unturned:?}");
+        }
+    }
+
+    /// The planes turn with the spin and stay orthonormal.
+    #[test]
+    fn planes_turn_with_the_material() {
+        let p = planes();
+        let c = TensileCracks {
+            normals: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            size: [p.flaw_size; 3],
+            opening: [0.0; 3],
+        };
+        // W_XY = -1/s over 1e-3 s in 1000 steps: about 1e-3 rad about z.
+        let mut c = Some(c);
+        for _ in 0..1000 {
+            c = p.step(c, &[0.0; 6], &[-1.0, 0.0, 0.0], 1e-6, 44.7, |_| 0.0);
+        }
+        let n = c.unwrap().normals;
+        let angle = n[0][1].atan2(n[0][0]);
+        assert!((angle - 1e-3).abs() < 1e-8, "{angle}");
+        for i in 0..3 {
+            for j in 0..3 {
+                let d = dot(&n[i], &n[j]);
+                assert!((d - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14);
+            }
+        }
+    }
+}
