@@ -147,7 +147,7 @@ const ALUMINA_SPECIFIC_HEAT: f64 = 880.0;
 /// the order of seed 004's Table 1, then the thermal constants and the
 /// initial temperature. Defaults: AD85 ([`RajendranGrove::ad85`]), 880
 /// J/(kg K), Taylor-Quinney 1, 293 K.
-pub const PLATE_CERAMIC: [ParamSpec; 26] = [
+pub const PLATE_CERAMIC: [ParamSpec; 27] = [
     levels_spec(
         "plate_ceramic",
         0,
@@ -313,6 +313,14 @@ pub const PLATE_CERAMIC: [ParamSpec; 26] = [
          (0 = none, the seed's model: its isotropic cracks open in tension too)",
     ),
     row(
+        "plate_tensile_flaw_scatter",
+        "1",
+        AD85.tensile_flaw_scatter,
+        Range::closed(0.0, 100.0),
+        "Weibull modulus m of the points' tensile strengths: each point draws its own tensile flaw \
+         a_t / s^2, s = (ln(1/U) / ln 2)^(1/m) from its index (0 = one flaw size everywhere)",
+    ),
+    row(
         "plate_specific_heat",
         "J/(kg.K)",
         ALUMINA_SPECIFIC_HEAT,
@@ -385,6 +393,7 @@ fn build(v: impl Fn(&str) -> Result<f64>) -> Result<Material> {
         pulverized_friction: v("plate_pulverized_friction")?,
         critical_damage: v("plate_critical_damage")?,
         tensile_flaw_size: v("plate_tensile_flaw_size")?,
+        tensile_flaw_scatter: v("plate_tensile_flaw_scatter")?,
     };
     Ok(Material::ceramic(
         rg,
@@ -462,7 +471,7 @@ mod tests {
     /// that a0.
     #[test]
     fn defaults_are_the_seed_ad85() {
-        let table1: [(&str, f64); 26] = [
+        let table1: [(&str, f64); 27] = [
             ("plate_ceramic", 0.0),
             ("plate_density", 3.42e3),
             ("plate_shear_modulus", 88.0e9),
@@ -486,6 +495,7 @@ mod tests {
             ("plate_pulverized_friction", 0.1),
             ("plate_critical_damage", 0.75),
             ("plate_tensile_flaw_size", 0.0),
+            ("plate_tensile_flaw_scatter", 0.0),
             ("plate_specific_heat", 880.0),
             ("plate_taylor_quinney", 1.0),
             ("plate_initial_temperature", 293.0),
@@ -679,7 +689,7 @@ mod tests {
         const CHOICE: MaterialChoice = MaterialChoice::BILINEAR_LINEAR;
         const N: usize = BEFORE.len() + block_len(CHOICE) + PLATE_CERAMIC.len();
         const TABLE: [ParamSpec; N] = compose::<N>(&BEFORE, CHOICE, &PLATE_CERAMIC);
-        assert_eq!(N, 1 + 8 + 26);
+        assert_eq!(N, 1 + 8 + 27);
         assert_eq!(TABLE[0].name, "impact_speed");
         assert_eq!(TABLE[1].name, "density");
         assert_eq!(&TABLE[9..], &PLATE_CERAMIC[..]);

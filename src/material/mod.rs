@@ -294,6 +294,21 @@ impl Material {
         }
     }
 
+    /// Gives a point of a ceramic whose tensile flaws scatter
+    /// ([`RajendranGrove::tensile_flaw_scatter`]) its own flaw before its
+    /// first step, drawn from `key` (its node or cell index); any other
+    /// point is left as it is.
+    pub(crate) fn seed_point(&self, key: u64, state: &mut PointState) {
+        if let Damage::RajendranGrove(c) = &self.damage
+            && c.tensile_flaw_scatter > 0.0
+            && state.damage.is_none()
+        {
+            let mut vars = c.initial_point().vars();
+            vars.tensile_flaw = c.tensile_flaw_of(key);
+            state.damage = Some(vars);
+        }
+    }
+
     /// One step of a particle, by the update its material has: the J2
     /// update of the equation of state and the strength model
     /// ([`Damage::None`]), or the ceramic's own update

@@ -312,6 +312,18 @@ fn same_bits_on_one_thread_and_two() {
         let s = coarse_with(2e-6, &[("symmetry", 1.0)]);
         (s.field("position"), s.field("velocity"), s.observables())
     });
+    // Tensile planes whose flaws scatter by the node's index.
+    common::same_on_one_thread_and_two(|| {
+        let s = coarse_with(
+            5e-6,
+            &[
+                ("symmetry", 1.0),
+                ("plate_tensile_flaw_size", 188e-6),
+                ("plate_tensile_flaw_scatter", 10.0),
+            ],
+        );
+        (s.field("position"), s.field("damage"), s.observables())
+    });
 }
 
 /// The seed's case at 3 nodes across, as a quarter model, at `speed`,

@@ -101,6 +101,7 @@ pub(super) fn update_material(
                         plastic_strain: *eps,
                         temperature: *temp,
                     };
+                    material.seed_point(i as u64, state);
                     let new = material.update(&load, &before, state).map_err(|l| {
                         (
                             i,
