@@ -114,12 +114,9 @@ impl History {
             return Vec::new();
         }
         let mut values = Vec::with_capacity(rows * now);
-        for row in self.values.chunks(had.max(1)).take(rows) {
-            values.extend_from_slice(&row[..had]);
+        for r in 0..rows {
+            values.extend_from_slice(&self.values[r * had..(r + 1) * had]);
             values.extend(std::iter::repeat_n(0.0, now - had));
-        }
-        if had == 0 {
-            values = vec![0.0; rows * now];
         }
         self.values = values;
         let added: Vec<String> = specs[had..].iter().map(|s| s.name.to_string()).collect();

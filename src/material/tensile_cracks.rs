@@ -26,26 +26,23 @@
 //!   tau^2) / 2`, which in pure tension is Sneddon's `4 (1 - nu^2)
 //!   sigma_n^2 a / (pi E)`, so a plane opens at `sigma_n = K_IC sqrt(pi / (4
 //!   a_t))` (the penny crack under normal tension). The stress that drives
-//!   it is the stress of the point without the plane's cracks (the
-//!   effective stress).
-//! - **Softening.** With the crack density `gamma_k = N0 a_k^3` of plane `k`
-//!   (the seed's flaw density), the plane's tensile normal stress is
-//!   carried at `1 / (1 + c_n gamma_k)` of the uncracked value, and the
-//!   shear stresses on it at `1 / (1 + c_s gamma_k)` (`c_n = 16 (1 -
-//!   nu^2) / 3`, `c_s = 16 (1 - nu) / (3 (2 - nu))`: the same compliances
-//!   added in series). A normal stress in compression crosses the plane
-//!   whole (the crack is closed), and its shear is held by friction up to
-//!   `mu |sigma_n|`. At the critical crack density the plane has *split*:
-//!   it carries no tension and no shear beyond friction.
+//!   it is the point's stress with the openings of the start of the step.
+//! - **Opening.** Each plane's cracks open by a normal strain `e_k >= 0`,
+//!   state of the point, with the aligned penny cracks' compliance:
+//!   `sigma_n = e / (B_n gamma)`, `gamma = N0 a^3` (the seed's flaw
+//!   density), no stiffness once the plane has *split* (the critical crack
+//!   density). The three openings are solved together in the planes'
+//!   frame, `M (e - e_old) + e / (B_n gamma) = sigma_n` with `M = lambda + 2
+//!   G delta`, over an active set of the planes that stay open; a shut
+//!   plane carries its normal compression whole. The openings leave the
+//!   matrix: its pressure is that of the density without them, and the
+//!   point's elastic strain is that of the stress it carries.
+//! - **Shear.** A plane carries its shear whole until it splits; a split
+//!   plane slips beyond friction `mu |sigma_n|` in compression, and carries
+//!   none in tension (the slip dissipates).
 //! - The point's isotropic cracks then grow only under compression (matrix
 //!   compression `eta >= 0`), as sliding cracks; in tension the planes
 //!   carry the cracking.
-//!
-//! The softening acts on the stress that the point returns to the solver
-//! (its elastic strain and pressure state are the uncracked ones): a
-//! smeared crack as a stress projection, the form of the hydrocodes'
-//! principal-stress fracture models. A split plane opens and closes
-//! without memory of its opening beyond the crack size.
 
 use super::tensor::{Full, matrix};
 use std::f64::consts::PI;
@@ -172,17 +169,10 @@ pub fn principal(s: &[[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
 }
 
 impl CrackPlanes {
-    /// Normal compliance factor `c_n = 16 (1 - nu^2) / 3` of aligned penny
-    /// cracks.
-    pub fn normal_factor(&self) -> f64 {
-        16.0 * (1.0 - self.nu * self.nu) / 3.0
-    }
-
-    /// Shear compliance factor `c_s = 16 (1 - nu) / (3 (2 - nu))` of
-    /// aligned penny cracks (their shear compliance over the matrix's
-    /// `1 / (2 G)`).
-    pub fn shear_factor(&self) -> f64 {
-        16.0 * (1.0 - self.nu) / (3.0 * (2.0 - self.nu))
+    /// The normal compliance `B_n = 16 (1 - nu^2) / (3 E)` of aligned penny
+    /// cracks per unit crack density (1/Pa).
+    fn normal_compliance(&self) -> f64 {
+        16.0 * (1.0 - self.nu * self.nu) / (3.0 * self.youngs_modulus)
     }
 
     /// The crack radius at which a plane has split (m).
@@ -195,11 +185,10 @@ impl CrackPlanes {
     /// `(3 a / 2 pi) (B_n sn^2 + B_t tau^2) / 2`, zero when the plane is
     /// in compression.
     pub fn release_rate(&self, a: f64, sn: f64, tau: f64) -> f64 {
-        if sn <= 0.0 {
+        if sn.is_nan() || sn <= 0.0 {
             return 0.0;
         }
-        let e = self.youngs_modulus;
-        let bn = 16.0 * (1.0 - self.nu * self.nu) / (3.0 * e);
+        let bn = self.normal_compliance();
         let bt = bn * 2.0 / (2.0 - self.nu);
         3.0 * a / (2.0 * PI) * 0.5 * (bn * sn * sn + bt * tau * tau)
     }
@@ -256,7 +245,8 @@ impl CrackPlanes {
             }
             None => {
                 let (values, vectors) = principal(&s);
-                if values[0] <= 0.0 || self.release_rate(self.flaw_size, values[0], 0.0) <= gc {
+                // False on NaN: no plane forms from a stress that is not a number.
+                if !(values[0] > 0.0 && self.release_rate(self.flaw_size, values[0], 0.0) > gc) {
                     return None;
                 }
                 TensileCracks {
@@ -299,7 +289,7 @@ impl CrackPlanes {
     pub fn open(&self, cracks: &TensileCracks, sigma: &Full, k: f64, g: f64) -> ([f64; 3], Full) {
         let mut s = rotate_in(&matrix(sigma), &cracks.normals);
         let split = self.split_size();
-        let bn = 16.0 * (1.0 - self.nu * self.nu) / (3.0 * self.youngs_modulus);
+        let bn = self.normal_compliance();
         // Each plane's normal stiffness 1 / (B_n gamma), 0 once split.
         let stiffness: [f64; 3] = std::array::from_fn(|k| {
             let a = cracks.size[k];
@@ -328,16 +318,8 @@ impl CrackPlanes {
                 for (c, &j) in idx.iter().enumerate() {
                     a[r][c] = m(i, j) + if i == j { stiffness[i] } else { 0.0 };
                 }
-                // The shut planes keep e = 0.
-                rhs[r] = normal0[i]
-                    + (0..3)
-                        .filter(|&j| active[j])
-                        .map(|j| m(i, j) * old[j])
-                        .sum::<f64>()
-                    + (0..3)
-                        .filter(|&j| !active[j])
-                        .map(|j| m(i, j) * old[j])
-                        .sum::<f64>();
+                // The shut planes' e = 0 leaves only their old openings.
+                rhs[r] = normal0[i] + (0..3).map(|j| m(i, j) * old[j]).sum::<f64>();
             }
             let x = solve_small(&a, &rhs, idx.len());
             e = [0.0; 3];
