@@ -695,6 +695,26 @@ impl CeramicVars {
         });
         m.crack_density(self.crack_size).max(planes)
     }
+
+    /// The point's crack density across the unit direction `dir`: its
+    /// isotropic cracks' `N0 a^3` (they lie in every orientation), or its
+    /// tensile plane whose normal lies nearest `dir` where that is larger:
+    /// the plane with `(n . dir)^2 > 1/2`, at most one of three orthonormal
+    /// planes (none when `dir` lies at 45° or more from each normal). The
+    /// crack density a crack across `dir` reads: with `dir` the hoop
+    /// direction, that of a radial crack.
+    pub fn crack_density_across(&self, m: &RajendranGrove, dir: [f64; 3]) -> f64 {
+        let planes = self.tensile.map_or(0.0, |c| {
+            (0..3)
+                .filter(|&k| {
+                    let n = c.normals[k];
+                    let cos = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+                    cos * cos > 0.5
+                })
+                .fold(0.0, |g, k| f64::max(g, m.crack_density(c.size[k])))
+        });
+        m.crack_density(self.crack_size).max(planes)
+    }
 }
 
 impl CeramicPoint {
@@ -1416,6 +1436,39 @@ mod tensile_plane_tests {
             old = new;
         }
         (work, old, point)
+    }
+
+    #[test]
+    fn a_pull_cracks_across_its_axis_only() {
+        let m = RajendranGrove {
+            tensile_flaw_size: 188e-6,
+            ..RajendranGrove::ad85()
+        };
+        // A uniaxial-strain pull along x to 4e-3: past the plane's onset.
+        let (_, _, point) = cycle(&m, &[[1e4, 0.0, 0.0, 0.0, 0.0, 0.0]; 400], 1e-9);
+        let v = point.vars();
+        let iso = m.crack_density(v.crack_size);
+        let across = |d: [f64; 3]| v.crack_density_across(&m, d);
+        // The plane across x has grown: its density is the point's.
+        assert!(v.crack_density(&m) > 2.0 * iso, "{v:?}");
+        assert_eq!(across([1.0, 0.0, 0.0]), v.crack_density(&m));
+        assert_eq!(across([-0.8, 0.6, 0.0]), v.crack_density(&m));
+        // Across y and z: the planes' flaws, not grown; at 45° or more
+        // from every normal (the diagonal): the isotropic cracks.
+        let flaw = m.crack_density(m.tensile_flaw_size).max(iso);
+        assert_eq!(across([0.0, 1.0, 0.0]), flaw);
+        assert_eq!(across([0.0, 0.0, 1.0]), flaw);
+        assert!(flaw < m.damaged_threshold());
+        let d = 1.0 / 3f64.sqrt();
+        assert_eq!(across([d, d, d]), iso);
+        // Without planes every direction reads the isotropic density.
+        let seed = RajendranGrove::ad85();
+        let (_, _, p) = cycle(&seed, &[[1e4, 0.0, 0.0, 0.0, 0.0, 0.0]; 400], 1e-9);
+        let w = p.vars();
+        assert_eq!(
+            w.crack_density_across(&seed, [1.0, 0.0, 0.0]),
+            w.crack_density(&seed)
+        );
     }
 
     #[test]

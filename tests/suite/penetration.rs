@@ -111,6 +111,12 @@ fn the_seed_case_perforates_the_plate() {
         quarter.observable("energy_error").unwrap()
     );
     assert!(4 * quarter.particles() < sim.particles() + 400);
+    // The seed's isotropic cracks lie in every orientation: a radial crack
+    // reads the crack density itself.
+    assert_eq!(
+        quarter.field("radial_damage").unwrap(),
+        quarter.field("damage").unwrap()
+    );
     assert!(
         (vq / v - 1.0).abs() < 0.01,
         "quarter {vq} m/s, whole {v} m/s"
@@ -596,4 +602,17 @@ fn a_plate_with_tensile_planes_cracks_and_conserves_energy() {
     assert!((o("max_damage") - 0.75).abs() < 1e-12);
     assert!(o("damaged_fraction") > 0.5);
     assert_eq!(o("pulverized_fraction"), 0.0);
+    // A crack across the hoop direction is one of the point's cracks: the
+    // radial crack density never passes the crack density, and the planes'
+    // orientation shows (some split node is split across another
+    // direction than the hoop).
+    let damage = sim.field("damage").unwrap();
+    let radial = sim.field("radial_damage").unwrap();
+    assert!(damage.iter().zip(&radial).all(|(g, r)| r <= g));
+    assert!(
+        damage
+            .iter()
+            .zip(&radial)
+            .any(|(g, r)| *g >= 0.75 && *r < 0.75)
+    );
 }

@@ -20,6 +20,10 @@ pub struct PlateNodes<'a> {
     pub reference: &'a [[f64; 3]],
     /// Each node's crack density γ = N0* a³.
     pub gamma: &'a [f64],
+    /// Each node's crack density across the hoop direction, the one a
+    /// radial crack reads (γ itself where the cracks lie in every
+    /// orientation).
+    pub radial: &'a [f64],
     /// Whether each node is pulverized.
     pub pulverized: &'a [bool],
     /// The crack density at which a node counts as damaged.
@@ -117,7 +121,8 @@ impl PlateNodes<'_> {
     /// the ring of one spacing either side of `radius` (m), in sectors of
     /// about one spacing of arc (at least 16), the quarter mirrored into
     /// the whole circle; a sector is cracked when at least half its nodes
-    /// are damaged; the count is the number of runs of cracked sectors
+    /// are damaged across the hoop direction (`radial`); the count is the
+    /// number of runs of cracked sectors
     /// around the circle. 0 when no sector or every sector is cracked (a
     /// damaged ring is no radial crack).
     pub fn radial_crack_count(&self, radius: f64) -> f64 {
@@ -137,7 +142,7 @@ impl PlateNodes<'_> {
             }
             let [x, y, _] = self.reference[i];
             let phi = y.atan2(x);
-            let hit = self.gamma[i] >= self.damaged;
+            let hit = self.radial[i] >= self.damaged;
             add(phi, hit);
             if self.quarter {
                 use std::f64::consts::PI;
@@ -215,6 +220,7 @@ mod tests {
         PlateNodes {
             reference,
             gamma,
+            radial: gamma,
             pulverized,
             damaged: 0.1,
             thickness: h,
@@ -309,6 +315,30 @@ mod tests {
         assert_eq!(
             nodes(&x, &top, &none, s, h, false).radial_crack_count(10e-3),
             0.0
+        );
+    }
+
+    #[test]
+    fn radial_cracks_read_the_damage_across_the_hoop_direction() {
+        // A rear face damaged all round (a ring, as split planes of any
+        // orientation read), with five wedges where the planes across the
+        // hoop direction are split: five radial cracks, not none.
+        let (s, r, h) = (0.25e-3, 20e-3, 2e-3);
+        let x = plate(s, r, h, false);
+        let none = vec![false; x.len()];
+        let ring = wedges(&x, h, &[0.0], 4.0);
+        let five: Vec<f64> = (0..5)
+            .map(|k| k as f64 * std::f64::consts::TAU / 5.0 + 0.1)
+            .collect();
+        let hoop = wedges(&x, h, &five, 0.08);
+        let mut plate = nodes(&x, &ring, &none, s, h, false);
+        assert_eq!(plate.radial_crack_count(10e-3), 0.0);
+        plate.radial = &hoop;
+        assert_eq!(plate.radial_crack_count(10e-3), 5.0);
+        // The cone reads the damage whatever its orientation.
+        assert_eq!(
+            plate.cone_half_angle(),
+            nodes(&x, &ring, &none, s, h, false).cone_half_angle()
         );
     }
 

@@ -18,7 +18,8 @@ use crate::approx::lattice::Cylinder;
 use crate::error::Result;
 use crate::material::Damage;
 use crate::material::Material;
-use crate::material::rajendran_grove::RajendranGrove;
+use crate::material::PointState;
+use crate::material::rajendran_grove::{CeramicVars, RajendranGrove};
 use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
 use crate::solver::mlpg3d::failure::PlateNodes;
 use crate::solver::mlpg3d::{Body, Energies, MLPG_FIELDS, Mlpg3d, RodSetup};
@@ -275,6 +276,36 @@ impl Penetration {
             .collect()
     }
 
+    /// The crack density across the hoop direction of each node of the
+    /// plate, in the order of [`Penetration::nodes`]: what a radial crack
+    /// reads ([`CeramicVars::crack_density_across`] at the node's place
+    /// about the axis; its crack density on the axis, where no hoop
+    /// direction is, and for a ceramic without tensile planes, whose
+    /// cracks lie in every orientation).
+    fn plate_radial_damage(&self) -> Vec<f64> {
+        let points = self.run.material_points();
+        let x = self.run.positions();
+        let Some(c) = self.ceramic() else {
+            return vec![0.0; self.nodes(1).count()];
+        };
+        self.nodes(1)
+            .map(|i| match points.get(i).and_then(|p| p.ceramic()) {
+                Some(v) => Self::radial_density(c, v, x[i]),
+                None => c.crack_density(c.initial_crack_size),
+            })
+            .collect()
+    }
+
+    /// [`Penetration::plate_radial_damage`] of one point at `x`.
+    fn radial_density(c: &RajendranGrove, v: &CeramicVars, x: [f64; 3]) -> f64 {
+        let r = x[0].hypot(x[1]);
+        if r == 0.0 {
+            v.crack_density(c)
+        } else {
+            v.crack_density_across(c, [-x[1] / r, x[0] / r, 0.0])
+        }
+    }
+
     /// Radius of the channel about the axis free of intact plate material
     /// within the plate's original thickness (m): the smallest distance
     /// from the axis of a plate node there that is not pulverized.
@@ -328,10 +359,12 @@ impl Penetration {
         let reference: Vec<[f64; 3]> = plate.iter().map(|&i| at[i]).collect();
         let (gamma, pulverized): (Vec<f64>, Vec<bool>) =
             self.plate_damage().iter().map(|&(g, p, _)| (g, p)).unzip();
+        let radial = self.plate_radial_damage();
         let rod = self.run.setup();
         let nodes = PlateNodes {
             reference: &reference,
             gamma: &gamma,
+            radial: &radial,
             pulverized: &pulverized,
             damaged: c.damaged_threshold(),
             thickness: self.setup.plate.length,
@@ -384,6 +417,12 @@ impl Penetration {
                 (c, vars, self.run.group()[i])
             })
         };
+        let points_of = |i: usize| {
+            self.run
+                .material_points()
+                .get(i)
+                .and_then(|p: &PointState| p.ceramic())
+        };
         Some(match name {
             "body" => self.run.group().iter().map(|&g| g as f64).collect(),
             "mass" => self.run.masses().to_vec(),
@@ -402,6 +441,17 @@ impl Penetration {
                     _ => crate::observe::LOG10_NO_CRACKS,
                 })
                 .collect(),
+            "radial_damage" => {
+                let x = self.run.positions();
+                (0..n)
+                    .map(|i| match (self.ceramic(), points_of(i)) {
+                        (Some(c), Some(v)) if self.run.group()[i] == 1 => {
+                            Self::radial_density(c, v, x[i])
+                        }
+                        _ => 0.0,
+                    })
+                    .collect()
+            }
             "crack_size" => damage()
                 .map(|(_, v, g)| match v {
                     Some(v) if g == 1 => v.crack_size,
@@ -427,7 +477,9 @@ impl Penetration {
 /// its value at the projectile's nodes), the crack radius a (m; 0 at
 /// the projectile's nodes), and the place at impact of the material each
 /// node is on (m; the plate's rear face is the nodes whose `z0` is the
-/// plate's `-thickness`).
+/// plate's `-thickness`), and the crack density across the hoop direction,
+/// that of a radial crack (the crack density where the cracks lie in every
+/// orientation; 0 at the projectile's nodes).
 pub const PENETRATION_FIELDS: &[FieldSpec] = &{
     const fn scalar(
         name: &'static str,
@@ -449,8 +501,9 @@ pub const PENETRATION_FIELDS: &[FieldSpec] = &{
         scalar("log10_damage", "1", &["log10_gamma"]),
         scalar("crack_size", "m", &["a"]),
         scalar("place_at_impact", "m", &["x0", "y0", "z0"]),
+        scalar("radial_damage", "1", &["gamma_hoop"]),
     ];
-    let mut out = [own[0]; MLPG_FIELDS.len() + 8];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 9];
     let mut i = 0;
     while i < out.len() {
         out[i] = if i < MLPG_FIELDS.len() {
