@@ -18,7 +18,6 @@ use crate::approx::lattice::Cylinder;
 use crate::error::Result;
 use crate::material::Damage;
 use crate::material::Material;
-use crate::material::PointState;
 use crate::material::rajendran_grove::{CeramicVars, RajendranGrove};
 use crate::observe::{FieldSpec, PENETRATION_OBSERVABLES};
 use crate::solver::mlpg3d::failure::PlateNodes;
@@ -417,12 +416,6 @@ impl Penetration {
                 (c, vars, self.run.group()[i])
             })
         };
-        let points_of = |i: usize| {
-            self.run
-                .material_points()
-                .get(i)
-                .and_then(|p: &PointState| p.ceramic())
-        };
         Some(match name {
             "body" => self.run.group().iter().map(|&g| g as f64).collect(),
             "mass" => self.run.masses().to_vec(),
@@ -441,17 +434,13 @@ impl Penetration {
                     _ => crate::observe::LOG10_NO_CRACKS,
                 })
                 .collect(),
-            "radial_damage" => {
-                let x = self.run.positions();
-                (0..n)
-                    .map(|i| match (self.ceramic(), points_of(i)) {
-                        (Some(c), Some(v)) if self.run.group()[i] == 1 => {
-                            Self::radial_density(c, v, x[i])
-                        }
-                        _ => 0.0,
-                    })
-                    .collect()
-            }
+            "radial_damage" => damage()
+                .zip(self.run.positions())
+                .map(|((c, v, g), x)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => Self::radial_density(c, v, *x),
+                    _ => 0.0,
+                })
+                .collect(),
             "crack_size" => damage()
                 .map(|(_, v, g)| match v {
                     Some(v) if g == 1 => v.crack_size,
