@@ -63,6 +63,15 @@ impl PointState {
         self.ceramic().is_some_and(|v| v.pulverized.is_some())
     }
 
+    /// The volumetric strain that the point's open tensile cracks take (the
+    /// sum of their openings; 0 without them): its matrix density is its
+    /// density times `1 + opened`.
+    pub fn opened(&self) -> f64 {
+        self.ceramic()
+            .and_then(|v| v.tensile)
+            .map_or(0.0, |t| t.opening.iter().sum())
+    }
+
     /// Whether the point is a ceramic whose tensile cracks stand open (any
     /// opening above zero): its matrix density is not its density.
     pub fn has_open_cracks(&self) -> bool {
