@@ -696,6 +696,20 @@ impl CeramicVars {
         m.crack_density(self.crack_size).max(planes)
     }
 
+    /// How many of the point's tensile planes have split (their cracks
+    /// grown to the split size, at the critical density `critical_damage`,
+    /// as the planes decide it): 0 to 3, 0 without planes. A point split on
+    /// all three is broken in every direction.
+    pub fn split_planes(&self, m: &RajendranGrove) -> usize {
+        match (self.tensile, m.crack_planes()) {
+            (Some(c), Some(planes)) => {
+                let split = planes.split_size();
+                c.size.iter().filter(|&&a| a >= split).count()
+            }
+            _ => 0,
+        }
+    }
+
     /// The point's crack density across the unit direction `dir`: its
     /// isotropic cracks' `N0 a^3` (they lie in every orientation), or its
     /// tensile plane whose normal lies nearest `dir` where that is larger:

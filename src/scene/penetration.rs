@@ -198,6 +198,15 @@ const AFTER: &[ParamSpec] = &[
          1 = outcome (as soon as shot_outcome is decided, perforated or stopped, with end_time as the cap; \
          README, \"Ballistic limit\")",
     ),
+    row(
+        "radial_crack_radius",
+        "m",
+        0.0,
+        Range::closed(0.0, 10.0),
+        "radius about the axis of the rear-face ring in which radial_crack_count counts the radial cracks: \
+         0 = the projectile's diameter (two projectile radii, at most 0.8 of the plate's radius; the default), \
+         else this radius, inside the plate",
+    ),
     levels_spec(
         "plate_rim",
         0,
@@ -325,7 +334,15 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
         plate,
         until_outcome: v("run_until")? >= 0.5,
         clamped_rim: v("plate_rim")? >= 0.5,
+        radial_crack_radius: v("radial_crack_radius")?,
     };
+    if setup.radial_crack_radius >= plate.radius {
+        return Err(Error::Inconsistent(format!(
+            "radial_crack_radius = {} m must lie inside the plate: below plate_diameter / 2 = {} m \
+             (0 counts at the projectile's diameter)",
+            setup.radial_crack_radius, plate.radius
+        )));
+    }
     let mut numerics = RodSetup::new(projectile, rings, v("impact_speed")?, end_time);
     numerics.damping = DAMPING;
     numerics.rebuild_strain = REBUILD_STRAIN;

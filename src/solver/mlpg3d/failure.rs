@@ -9,7 +9,8 @@
 //! grouped in layers of one spacing through the thickness and in rings of
 //! one spacing about the axis. A ring is *damaged* when at least half its
 //! nodes are (a crack density at or past the plate's damaged threshold),
-//! *comminuted* when at least half its nodes are pulverized; rings with no
+//! *comminuted* when at least half its nodes are comminuted (pulverized,
+//! or split on all three tensile crack planes); rings with no
 //! node are passed over. The quarter model is mirrored across its planes
 //! into the whole plate before anything is counted.
 
@@ -24,7 +25,9 @@ pub struct PlateNodes<'a> {
     /// radial crack reads (γ itself where the cracks lie in every
     /// orientation).
     pub radial: &'a [f64],
-    /// Whether each node is pulverized.
+    /// Whether each node is comminuted: pulverized (its isotropic cracks
+    /// at the critical density), or split on all three tensile crack
+    /// planes (broken in every direction).
     pub pulverized: &'a [bool],
     /// The crack density at which a node counts as damaged.
     pub damaged: f64,
@@ -179,7 +182,7 @@ impl PlateNodes<'_> {
 
     /// The comminuted zone's radius (m): the outer radius of the rings from
     /// the axis, over the whole thickness, in which at least half the nodes
-    /// are pulverized; 0 when the ring at the axis is not.
+    /// are comminuted; 0 when the ring at the axis is not.
     pub fn comminuted_radius(&self) -> f64 {
         self.front(0..self.reference.len(), |i| self.pulverized[i])
     }

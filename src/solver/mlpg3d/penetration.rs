@@ -39,6 +39,10 @@ pub struct PenetrationSetup {
     /// [`crate::solver::mlpg3d::Body::clamped_rim`]); false (the default,
     /// the seed's case): free.
     pub clamped_rim: bool,
+    /// The radius about the axis at which `radial_crack_count` counts the
+    /// rear face's radial cracks (m); 0 (the default): the projectile's
+    /// diameter, at most 0.8 of the plate's radius.
+    pub radial_crack_radius: f64,
 }
 
 /// What a shot has come to ([`Penetration::outcome`]; the observable
@@ -346,7 +350,8 @@ impl Penetration {
 
     /// The plate's failure modes ([`super::failure`]):
     /// `(cone_half_angle, radial_crack_count, comminuted_radius)`; zeros
-    /// for a plate without damage. The radial cracks are counted at the
+    /// for a plate without damage. The radial cracks are counted at
+    /// [`PenetrationSetup::radial_crack_radius`], by default at the
     /// projectile's diameter from the axis (at most 0.8 of the plate's
     /// radius).
     pub fn failure_modes(&self) -> (f64, f64, f64) {
@@ -356,8 +361,15 @@ impl Penetration {
         let at = self.run.reference();
         let plate: Vec<usize> = self.nodes(1).collect();
         let reference: Vec<[f64; 3]> = plate.iter().map(|&i| at[i]).collect();
-        let (gamma, pulverized): (Vec<f64>, Vec<bool>) =
+        let (gamma, mut pulverized): (Vec<f64>, Vec<bool>) =
             self.plate_damage().iter().map(|&(g, p, _)| (g, p)).unzip();
+        // A node split on all three tensile planes is comminuted too.
+        let points = self.run.material_points();
+        for (k, i) in plate.iter().enumerate() {
+            if let Some(v) = points.get(*i).and_then(|p| p.ceramic()) {
+                pulverized[k] |= v.split_planes(c) == 3;
+            }
+        }
         let radial = self.plate_radial_damage();
         let rod = self.run.setup();
         let nodes = PlateNodes {
@@ -370,7 +382,11 @@ impl Penetration {
             spacing: rod.cylinder.radius / rod.rings as f64,
             quarter: rod.quarter,
         };
-        let radius = (2.0 * rod.cylinder.radius).min(0.8 * self.setup.plate.radius);
+        let radius = if self.setup.radial_crack_radius > 0.0 {
+            self.setup.radial_crack_radius
+        } else {
+            (2.0 * rod.cylinder.radius).min(0.8 * self.setup.plate.radius)
+        };
         (
             nodes.cone_half_angle(),
             nodes.radial_crack_count(radius),
@@ -441,6 +457,12 @@ impl Penetration {
                     _ => 0.0,
                 })
                 .collect(),
+            "split_planes" => damage()
+                .map(|(c, v, g)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => v.split_planes(c) as f64,
+                    _ => 0.0,
+                })
+                .collect(),
             "crack_size" => damage()
                 .map(|(_, v, g)| match v {
                     Some(v) if g == 1 => v.crack_size,
@@ -468,7 +490,9 @@ impl Penetration {
 /// node is on (m; the plate's rear face is the nodes whose `z0` is the
 /// plate's `-thickness`), and the crack density across the hoop direction,
 /// that of a radial crack (the crack density where the cracks lie in every
-/// orientation; 0 at the projectile's nodes).
+/// orientation; 0 at the projectile's nodes), and the number of tensile
+/// planes split at each node (0 to 3; 0 without planes and at the
+/// projectile's nodes).
 pub const PENETRATION_FIELDS: &[FieldSpec] = &{
     const fn scalar(
         name: &'static str,
@@ -491,8 +515,9 @@ pub const PENETRATION_FIELDS: &[FieldSpec] = &{
         scalar("crack_size", "m", &["a"]),
         scalar("place_at_impact", "m", &["x0", "y0", "z0"]),
         scalar("radial_damage", "1", &["gamma_hoop"]),
+        scalar("split_planes", "1", &["split_planes"]),
     ];
-    let mut out = [own[0]; MLPG_FIELDS.len() + 9];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 10];
     let mut i = 0;
     while i < out.len() {
         out[i] = if i < MLPG_FIELDS.len() {
