@@ -647,6 +647,24 @@ fn a_plate_with_tensile_planes_cracks_and_conserves_energy() {
             .zip(&radial)
             .any(|(g, r)| *g >= 0.75 && *r < 0.75)
     );
+    // Each node with a split plane gives the unit normal of its first one
+    // (n_z >= 0, the hoop part >= 0), the others zero; some nodes split on
+    // all three planes, none on more.
+    let split = sim.field("split_planes").unwrap();
+    let normal = sim.field("split_normal").unwrap();
+    assert_eq!(normal.len(), 3 * split.len());
+    for (k, n) in normal.chunks(3).enumerate() {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if split[k] > 0.0 {
+            assert!(
+                (len - 1.0).abs() < 1e-9 && n[1] >= 0.0 && n[2] >= 0.0,
+                "{n:?}"
+            );
+        } else {
+            assert_eq!(len, 0.0, "{n:?}");
+        }
+    }
+    assert!(split.contains(&3.0) && split.iter().all(|&s| s <= 3.0));
 }
 
 /// The radius of the radial-crack count must lie inside the plate: one at

@@ -309,6 +309,33 @@ impl Penetration {
         }
     }
 
+    /// The normal of the point's split tensile plane of lowest index (plane
+    /// 0 lies across the largest principal tension when the planes formed)
+    /// in the cylindrical frame at `x`, `(n_r, |n_theta|, n_z)` with the
+    /// sign that makes `n_z >= 0`; zero when no plane has split.
+    fn split_normal(c: &RajendranGrove, v: &CeramicVars, x: [f64; 3]) -> [f64; 3] {
+        let (Some(t), Some(planes)) = (v.tensile, c.crack_planes()) else {
+            return [0.0; 3];
+        };
+        let split = planes.split_size();
+        let Some(k) = (0..3).find(|&k| t.size[k] >= split) else {
+            return [0.0; 3];
+        };
+        let n = t.normals[k];
+        let r = x[0].hypot(x[1]);
+        let (cos, sin) = if r > 0.0 {
+            (x[0] / r, x[1] / r)
+        } else {
+            (1.0, 0.0)
+        };
+        let sign = if n[2] < 0.0 { -1.0 } else { 1.0 };
+        [
+            sign * (n[0] * cos + n[1] * sin),
+            (n[1] * cos - n[0] * sin).abs(),
+            sign * n[2],
+        ]
+    }
+
     /// Radius of the channel about the axis free of intact plate material
     /// within the plate's original thickness (m): the smallest distance
     /// from the axis of a plate node there that is not pulverized.
@@ -463,6 +490,13 @@ impl Penetration {
                     _ => 0.0,
                 })
                 .collect(),
+            "split_normal" => damage()
+                .zip(self.run.positions())
+                .flat_map(|((c, v, g), x)| match (c, v) {
+                    (Some(c), Some(v)) if g == 1 => Self::split_normal(c, v, *x),
+                    _ => [0.0; 3],
+                })
+                .collect(),
             "crack_size" => damage()
                 .map(|(_, v, g)| match v {
                     Some(v) if g == 1 => v.crack_size,
@@ -492,7 +526,9 @@ impl Penetration {
 /// that of a radial crack (the crack density where the cracks lie in every
 /// orientation; 0 at the projectile's nodes), and the number of tensile
 /// planes split at each node (0 to 3; 0 without planes and at the
-/// projectile's nodes).
+/// projectile's nodes) with the normal of its first split plane in the
+/// cylindrical frame (`(n_r, |n_theta|, n_z)`, `n_z >= 0`; zero where none
+/// has split).
 pub const PENETRATION_FIELDS: &[FieldSpec] = &{
     const fn scalar(
         name: &'static str,
@@ -516,8 +552,9 @@ pub const PENETRATION_FIELDS: &[FieldSpec] = &{
         scalar("place_at_impact", "m", &["x0", "y0", "z0"]),
         scalar("radial_damage", "1", &["gamma_hoop"]),
         scalar("split_planes", "1", &["split_planes"]),
+        scalar("split_normal", "1", &["nr", "nt", "nz"]),
     ];
-    let mut out = [own[0]; MLPG_FIELDS.len() + 10];
+    let mut out = [own[0]; MLPG_FIELDS.len() + 11];
     let mut i = 0;
     while i < out.len() {
         out[i] = if i < MLPG_FIELDS.len() {
