@@ -5,7 +5,12 @@
 //! `*MAT_JOHNSON_HOLMQUIST_CERAMICS` (`*MAT_110`, LS-DYNA Keyword User's
 //! Manual, Volume II; cited as MAT_110). A point model; the plate-impact
 //! solver steps it as the plate material `Layer::Jh2` (the `plate_impact`
-//! scene's level `jh2`, constants under `jh_`).
+//! scene's level `jh2`, constants under `jh_`). For the particle solvers it
+//! is a material, [`super::Material::jh2`] ([`super::Damage::Jh2`]), whose
+//! update steps the point at the solver's density
+//! ([`Jh2::step_to_density`]) and keeps it in the particle's
+//! [`super::PointState`], saved with the run's material state (no scene
+//! builds one yet).
 //!
 //! The model, with the sources read for each part (the paper itself was not
 //! at hand; its equations are those every secondary source below repeats):
@@ -485,8 +490,24 @@ impl Jh2 {
         spin: &[f64; 3],
         dt: f64,
     ) -> f64 {
+        let density = point.density * (-(rate[0] + rate[1] + rate[2]) * dt).exp();
+        self.step_to_density(point, rate, spin, dt, density)
+    }
+
+    /// [`Jh2::step_with_spin`] with the density at the end of the step
+    /// given (`density`, kg/m3): for a solver that integrates the density
+    /// itself, so that the point's pressure is that of the solver's
+    /// density.
+    pub fn step_to_density(
+        &self,
+        point: &mut Jh2Point,
+        rate: &Full,
+        spin: &[f64; 3],
+        dt: f64,
+        density: f64,
+    ) -> f64 {
         let c = &self.constants;
-        point.density *= (-(rate[0] + rate[1] + rate[2]) * dt).exp();
+        point.density = density;
         if point.failed {
             point.deviator = [0.0; 6];
             point.pressure = 0.0;

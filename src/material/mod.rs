@@ -37,6 +37,7 @@ use bilinear::Bilinear;
 use eos::LinearEos;
 use ideal_gas::IdealGas;
 use johnson_cook::JohnsonCook;
+use johnson_holmquist::Jh2;
 use mie_gruneisen::{CompressionLimit, MieGruneisen, check};
 use rajendran_grove::{CeramicPoint, RajendranGrove};
 use state::Memo;
@@ -116,6 +117,12 @@ pub enum Damage {
     /// Gurson and Mohr-Coulomb strengths (eqs. 21, 25) for the strength
     /// model. Build it with [`Material::ceramic`].
     RajendranGrove(RajendranGrove),
+    /// The Johnson-Holmquist ceramic JH-2 (JH94; the module
+    /// `johnson_holmquist`): its pressure with bulking stands in for the
+    /// equation of state and its damaged strength surfaces for the
+    /// strength model, so it owns the whole update of its points, as the
+    /// Rajendran-Grove ceramic does. Build it with [`Material::jh2`].
+    Jh2(Jh2),
 }
 
 /// A material: equation of state, strength and damage models, with the
@@ -194,25 +201,36 @@ impl Material {
             check("yield_stress", b.yield_stress, non_negative)?;
             check("hardening_modulus", b.hardening_modulus, non_negative)?;
         }
-        if let Damage::RajendranGrove(c) = &self.damage {
-            c.validate()?;
-            // The slots the ceramic stands in for hold its intact matrix
-            // ([`Material::ceramic`]); anything else is a contradiction.
-            let intact = Material::ceramic(
-                *c,
-                self.specific_heat,
-                self.taylor_quinney,
-                self.reference_temperature,
-            );
-            if (self.eos, self.strength, self.shear_modulus)
-                != (intact.eos, intact.strength, intact.shear_modulus)
-            {
-                return Err(crate::Error::Inconsistent(
-                    "a Rajendran-Grove material holds its own moduli, pressure and strength: \
-                     build it with Material::ceramic"
-                        .into(),
-                ));
+        // A model that owns its points' update keeps its intact solid in
+        // the slots it stands in for ([`Material::ceramic`],
+        // [`Material::jh2`]); anything else is a contradiction.
+        let (c, t, tr) = (
+            self.specific_heat,
+            self.taylor_quinney,
+            self.reference_temperature,
+        );
+        let (intact, name, builder) = match &self.damage {
+            Damage::None => return Ok(()),
+            Damage::RajendranGrove(rg) => {
+                rg.validate()?;
+                (
+                    Material::ceramic(*rg, c, t, tr),
+                    "Rajendran-Grove",
+                    "ceramic",
+                )
             }
+            Damage::Jh2(j) => {
+                j.constants().validate()?;
+                (Material::jh2(*j, c, t, tr), "JH-2", "jh2")
+            }
+        };
+        if (self.eos, self.strength, self.shear_modulus)
+            != (intact.eos, intact.strength, intact.shear_modulus)
+        {
+            return Err(crate::Error::Inconsistent(format!(
+                "a {name} material holds its own moduli, pressure and strength: \
+                 build it with Material::{builder}"
+            )));
         }
         Ok(())
     }
@@ -246,6 +264,36 @@ impl Material {
         }
     }
 
+    /// A material of JH-2 ceramic ([`Damage::Jh2`]) with its thermal
+    /// constants. The equation-of-state and strength slots hold the intact
+    /// solid (linear pressure of bulk modulus `K1` at `rho0`, perfectly
+    /// plastic at the strength of the HEL, `sigma_HEL`), for what reads
+    /// them outside the update; the update of a point and
+    /// [`Material::longitudinal_modulus`] use the model itself.
+    pub fn jh2(
+        j: Jh2,
+        specific_heat: f64,
+        taylor_quinney: f64,
+        reference_temperature: f64,
+    ) -> Material {
+        let c = j.constants();
+        Material {
+            eos: Eos::Linear(LinearEos {
+                bulk_modulus: c.k[0],
+                density: c.density,
+            }),
+            strength: Strength::Bilinear(Bilinear {
+                yield_stress: j.limit().strength,
+                hardening_modulus: 0.0,
+            }),
+            damage: Damage::Jh2(j),
+            shear_modulus: c.shear_modulus,
+            specific_heat,
+            taylor_quinney,
+            reference_temperature,
+        }
+    }
+
     /// The specific internal energy the equation of state sees at
     /// temperature `temp`: the heat `c (T - T_ref)` above the reference
     /// state. (The solvers track temperature, heated by the plastic work;
@@ -269,10 +317,11 @@ impl Material {
     /// ([`Material::wave_modulus`] takes the state).
     #[inline]
     pub fn longitudinal_modulus(&self, rho: f64, p: f64) -> f64 {
-        if let Damage::RajendranGrove(c) = &self.damage {
-            return c.longitudinal_modulus(rho, c.initial_porosity);
+        match &self.damage {
+            Damage::RajendranGrove(c) => c.longitudinal_modulus(rho, c.initial_porosity),
+            Damage::Jh2(j) => j.longitudinal_modulus(rho),
+            Damage::None => self.eos.bulk_modulus(rho, p) + 4.0 / 3.0 * self.shear_modulus,
         }
-        self.eos.bulk_modulus(rho, p) + 4.0 / 3.0 * self.shear_modulus
     }
 
     /// The longitudinal modulus of a point in state `state` at density
@@ -290,6 +339,7 @@ impl Material {
                 let opened: f64 = v.tensile.map_or(0.0, |t| t.opening.iter().sum());
                 c.longitudinal_modulus(rho * (1.0 + opened), v.porosity)
             }
+            (Damage::Jh2(j), _) => j.longitudinal_modulus(rho),
             _ => self.longitudinal_modulus(rho, p),
         }
     }
@@ -328,6 +378,7 @@ impl Material {
             Damage::RajendranGrove(c) => {
                 Ok(self.update_ceramic(c, load, old, self.energy(old.temperature), state))
             }
+            Damage::Jh2(j) => Ok(self.update_jh2(j, load, old, state)),
         }
     }
 
@@ -349,6 +400,7 @@ impl Material {
         match &self.damage {
             Damage::None => self.update_j2(load, old, state),
             Damage::RajendranGrove(c) => Ok(self.update_ceramic(c, load, old, energy, state)),
+            Damage::Jh2(j) => Ok(self.update_jh2(j, load, old, state)),
         }
     }
 
@@ -427,13 +479,48 @@ impl Material {
         );
         let work = c.update(&full, energy, &mut point);
         state.damage = Some(point.vars());
+        let stress = (&point.deviator, point.pressure, point.plastic_strain);
+        self.heated(stress, work, old.temperature, load.density)
+    }
+
+    /// The state of a point of a model that owns its update: its deviator,
+    /// pressure and plastic strain `(s, p, eps_p)` in 3-D components, and
+    /// the temperature `temp` raised by the Taylor-Quinney fraction of the
+    /// plastic work `work` (J/m3) at density `rho`.
+    fn heated<T: SymTensor>(
+        &self,
+        (s, p, eps_p): (&Full, f64, f64),
+        work: f64,
+        temp: f64,
+        rho: f64,
+    ) -> Point<T> {
         Point {
-            deviator: T::from_full(&point.deviator),
-            pressure: point.pressure,
-            plastic_strain: point.plastic_strain,
-            temperature: old.temperature
-                + self.taylor_quinney * work / (load.density * self.specific_heat),
+            deviator: T::from_full(s),
+            pressure: p,
+            plastic_strain: eps_p,
+            temperature: temp + self.taylor_quinney * work / (rho * self.specific_heat),
         }
+    }
+
+    /// One step of a JH-2 point ([`Jh2::step_to_density`] at the solver's
+    /// density, in 3-D components whatever the solver's form; its state in
+    /// `state`, the intact point before its first step), heated by the
+    /// Taylor-Quinney fraction of its plastic work. JH-2's pressure takes
+    /// no energy.
+    fn update_jh2<T: SymTensor>(
+        &self,
+        j: &Jh2,
+        load: &Loading<T>,
+        old: &Point<T>,
+        state: &mut PointState,
+    ) -> Point<T> {
+        let mut point = state.jh2.unwrap_or_else(|| j.initial_point());
+        let rate = load.rate.to_full();
+        let spin = T::spin_to_full(&load.spin);
+        let work = j.step_to_density(&mut point, &rate, &spin, load.dt, load.density);
+        state.jh2 = Some(point);
+        let stress = (&point.deviator, point.pressure, point.plastic_strain);
+        self.heated(stress, work, old.temperature, load.density)
     }
 }
 
@@ -659,6 +746,88 @@ mod tests {
         assert!(twin_temp > t0 && full.plastic_strain > 0.0);
     }
 
+    /// The JH-2 material steps a point exactly as the JH-2 point model does
+    /// (its analytic checks are in [`johnson_holmquist`]), to the bit, in
+    /// the 3-D form, with the density the solver gives it; the point is
+    /// heated by the Taylor-Quinney fraction of its plastic work. The path
+    /// passes the HEL, shears and is pulled apart, so the point is damaged
+    /// and fractured and every branch is taken.
+    #[test]
+    fn jh2_material_steps_as_the_point_model() {
+        let j = johnson_holmquist::JohnsonHolmquist::example_ceramic()
+            .model()
+            .unwrap();
+        let (heat, tq, t0) = (750.0, 0.9, 293.0);
+        let m = Material::jh2(j, heat, tq, t0);
+        assert!(m.validate().is_ok());
+        let dt = 1e-9;
+        let mut twin = j.initial_point();
+        let mut twin_temp = t0;
+        let mut full = unloaded([0.0; 6], 0.0);
+        let mut state = PointState::default();
+        for (rate, spin, n) in ceramic_path() {
+            for _ in 0..n {
+                let work = j.step_with_spin(&mut twin, &rate, &spin, dt);
+                twin_temp += tq * work / (twin.density * heat);
+                let load = Loading::<Full> {
+                    dt,
+                    rate,
+                    spin,
+                    density: twin.density,
+                };
+                full = m.update(&load, &full, &mut state).unwrap();
+                assert_eq!(full.deviator, twin.deviator);
+                assert_eq!(full.pressure, twin.pressure);
+                assert_eq!(full.plastic_strain, twin.plastic_strain);
+                assert_eq!(full.temperature, twin_temp);
+                assert_eq!(state.jh2(), Some(&twin));
+            }
+        }
+        assert_eq!(twin.damage, 1.0);
+        assert!(full.plastic_strain > 0.0 && twin_temp > t0);
+        // The wave speed: the intact solid's K1 + 4/3 G at rho0.
+        let c = j.constants();
+        let expected = c.k[0] + 4.0 / 3.0 * c.shear_modulus;
+        let got = m.wave_modulus(c.density, 0.0, &state);
+        assert!((got / expected - 1.0).abs() < 1e-12, "{got} {expected}");
+        // The slots hold the intact solid: anything else is refused.
+        let mut bad = m;
+        bad.shear_modulus *= 2.0;
+        assert!(bad.validate().is_err());
+        // A state with JH-2 points saves them and reads them back, in JSON
+        // and in postcard, beside a ceramic point and a point with none;
+        // a damage past 1 is refused by the check of a restored state.
+        let mut ceramic = PointState::default();
+        let rg = RajendranGrove::ad85();
+        let squeeze = Loading::<Full> {
+            dt: 1e-9,
+            rate: [0.0, -1e5, 0.0, 0.0, 0.0, 0.0],
+            spin: [0.0; 3],
+            density: rg.density * (1.0 + 1e-4),
+        };
+        Material::ceramic(rg, heat, tq, t0)
+            .update(&squeeze, &unloaded([0.0; 6], 0.0), &mut ceramic)
+            .unwrap();
+        let saved = MaterialState {
+            points: vec![state, ceramic, PointState::default()],
+        };
+        let json = serde_json::to_string(&saved).unwrap();
+        assert!(json.starts_with("{\"ceramic\":[null,{"), "{json}");
+        let from_json: MaterialState = serde_json::from_str(&json).unwrap();
+        let bytes = postcard::to_allocvec(&saved).unwrap();
+        let from_postcard: MaterialState = postcard::from_bytes(&bytes).unwrap();
+        for back in [&from_json, &from_postcard] {
+            assert_eq!(back.points.len(), 3);
+            assert_eq!(back.points[0].jh2(), Some(&twin));
+            assert_eq!(back.points[1].ceramic(), ceramic.ceramic());
+            assert!(back.points[2].jh2().is_none() && back.points[2].ceramic().is_none());
+            assert!(back.check_len(3).is_ok());
+        }
+        let mut forged = from_json;
+        forged.points[0].jh2.as_mut().unwrap().damage = 1.5;
+        assert!(forged.check_len(3).is_err());
+    }
+
     /// The ceramic's wave modulus at its initial density and porosity is
     /// `beta1 + 4/3 R_g G` (the matrix is neither compressed nor
     /// stretched), with Mackenzie's `R_g` typed out; a compressed point is
@@ -770,7 +939,8 @@ mod tests {
             }
             back.check_len(4).unwrap();
         }
-        // The payload: Some, four entries, the last None.
+        // The payload: Some, four entries, the last None (then no JH-2
+        // points).
         assert_eq!(bytes[..2], [1, 4]);
         assert_eq!(*bytes.last().unwrap(), 0);
         assert!(text.starts_with("[{\"elastic_strain\":") && text.ends_with(",null]"));
@@ -790,9 +960,10 @@ mod tests {
             assert_eq!(s.memo.eps_p, 0.0);
         }
         assert!(!steel_state.has_damage());
-        assert_eq!(postcard::to_allocvec(&steel_state).unwrap(), [0]);
+        // In postcard the pair (ceramic, JH-2): neither.
+        assert_eq!(postcard::to_allocvec(&steel_state).unwrap(), [0, 0]);
         assert_eq!(serde_json::to_string(&steel_state).unwrap(), "null");
-        let back: MaterialState = postcard::from_bytes(&[0]).unwrap();
+        let back: MaterialState = postcard::from_bytes(&[0, 0]).unwrap();
         assert!(back.points.is_empty());
         back.check_len(3).unwrap();
     }

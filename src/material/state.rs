@@ -2,6 +2,7 @@
 //! damage variables ([`PointState`]), and the state of every particle of a
 //! run with its saved form ([`MaterialState`]).
 
+use super::johnson_holmquist::Jh2Point;
 use super::rajendran_grove::CeramicVars;
 
 /// Per-particle state of the models, kept from step to step.
@@ -16,6 +17,10 @@ pub struct PointState {
     /// and for a ceramic point before its first step (it then starts from
     /// the intact state, [`RajendranGrove::initial_point`](super::rajendran_grove::RajendranGrove::initial_point)).
     pub(super) damage: Option<CeramicVars>,
+    /// The JH-2 point: `None` for another material, and for a JH-2 point
+    /// before its first step (it then starts intact,
+    /// [`Jh2::initial_point`]).
+    pub(super) jh2: Option<Jh2Point>,
 }
 
 /// The Johnson-Cook factors of a point ([`PointState`]'s memo).
@@ -38,6 +43,7 @@ impl Default for PointState {
                 thermal: 0.0,
             },
             damage: None,
+            jh2: None,
         }
     }
 }
@@ -55,6 +61,12 @@ impl PointState {
     /// has taken a step.
     pub fn ceramic(&self) -> Option<&CeramicVars> {
         self.damage.as_ref()
+    }
+
+    /// The JH-2 state of the point, if its material is JH-2 and it has
+    /// taken a step.
+    pub fn jh2(&self) -> Option<&Jh2Point> {
+        self.jh2.as_ref()
     }
 
     /// Whether the point is a pulverized ceramic (its material has the
@@ -111,7 +123,9 @@ impl MaterialState {
 
     /// Whether some point holds damage variables.
     pub fn has_damage(&self) -> bool {
-        self.points.iter().any(|p| p.damage.is_some())
+        self.points
+            .iter()
+            .any(|p| p.damage.is_some() || p.jh2.is_some())
     }
 
     /// Checks a restored state for a run of `n` particles (the message
@@ -128,11 +142,9 @@ impl MaterialState {
         if len != n {
             return Err(format!("it holds {len} damage states for {n} particles"));
         }
-        match self
-            .points
-            .iter()
-            .position(|p| p.damage.is_some_and(|v| !physical(&v)))
-        {
+        match self.points.iter().position(|p| {
+            p.damage.is_some_and(|v| !physical(&v)) || p.jh2.is_some_and(|j| !physical_jh2(&j))
+        }) {
             Some(i) => Err(format!(
                 "its damage variables are not all finite and in range (particle {i})"
             )),
@@ -159,6 +171,20 @@ impl MaterialState {
     }
 }
 
+/// Whether the state of a JH-2 point is finite and physical: a positive
+/// density, damage in [0, 1], bulking not below zero.
+fn physical_jh2(j: &Jh2Point) -> bool {
+    j.deviator.iter().all(|x| x.is_finite())
+        && j.pressure.is_finite()
+        && j.density.is_finite()
+        && j.density > 0.0
+        && j.plastic_strain.is_finite()
+        && j.plastic_strain >= 0.0
+        && (0.0..=1.0).contains(&j.damage)
+        && j.bulking.is_finite()
+        && j.bulking >= 0.0
+}
+
 /// Whether the variables of a ceramic point are finite and physical.
 fn physical(v: &CeramicVars) -> bool {
     v.elastic_strain.iter().all(|x| x.is_finite())
@@ -183,6 +209,11 @@ fn physical(v: &CeramicVars) -> bool {
 }
 
 /// The saved form: the damage variables only, `None` when no point has any.
+/// With JH-2 points, a human-readable format (JSON) writes
+/// `{"ceramic": <that form>, "jh2": [<JH-2 point or null>, ...]}` (a state
+/// without them keeps the form of format 2, so files written before read
+/// back as they were); a binary one (postcard, the FMU state) always writes
+/// the pair `(ceramic, jh2)`, `jh2` being `None` when no point has one.
 impl serde::Serialize for MaterialState {
     fn serialize<S: serde::Serializer>(
         &self,
@@ -197,11 +228,42 @@ impl serde::Serialize for MaterialState {
                 serializer.collect_seq(self.0.iter().map(|p| p.damage.as_ref()))
             }
         }
-        self.has_damage()
-            .then_some(Damage(&self.points))
-            .serialize(serializer)
+        struct Jh2s<'a>(&'a [PointState]);
+        impl serde::Serialize for Jh2s<'_> {
+            fn serialize<S: serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> std::result::Result<S::Ok, S::Error> {
+                serializer.collect_seq(self.0.iter().map(|p| p.jh2.as_ref()))
+            }
+        }
+        use serde::ser::SerializeStruct as _;
+        let ceramic = self
+            .points
+            .iter()
+            .any(|p| p.damage.is_some())
+            .then_some(Damage(&self.points));
+        let jh2 = self
+            .points
+            .iter()
+            .any(|p| p.jh2.is_some())
+            .then_some(Jh2s(&self.points));
+        match (serializer.is_human_readable(), jh2) {
+            (true, None) => ceramic.serialize(serializer),
+            (true, Some(jh2)) => {
+                let mut both = serializer.serialize_struct("MaterialState", 2)?;
+                both.serialize_field("ceramic", &ceramic)?;
+                both.serialize_field("jh2", &jh2)?;
+                both.end()
+            }
+            (false, jh2) => (ceramic, jh2).serialize(serializer),
+        }
     }
 }
+
+/// The per-point variables of the saved form.
+type SavedCeramic = Option<Vec<Option<CeramicVars>>>;
+type SavedJh2 = Option<Vec<Option<Jh2Point>>>;
 
 /// Reads the saved form back: the damage variables, with empty caches (not
 /// yet checked: [`MaterialState::check_len`]).
@@ -209,13 +271,35 @@ impl<'de> serde::Deserialize<'de> for MaterialState {
     fn deserialize<D: serde::Deserializer<'de>>(
         deserializer: D,
     ) -> std::result::Result<Self, D::Error> {
-        let damage = Option::<Vec<Option<CeramicVars>>>::deserialize(deserializer)?;
+        /// The JSON form with JH-2 points.
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Both {
+            ceramic: SavedCeramic,
+            jh2: SavedJh2,
+        }
+        /// The JSON forms: without JH-2 points (format 2's) or with them.
+        #[derive(serde::Deserialize)]
+        #[serde(untagged)]
+        enum Human {
+            Ceramic(SavedCeramic),
+            Both(Both),
+        }
+        let (ceramic, jh2) = if deserializer.is_human_readable() {
+            match Human::deserialize(deserializer)? {
+                Human::Ceramic(c) => (c, None),
+                Human::Both(b) => (b.ceramic, b.jh2),
+            }
+        } else {
+            <(SavedCeramic, SavedJh2)>::deserialize(deserializer)?
+        };
+        let (ceramic, jh2) = (ceramic.unwrap_or_default(), jh2.unwrap_or_default());
+        let n = ceramic.len().max(jh2.len());
         Ok(MaterialState {
-            points: damage
-                .unwrap_or_default()
-                .into_iter()
-                .map(|damage| PointState {
-                    damage,
+            points: (0..n)
+                .map(|i| PointState {
+                    damage: ceramic.get(i).copied().flatten(),
+                    jh2: jh2.get(i).copied().flatten(),
                     ..PointState::default()
                 })
                 .collect(),

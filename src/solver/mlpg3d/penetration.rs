@@ -257,7 +257,7 @@ impl Penetration {
     fn ceramic(&self) -> Option<&RajendranGrove> {
         match &self.run.others()[0].material.damage {
             Damage::RajendranGrove(c) => Some(c),
-            Damage::None => None,
+            Damage::None | Damage::Jh2(_) => None,
         }
     }
 
