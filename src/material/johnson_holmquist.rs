@@ -9,8 +9,8 @@
 //! is a material, [`super::Material::jh2`] ([`super::Damage::Jh2`]), whose
 //! update steps the point at the solver's density
 //! ([`Jh2::step_to_density`]) and keeps it in the particle's
-//! [`super::PointState`], saved with the run's material state (no scene
-//! builds one yet).
+//! [`super::PointState`], saved with the run's material state
+//! (`penetration`'s `plate_model = jh2`).
 //!
 //! The model, with the sources read for each part (the paper itself was not
 //! at hand; its equations are those every secondary source below repeats):

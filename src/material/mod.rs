@@ -23,6 +23,7 @@ pub mod ideal_gas;
 pub mod johnson_cook;
 // The JH-2 point model, not yet wired into a material; its tests use it.
 #[allow(dead_code)]
+pub mod jh2_block;
 pub mod johnson_holmquist;
 pub mod mie_gruneisen;
 pub mod presets;
@@ -40,8 +41,8 @@ use johnson_cook::JohnsonCook;
 use johnson_holmquist::Jh2;
 use mie_gruneisen::{CompressionLimit, MieGruneisen, check};
 use rajendran_grove::{CeramicPoint, RajendranGrove};
-use state::Memo;
 pub use state::{MaterialState, PointState};
+use state::{Memo, Vars};
 use tensor::{Full, SymTensor, radial_return};
 
 /// Equation of state: the pressure from the density and the specific
@@ -331,7 +332,7 @@ impl Material {
     /// soften it, so the wave speed is bounded from above, as a stable
     /// time step needs).
     pub fn wave_modulus(&self, rho: f64, p: f64, state: &PointState) -> f64 {
-        match (&self.damage, &state.damage) {
+        match (&self.damage, state.ceramic()) {
             // The matrix's density: the point's, less its tensile cracks'
             // openings (a point whose cracks have opened is stiffer than its
             // density says once they close).
@@ -351,11 +352,11 @@ impl Material {
     pub(crate) fn seed_point(&self, key: u64, state: &mut PointState) {
         if let Damage::RajendranGrove(c) = &self.damage
             && c.tensile_flaw_scatter > 0.0
-            && state.damage.is_none()
+            && state.ceramic().is_none()
         {
             let mut vars = c.initial_point().vars();
             vars.tensile_flaw = c.tensile_flaw_of(key);
-            state.damage = Some(vars);
+            state.vars = Vars::Ceramic(vars);
         }
     }
 
@@ -470,7 +471,10 @@ impl Material {
             spin: T::spin_to_full(&load.spin),
             density: load.density,
         };
-        let vars = state.damage.unwrap_or_else(|| c.initial_point().vars());
+        let vars = state
+            .ceramic()
+            .copied()
+            .unwrap_or_else(|| c.initial_point().vars());
         let mut point = CeramicPoint::of(
             &vars,
             old.deviator.to_full(),
@@ -478,7 +482,7 @@ impl Material {
             old.plastic_strain,
         );
         let work = c.update(&full, energy, &mut point);
-        state.damage = Some(point.vars());
+        state.vars = Vars::Ceramic(point.vars());
         let stress = (&point.deviator, point.pressure, point.plastic_strain);
         self.heated(stress, work, old.temperature, load.density)
     }
@@ -514,11 +518,11 @@ impl Material {
         old: &Point<T>,
         state: &mut PointState,
     ) -> Point<T> {
-        let mut point = state.jh2.unwrap_or_else(|| j.initial_point());
+        let mut point = state.jh2().copied().unwrap_or_else(|| j.initial_point());
         let rate = load.rate.to_full();
         let spin = T::spin_to_full(&load.spin);
         let work = j.step_to_density(&mut point, &rate, &spin, load.dt, load.density);
-        state.jh2 = Some(point);
+        state.vars = Vars::Jh2(point);
         let stress = (&point.deviator, point.pressure, point.plastic_strain);
         self.heated(stress, work, old.temperature, load.density)
     }
@@ -824,7 +828,9 @@ mod tests {
             assert!(back.check_len(3).is_ok());
         }
         let mut forged = from_json;
-        forged.points[0].jh2.as_mut().unwrap().damage = 1.5;
+        if let Vars::Jh2(j) = &mut forged.points[0].vars {
+            j.damage = 1.5;
+        }
         assert!(forged.check_len(3).is_err());
     }
 
@@ -844,7 +850,7 @@ mod tests {
         // A point whose pores have closed to 5%: its matrix is less
         // compressed at the same density, and its shear modulus higher.
         let state = PointState {
-            damage: Some(CeramicVars {
+            vars: Vars::Ceramic(CeramicVars {
                 porosity: 0.05,
                 ..c.initial_point().vars()
             }),
@@ -980,7 +986,10 @@ mod tests {
         assert!(state.check_len(3).is_err());
         let forged = |edit: fn(&mut CeramicVars)| {
             let mut s = state.clone();
-            edit(s.points[1].damage.as_mut().unwrap());
+            let Vars::Ceramic(v) = &mut s.points[1].vars else {
+                panic!("a ceramic point")
+            };
+            edit(v);
             s.check_len(4)
         };
         type Edit = fn(&mut CeramicVars);

@@ -13,14 +13,25 @@ pub struct PointState {
     /// same (a particle that does not yield), which spares two `powf` and
     /// gives the same bits.
     pub(super) memo: Memo,
-    /// The damage model's variables: `None` for a material without damage,
-    /// and for a ceramic point before its first step (it then starts from
-    /// the intact state, [`RajendranGrove::initial_point`](super::rajendran_grove::RajendranGrove::initial_point)).
-    pub(super) damage: Option<CeramicVars>,
-    /// The JH-2 point: `None` for another material, and for a JH-2 point
-    /// before its first step (it then starts intact,
-    /// [`Jh2::initial_point`]).
-    pub(super) jh2: Option<Jh2Point>,
+    /// The damage model's variables: none for a material without damage,
+    /// and for a damaging point before its first step (it then starts from
+    /// the intact state: [`RajendranGrove::initial_point`](super::rajendran_grove::RajendranGrove::initial_point),
+    /// [`Jh2::initial_point`](super::johnson_holmquist::Jh2::initial_point)).
+    /// One slot for either model, so that the state of a point costs no
+    /// more for a second model.
+    pub(super) vars: Vars,
+}
+
+/// The variables of a point's damage model ([`PointState`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) enum Vars {
+    /// No damage model, or no step yet.
+    #[default]
+    None,
+    /// A Rajendran-Grove ceramic point.
+    Ceramic(CeramicVars),
+    /// A JH-2 point.
+    Jh2(Jh2Point),
 }
 
 /// The Johnson-Cook factors of a point ([`PointState`]'s memo).
@@ -42,8 +53,7 @@ impl Default for PointState {
                 hardening: 0.0,
                 thermal: 0.0,
             },
-            damage: None,
-            jh2: None,
+            vars: Vars::None,
         }
     }
 }
@@ -52,7 +62,7 @@ impl PointState {
     /// The state of a ceramic point with variables `vars` (empty caches).
     pub(crate) fn with_ceramic(vars: CeramicVars) -> Self {
         PointState {
-            damage: Some(vars),
+            vars: Vars::Ceramic(vars),
             ..PointState::default()
         }
     }
@@ -60,13 +70,19 @@ impl PointState {
     /// The ceramic variables of the point, if its material has them and it
     /// has taken a step.
     pub fn ceramic(&self) -> Option<&CeramicVars> {
-        self.damage.as_ref()
+        match &self.vars {
+            Vars::Ceramic(v) => Some(v),
+            _ => None,
+        }
     }
 
     /// The JH-2 state of the point, if its material is JH-2 and it has
     /// taken a step.
     pub fn jh2(&self) -> Option<&Jh2Point> {
-        self.jh2.as_ref()
+        match &self.vars {
+            Vars::Jh2(j) => Some(j),
+            _ => None,
+        }
     }
 
     /// Whether the point is a pulverized ceramic (its material has the
@@ -82,6 +98,13 @@ impl PointState {
         self.ceramic()
             .and_then(|v| v.tensile)
             .map_or(0.0, |t| t.opening.iter().sum())
+    }
+
+    /// Whether the point is comminuted: a pulverized Rajendran-Grove
+    /// ceramic, or a JH-2 point fully damaged (D = 1: fractured, its
+    /// strength the fractured one's).
+    pub fn is_comminuted(&self) -> bool {
+        self.is_pulverized() || self.jh2().is_some_and(|j| j.damage >= 1.0)
     }
 
     /// Whether the point is a ceramic whose tensile cracks stand open (any
@@ -123,9 +146,7 @@ impl MaterialState {
 
     /// Whether some point holds damage variables.
     pub fn has_damage(&self) -> bool {
-        self.points
-            .iter()
-            .any(|p| p.damage.is_some() || p.jh2.is_some())
+        self.points.iter().any(|p| p.vars != Vars::None)
     }
 
     /// Checks a restored state for a run of `n` particles (the message
@@ -143,7 +164,7 @@ impl MaterialState {
             return Err(format!("it holds {len} damage states for {n} particles"));
         }
         match self.points.iter().position(|p| {
-            p.damage.is_some_and(|v| !physical(&v)) || p.jh2.is_some_and(|j| !physical_jh2(&j))
+            p.ceramic().is_some_and(|v| !physical(v)) || p.jh2().is_some_and(|j| !physical_jh2(j))
         }) {
             Some(i) => Err(format!(
                 "its damage variables are not all finite and in range (particle {i})"
@@ -159,7 +180,7 @@ impl MaterialState {
     /// observable infinite).
     pub fn check_cracks(&self, extent: f64) -> std::result::Result<(), String> {
         match self.points.iter().position(|p| {
-            p.damage
+            p.ceramic()
                 .is_some_and(|v| v.crack_size.is_nan() || v.crack_size > extent)
         }) {
             Some(i) => Err(format!(
@@ -225,7 +246,7 @@ impl serde::Serialize for MaterialState {
                 &self,
                 serializer: S,
             ) -> std::result::Result<S::Ok, S::Error> {
-                serializer.collect_seq(self.0.iter().map(|p| p.damage.as_ref()))
+                serializer.collect_seq(self.0.iter().map(PointState::ceramic))
             }
         }
         struct Jh2s<'a>(&'a [PointState]);
@@ -234,19 +255,19 @@ impl serde::Serialize for MaterialState {
                 &self,
                 serializer: S,
             ) -> std::result::Result<S::Ok, S::Error> {
-                serializer.collect_seq(self.0.iter().map(|p| p.jh2.as_ref()))
+                serializer.collect_seq(self.0.iter().map(PointState::jh2))
             }
         }
         use serde::ser::SerializeStruct as _;
         let ceramic = self
             .points
             .iter()
-            .any(|p| p.damage.is_some())
+            .any(|p| p.ceramic().is_some())
             .then_some(Damage(&self.points));
         let jh2 = self
             .points
             .iter()
-            .any(|p| p.jh2.is_some())
+            .any(|p| p.jh2().is_some())
             .then_some(Jh2s(&self.points));
         match (serializer.is_human_readable(), jh2) {
             (true, None) => ceramic.serialize(serializer),
@@ -295,15 +316,28 @@ impl<'de> serde::Deserialize<'de> for MaterialState {
         };
         let (ceramic, jh2) = (ceramic.unwrap_or_default(), jh2.unwrap_or_default());
         let n = ceramic.len().max(jh2.len());
-        Ok(MaterialState {
-            points: (0..n)
-                .map(|i| PointState {
-                    damage: ceramic.get(i).copied().flatten(),
-                    jh2: jh2.get(i).copied().flatten(),
+        let points = (0..n)
+            .map(|i| {
+                let vars = match (
+                    ceramic.get(i).copied().flatten(),
+                    jh2.get(i).copied().flatten(),
+                ) {
+                    (None, None) => Vars::None,
+                    (Some(c), None) => Vars::Ceramic(c),
+                    (None, Some(j)) => Vars::Jh2(j),
+                    (Some(_), Some(_)) => {
+                        return Err(serde::de::Error::custom(format!(
+                            "its particle {i} holds the variables of two damage models"
+                        )));
+                    }
+                };
+                Ok(PointState {
+                    vars,
                     ..PointState::default()
                 })
-                .collect(),
-        })
+            })
+            .collect::<std::result::Result<Vec<_>, D::Error>>()?;
+        Ok(MaterialState { points })
     }
 }
 

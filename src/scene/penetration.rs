@@ -16,6 +16,7 @@ use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
 use crate::material::choice::{MaterialChoice, Prefix};
+use crate::material::jh2_block::{JH_BLOCK, jh2_model};
 use crate::observe::PENETRATION_OBSERVABLES;
 use crate::solver::mlpg3d::penetration::{Penetration, PenetrationSetup};
 use crate::solver::mlpg3d::scheme::MlpgScheme;
@@ -198,6 +199,15 @@ const AFTER: &[ParamSpec] = &[
          1 = outcome (as soon as shot_outcome is decided, perforated or stopped, with end_time as the cap; \
          README, \"Ballistic limit\")",
     ),
+    levels_spec(
+        "plate_model",
+        0,
+        PLATE_MODEL,
+        "the plate's ceramic model: 0 = rajendran_grove (the default, the seed's: the plate_ parameters), \
+         1 = jh2 (Johnson-Holmquist JH-2 of the jh_ parameters, with the plate's specific heat, \
+         Taylor-Quinney coefficient and initial temperature; defaults: the example ceramic of \
+         Johnson & Holmquist 1994)",
+    ),
     row(
         "radial_crack_radius",
         "m",
@@ -214,6 +224,20 @@ const AFTER: &[ParamSpec] = &[
         "the plate's rim: 0 = free (the default, the seed's case: momentum is shared by projectile and plate \
          alone), 1 = clamped (the outer ring of plate nodes held still; README, \"Ballistic penetration\")",
     ),
+];
+
+/// The levels of `plate_model`.
+const PLATE_MODEL: &[Level] = &[
+    Level {
+        name: "rajendran_grove",
+        description: "the Rajendran-Grove ceramic of the plate_ parameters (the seed's model)",
+        sets: &[],
+    },
+    Level {
+        name: "jh2",
+        description: "the Johnson-Holmquist ceramic JH-2 of the jh_ parameters",
+        sets: &[],
+    },
 ];
 
 /// The levels of `plate_rim`.
@@ -264,12 +288,13 @@ pub const SCHEMES: &[Level] = &[
     super::taylor3d::PAPER_3D,
 ];
 
-const LEN: usize = BEFORE.len() + PLATE_CERAMIC.len() + AFTER.len();
+const LEN: usize = BEFORE.len() + PLATE_CERAMIC.len() + AFTER.len() + JH_BLOCK.len();
 
 /// Parameters of the penetration scene (SI units): the geometry, the
 /// projectile's block (bilinear, linear EOS; `tungsten_seed`), the plate's
 /// ceramic block (AD85), the resolution and the solver's choices.
-pub const PENETRATION_PARAMS: &[ParamSpec] = &concat::<LEN>(&[BEFORE, &PLATE_CERAMIC, AFTER]);
+pub const PENETRATION_PARAMS: &[ParamSpec] =
+    &concat::<LEN>(&[BEFORE, &PLATE_CERAMIC, AFTER, &JH_BLOCK]);
 
 /// The nodes of a run: the ring lattices of the projectile and the plate at
 /// the projectile's radial spacing (their quarters in the quarter model).
@@ -328,7 +353,25 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
     }
     let quarter = v("symmetry")? >= 0.5;
     let projectile_material = MaterialChoice::BILINEAR_LINEAR.material(Prefix::Projectile, v)?;
-    let plate_material = ceramic_material(v)?;
+    // The plate's model: the Rajendran-Grove ceramic of the plate_ block,
+    // or JH-2 of the jh_ block with the plate's thermal constants.
+    let plate_material = if v("plate_model")? >= 0.5 {
+        let checked = |name: &str| -> Result<f64> {
+            let x = v(name)?;
+            if let Some(spec) = PENETRATION_PARAMS.iter().find(|r| r.name == name) {
+                spec.check(x)?;
+            }
+            Ok(x)
+        };
+        Material::jh2(
+            jh2_model(v)?,
+            checked("plate_specific_heat")?,
+            checked("plate_taylor_quinney")?,
+            checked("plate_initial_temperature")?,
+        )
+    } else {
+        ceramic_material(v)?
+    };
     let end_time = v("end_time")?;
     let setup = PenetrationSetup {
         plate,

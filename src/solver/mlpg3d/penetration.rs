@@ -45,6 +45,11 @@ pub struct PenetrationSetup {
     pub radial_crack_radius: f64,
 }
 
+/// The JH-2 damage D at which a plate node counts as damaged: 1 % of the
+/// full damage, as the Rajendran-Grove plate counts 1 % of the critical
+/// crack density.
+pub const JH2_DAMAGED: f64 = 0.01;
+
 /// What a shot has come to ([`Penetration::outcome`]; the observable
 /// `shot_outcome` is its number).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -172,10 +177,7 @@ impl Penetration {
             let points = self.run.material_points();
             let (mut p, mut total) = (0.0, 0.0);
             for i in self.nodes(1) {
-                let intact = points
-                    .get(i)
-                    .and_then(|p| p.ceramic())
-                    .is_none_or(|c| c.pulverized.is_none());
+                let intact = points.get(i).is_none_or(|p| !p.is_comminuted());
                 if intact && (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt() <= reach {
                     p -= m[i] * v[i][2];
                     total += m[i];
@@ -261,20 +263,48 @@ impl Penetration {
         }
     }
 
-    /// Crack density and pulverization of each plate node, with its mass:
-    /// `(γ, pulverized, mass)`; γ = 0 for a plate without damage.
+    /// Whether the plate is of JH-2.
+    fn jh2_plate(&self) -> bool {
+        matches!(self.run.others()[0].material.damage, Damage::Jh2(_))
+    }
+
+    /// The damage at which a plate node counts as damaged: the ceramic's
+    /// [`RajendranGrove::damaged_threshold`], JH-2's [`JH2_DAMAGED`],
+    /// infinite for a plate without damage.
+    fn damaged_threshold(&self) -> f64 {
+        match &self.run.others()[0].material.damage {
+            Damage::RajendranGrove(c) => c.damaged_threshold(),
+            Damage::Jh2(_) => JH2_DAMAGED,
+            Damage::None => f64::INFINITY,
+        }
+    }
+
+    /// The damage of plate node `i` and whether it is comminuted: the
+    /// crack density γ and pulverization of a Rajendran-Grove ceramic (the
+    /// initial γ before its first step), JH-2's damage D and D = 1; zero
+    /// for a plate without damage.
+    fn node_damage(&self, i: usize) -> (f64, bool) {
+        let point = self.run.material_points().get(i);
+        if let Some(c) = self.ceramic() {
+            return match point.and_then(|p| p.ceramic()) {
+                Some(v) => (v.crack_density(c), v.pulverized.is_some()),
+                None => (c.crack_density(c.initial_crack_size), false),
+            };
+        }
+        match point.and_then(|p| p.jh2()) {
+            Some(j) => (j.damage, j.damage >= 1.0),
+            None => (0.0, false),
+        }
+    }
+
+    /// Damage and comminution of each plate node ([`Penetration::node_damage`]),
+    /// with its mass: `(γ or D, comminuted, mass)`.
     fn plate_damage(&self) -> Vec<(f64, bool, f64)> {
-        let points = self.run.material_points();
         let m = self.run.masses();
-        let c = self.ceramic();
         self.nodes(1)
             .map(|i| {
-                let vars = points.get(i).and_then(|p| p.ceramic());
-                match (c, vars) {
-                    (Some(c), Some(v)) => (v.crack_density(c), v.pulverized.is_some(), m[i]),
-                    (Some(c), None) => (c.crack_density(c.initial_crack_size), false, m[i]),
-                    _ => (0.0, false, m[i]),
-                }
+                let (g, p) = self.node_damage(i);
+                (g, p, m[i])
             })
             .collect()
     }
@@ -289,7 +319,8 @@ impl Penetration {
         let points = self.run.material_points();
         let x = self.run.positions();
         let Some(c) = self.ceramic() else {
-            return vec![0.0; self.nodes(1).count()];
+            // JH-2's damage has no orientation.
+            return self.nodes(1).map(|i| self.node_damage(i).0).collect();
         };
         self.nodes(1)
             .map(|i| match points.get(i).and_then(|p| p.ceramic()) {
@@ -307,6 +338,22 @@ impl Penetration {
         } else {
             v.crack_density_across(c, [-x[1] / r, x[0] / r, 0.0])
         }
+    }
+
+    /// A node field of a JH-2 plate: `f` of each plate node's JH-2 point
+    /// (0 before its first step and at the projectile's nodes).
+    fn jh2_field(
+        &self,
+        f: impl Fn(&crate::material::johnson_holmquist::Jh2Point) -> f64,
+    ) -> Vec<f64> {
+        let points = self.run.material_points();
+        let group = self.run.group();
+        (0..self.particles())
+            .map(|i| match points.get(i).and_then(|p| p.jh2()) {
+                Some(j) if group[i] == 1 => f(j),
+                _ => 0.0,
+            })
+            .collect()
     }
 
     /// The normal of the point's split tensile plane of lowest index (plane
@@ -345,12 +392,7 @@ impl Penetration {
         let points = self.run.material_points();
         self.nodes(1)
             .filter(|&i| x[i][2] >= -h && x[i][2] <= 0.0)
-            .filter(|&i| {
-                points
-                    .get(i)
-                    .and_then(|p| p.ceramic())
-                    .is_none_or(|v| v.pulverized.is_none())
-            })
+            .filter(|&i| points.get(i).is_none_or(|p| !p.is_comminuted()))
             .map(|i| (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt())
             .fold(f64::INFINITY, f64::min)
             .min(self.setup.plate.radius)
@@ -358,9 +400,7 @@ impl Penetration {
 
     /// `(damaged_fraction, pulverized_fraction, max_damage)` of the plate.
     pub fn damage(&self) -> (f64, f64, f64) {
-        let threshold = self
-            .ceramic()
-            .map_or(f64::INFINITY, RajendranGrove::damaged_threshold);
+        let threshold = self.damaged_threshold();
         let (mut damaged, mut pulverized, mut total, mut max) = (0.0, 0.0, 0.0, 0.0f64);
         for (g, p, m) in self.plate_damage() {
             total += m;
@@ -382,9 +422,9 @@ impl Penetration {
     /// projectile's diameter from the axis (at most 0.8 of the plate's
     /// radius).
     pub fn failure_modes(&self) -> (f64, f64, f64) {
-        let Some(c) = self.ceramic() else {
+        if self.ceramic().is_none() && !self.jh2_plate() {
             return (0.0, 0.0, 0.0);
-        };
+        }
         let at = self.run.reference();
         let plate: Vec<usize> = self.nodes(1).collect();
         let reference: Vec<[f64; 3]> = plate.iter().map(|&i| at[i]).collect();
@@ -392,9 +432,11 @@ impl Penetration {
             self.plate_damage().iter().map(|&(g, p, _)| (g, p)).unzip();
         // A node split on all three tensile planes is comminuted too.
         let points = self.run.material_points();
-        for (k, i) in plate.iter().enumerate() {
-            if let Some(v) = points.get(*i).and_then(|p| p.ceramic()) {
-                pulverized[k] |= v.split_planes(c) == 3;
+        if let Some(c) = self.ceramic() {
+            for (k, i) in plate.iter().enumerate() {
+                if let Some(v) = points.get(*i).and_then(|p| p.ceramic()) {
+                    pulverized[k] |= v.split_planes(c) == 3;
+                }
             }
         }
         let radial = self.plate_radial_damage();
@@ -404,7 +446,7 @@ impl Penetration {
             gamma: &gamma,
             radial: &radial,
             pulverized: &pulverized,
-            damaged: c.damaged_threshold(),
+            damaged: self.damaged_threshold(),
             thickness: self.setup.plate.length,
             spacing: rod.cylinder.radius / rod.rings as f64,
             quarter: rod.quarter,
@@ -462,12 +504,20 @@ impl Penetration {
         Some(match name {
             "body" => self.run.group().iter().map(|&g| g as f64).collect(),
             "mass" => self.run.masses().to_vec(),
+            "damage" if self.jh2_plate() => self.jh2_field(|j| j.damage),
             "damage" => damage()
                 .map(|(c, v, g)| match (c, v) {
                     (Some(c), Some(v)) if g == 1 => v.crack_density(c),
                     _ => 0.0,
                 })
                 .collect(),
+            "log10_damage" if self.jh2_plate() => {
+                self.jh2_field(|j| j.damage.log10().max(crate::observe::LOG10_NO_CRACKS))
+            }
+            "radial_damage" if self.jh2_plate() => self.jh2_field(|j| j.damage),
+            "pulverized" if self.jh2_plate() => {
+                self.jh2_field(|j| f64::from(u8::from(j.damage >= 1.0)))
+            }
             "log10_damage" => damage()
                 .map(|(c, v, g)| match (c, v) {
                     (Some(c), Some(v)) if g == 1 => v
