@@ -379,7 +379,8 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
         clamped_rim: v("plate_rim")? >= 0.5,
         radial_crack_radius: v("radial_crack_radius")?,
     };
-    if setup.radial_crack_radius >= plate.radius {
+    // False-safe: a radius that is not a number is refused too.
+    if setup.radial_crack_radius.is_nan() || setup.radial_crack_radius >= plate.radius {
         return Err(Error::Inconsistent(format!(
             "radial_crack_radius = {} m must lie inside the plate: below plate_diameter / 2 = {} m \
              (0 counts at the projectile's diameter)",
