@@ -163,6 +163,7 @@ pub mod internals {
     }
     /// The 3-D MLPG method's parts.
     pub mod mlpg {
+        pub use crate::approx::conform::Preconditioner;
         pub use crate::approx::lattice::{Cylinder, NodeLattice, Surfaces};
         pub use crate::approx::mls::distance;
         pub use crate::approx::mls::{NodalShapes, SupportParams, Supports};

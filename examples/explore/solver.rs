@@ -145,7 +145,8 @@ pub fn explore_taylor3d_stop() {
 }
 
 /// Exploration: the phase profile of `taylor3d` run to its end
-/// (`PARTICLES_RADIAL`, default 6), or for `STEPS` steps when that is set,
+/// (`PARTICLES_RADIAL`, default 6; `PRECONDITIONER`, the
+/// `conform_preconditioner`, default 0), or for `STEPS` steps when that is set,
 /// printed with the wall time of the construction and of the loop per
 /// node-step, and each phase's serial time (BENCHMARKS.md, "3-D MLPG
 /// speed"); with `MI_SCENE_FILE` or `MI_SET` set, of that scene instead
@@ -160,6 +161,9 @@ pub fn explore_taylor3d_profile() {
     } else {
         let p = Taylor3dParams {
             particles_radial: across,
+            conform_preconditioner: std::env::var("PRECONDITIONER")
+                .map(|s| s.parse().unwrap())
+                .unwrap_or(0.0),
             ..Taylor3dParams::default()
         };
         p.build().unwrap()

@@ -33,6 +33,7 @@
 
 mod buffers;
 pub mod conform;
+mod conform_levels;
 pub mod lattice;
 #[cfg(test)]
 mod measure;

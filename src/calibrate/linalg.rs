@@ -65,6 +65,12 @@ impl Mat {
 /// Solves `a x = b` for a symmetric positive definite `a` by Cholesky;
 /// `None` where `a` is not positive definite.
 pub fn solve_spd(a: &Mat, b: &[f64]) -> Option<Vec<f64>> {
+    Some(cholesky_solve(&cholesky(a)?, b))
+}
+
+/// The lower Cholesky factor `l` of a symmetric positive definite `a`
+/// (`a = l lᵀ`); `None` where `a` is not positive definite.
+pub fn cholesky(a: &Mat) -> Option<Mat> {
     let n = a.rows;
     let mut l = Mat::zeros(n, n);
     for i in 0..n {
@@ -80,6 +86,12 @@ pub fn solve_spd(a: &Mat, b: &[f64]) -> Option<Vec<f64>> {
             }
         }
     }
+    Some(l)
+}
+
+/// Solves `l lᵀ x = b` with the factor `l` of [`cholesky`].
+pub fn cholesky_solve(l: &Mat, b: &[f64]) -> Vec<f64> {
+    let n = l.rows;
     let mut y = vec![0.0; n];
     for i in 0..n {
         y[i] = (b[i] - (0..i).map(|m| l[(i, m)] * y[m]).sum::<f64>()) / l[(i, i)];
@@ -88,7 +100,7 @@ pub fn solve_spd(a: &Mat, b: &[f64]) -> Option<Vec<f64>> {
     for i in (0..n).rev() {
         x[i] = (y[i] - (i + 1..n).map(|m| l[(m, i)] * x[m]).sum::<f64>()) / l[(i, i)];
     }
-    Some(x)
+    x
 }
 
 /// The eigenvalues and eigenvectors (columns of the returned matrix) of a

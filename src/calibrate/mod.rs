@@ -19,7 +19,7 @@
 //! - The uncertainty comes from the Jacobian at the optimum scaled by the
 //!   residual (`stats.rs`).
 
-mod linalg;
+pub(crate) mod linalg;
 mod lsq;
 mod result;
 mod shots;

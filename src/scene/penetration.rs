@@ -172,6 +172,7 @@ const AFTER: &[ParamSpec] = &[
         default: 1.0,
         ..super::taylor3d::WEAK_FORM
     },
+    super::taylor3d::CONFORM_PRECONDITIONER,
     super::taylor3d::SYMMETRY,
     ParamSpec {
         default: 0.0,

@@ -175,6 +175,18 @@ pub(crate) const WEAK_FORM: ParamSpec = spec(
      corrected so that a uniform stress leaves the nodes off the surfaces in equilibrium (whole body only; README, 3-D MLPG) (scheme)",
 );
 
+/// The `conform_preconditioner` row of the 3-D scenes: the preconditioner
+/// of the conforming correction's conjugate gradients (`weak_form = 2`).
+pub(crate) const CONFORM_PRECONDITIONER: ParamSpec = spec(
+    "conform_preconditioner",
+    "1",
+    0.0,
+    Range::integer(0.0, 1.0),
+    "preconditioner of the conjugate gradients of the conforming correction (weak_form = 2): 0 = Jacobi's (the \
+     iterations grow as the spacing shrinks), 1 = Jacobi's plus levels of groups of nodes whose linear functions take \
+     the smooth modes (README, 3-D MLPG); moves the answer within the correction's tolerance",
+);
+
 /// The `lattice` row of the 3-D scenes: 0 the ring lattice with every
 /// layer's nodes on the same radial lines, 1 the staggered lattice (odd
 /// layers turned by half a node's angle, `NodeLattice::cylinder_with`).
@@ -221,6 +233,7 @@ const AFTER: &[ParamSpec] = &[
     ),
     SHIFTING,
     WEAK_FORM,
+    CONFORM_PRECONDITIONER,
     SYMMETRY,
     LATTICE,
     END_TIME,
@@ -330,7 +343,7 @@ param_struct! {
         bulk_modulus, specific_heat, taylor_quinney, jc_a, jc_b, jc_n, jc_c, jc_m,
         melt_temperature, room_temperature, initial_temperature, ref_strain_rate,
         particles_radial, damping, smoothing_coefficient, smoothing_order, rebuild_strain,
-        shifting, weak_form, symmetry, lattice, end_time,
+        shifting, weak_form, conform_preconditioner, symmetry, lattice, end_time,
     }
 }
 

@@ -167,3 +167,12 @@ pub fn scratch(file: &str, test: &str) -> std::path::PathBuf {
 pub fn stderr(out: &std::process::Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
+
+/// The bits of every observable and every node field of a run.
+pub fn all_bits(s: &Simulation) -> Vec<u64> {
+    let mut v = s.observables();
+    for f in s.field_specs() {
+        v.extend(s.field(f.name).unwrap());
+    }
+    v.iter().map(|x| x.to_bits()).collect()
+}

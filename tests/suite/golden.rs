@@ -325,7 +325,7 @@ fn golden_runs_keep_their_bits_in_every_copy() {
 #[test]
 fn the_papers_3d_scheme_is_still_the_seeds_method() {
     use meshless_impact::internals::mlpg::{
-        Forces, Lattice, MlpgScheme, SMOOTHING, SmoothingOrder,
+        Forces, Lattice, MlpgScheme, Preconditioner, SMOOTHING, SmoothingOrder,
     };
     let mut scene = Scene::builtin("taylor3d").unwrap();
     scene.set("scheme", 1.0).unwrap();
@@ -338,6 +338,7 @@ fn the_papers_3d_scheme_is_still_the_seeds_method() {
             smoothing: SMOOTHING,
             shifting: 0.0,
             lattice: Lattice::Aligned,
+            preconditioner: Preconditioner::Jacobi,
         }
     );
     /// The paper's case's finals as the scheme work recorded them.

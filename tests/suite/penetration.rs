@@ -44,15 +44,6 @@ fn coarse_with(t: f64, sets: &[(&str, f64)]) -> Simulation {
     sim
 }
 
-/// The bits of every observable and every node field of a run.
-fn all_bits(s: &Simulation) -> Vec<u64> {
-    let mut v = s.observables();
-    for f in s.field_specs() {
-        v.extend(s.field(f.name).unwrap());
-    }
-    v.iter().map(|x| x.to_bits()).collect()
-}
-
 /// The seed's residual velocity (section 5.2), m/s.
 const SEED_RESIDUAL: f64 = 1240.0;
 
@@ -246,7 +237,7 @@ fn a_penetration_run_saved_mid_way_resumes_to_the_same_bits() {
     let state: serde_json::Value = serde_json::from_slice(&mid.serialize_state()).unwrap();
     let mut back = Simulation::deserialize_state(&serde_json::to_vec(&state).unwrap()).unwrap();
     back.run().unwrap();
-    assert_eq!(all_bits(&back), all_bits(&whole));
+    assert_eq!(common::all_bits(&back), common::all_bits(&whole));
     // Cut the damage variables short: refused by name.
     let mut forged = state.clone();
     let damage = &mut forged["solver"]["Penetration"]["material_state"];
@@ -769,7 +760,7 @@ fn a_jh2_plate_is_perforated_damaged_and_resumes_to_the_same_bits() {
     assert!(mid.observable("max_damage").unwrap() > 0.0);
     let mut back = Simulation::deserialize_state(&mid.serialize_state()).unwrap();
     back.run().unwrap();
-    assert_eq!(all_bits(&back), all_bits(&whole));
+    assert_eq!(common::all_bits(&back), common::all_bits(&whole));
     // A constant out of range, by name.
     let mut bad = scene_until(1e-6);
     let e = bad.set("jh_d1", -1.0).unwrap_err();

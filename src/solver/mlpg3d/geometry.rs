@@ -10,7 +10,7 @@ use super::util::extended;
 use super::util::norm;
 use crate::Error;
 use crate::approx::conform::CONFORM_TOLERANCE;
-use crate::approx::conform::conform;
+use crate::approx::conform::{Stop, conform};
 use crate::approx::mirror;
 use crate::approx::mirror::Mirror;
 use crate::approx::mls::NodalShapes;
@@ -173,7 +173,10 @@ pub(super) fn build_geometry(
             pts,
             &volume,
             &inner,
-            CONFORM_TOLERANCE,
+            Stop {
+                tolerance: CONFORM_TOLERANCE,
+                preconditioner: setup.rod.scheme.preconditioner,
+            },
             &mut g.multipliers,
         );
         pipe.profile.conform_iterations += c.iterations as u64;

@@ -4,6 +4,7 @@
 //! their combination with the model's `symmetry`, for every scene on this
 //! solver (`taylor3d`, `penetration`).
 
+use crate::approx::conform::Preconditioner;
 use crate::approx::step::{OMEGA_FACTOR, OMEGA_FACTOR_CONFORMING, OMEGA_FACTOR_NODAL};
 use crate::error::{Error, Result};
 
@@ -102,6 +103,12 @@ pub struct MlpgScheme {
     pub shifting: f64,
     /// The rod's lattice.
     pub lattice: Lattice,
+    /// The preconditioner of the conforming correction (its forces
+    /// only). Jacobi's, the default, is not written, so a setup without
+    /// the option keeps its digest and the states saved before it existed
+    /// read as Jacobi's.
+    #[serde(default, skip_serializing_if = "Preconditioner::is_jacobi")]
+    pub preconditioner: Preconditioner,
 }
 
 /// The seed's scheme: its weak form, the smoothing of order 1 with
@@ -114,6 +121,7 @@ impl Default for MlpgScheme {
             smoothing: crate::solver::mlpg3d::SMOOTHING,
             shifting: 0.0,
             lattice: Lattice::Aligned,
+            preconditioner: Preconditioner::Jacobi,
         }
     }
 }
@@ -145,6 +153,11 @@ impl MlpgScheme {
             smoothing: get("smoothing_coefficient")?,
             shifting: get("shifting")?,
             lattice,
+            preconditioner: if get("conform_preconditioner")? >= 0.5 {
+                Preconditioner::Levels
+            } else {
+                Preconditioner::Jacobi
+            },
         };
         scheme.check(get("symmetry")? >= 0.5)?;
         Ok(scheme)
