@@ -8,9 +8,11 @@
 //! opposite impulses (perfectly inelastic, frictionless). The impulses
 //! conserve the linear momentum `Σ m v` exactly and never add kinetic
 //! energy; what they remove is booked as contact dissipation. Pairs are
-//! resolved one after the other in ascending `(i, j)` order (one
+//! resolved as one after the other in ascending `(i, j)` order (one
 //! Gauss-Seidel sweep), so the result is the same for any number of
-//! threads.
+//! threads; with many pairs, the pairs that share no node are resolved
+//! together on the pool, in waves that keep each node's order (the
+//! sweep's bits: a test pins the two).
 //!
 //! The boundary nodes of the ring lattice lie on the surfaces, so with this
 //! reach the surfaces of bodies in contact stay one spacing apart; a node
@@ -177,32 +179,136 @@ pub fn resolve_with_images(
     vel: &mut [[f64; 3]],
     real: usize,
 ) -> f64 {
+    if pairs.len() < PARALLEL_PAIRS {
+        return sweep(pairs, pos, mass, before, vel, real);
+    }
+    // The waves: a pair goes one wave after the last of either of its
+    // nodes' earlier pairs. The pairs of a wave share no node, and every
+    // node meets its pairs in ascending order, as in the sweep: the
+    // impulses of a wave, taken on the pool from the velocities after the
+    // wave before, are the sweep's to the bit.
+    let mut last = vec![0u32; vel.len()];
+    let wave: Vec<u32> = pairs
+        .iter()
+        .map(|&(i, j)| {
+            let w = last[i].max(last[j]) + 1;
+            last[i] = w;
+            last[j] = w;
+            w
+        })
+        .collect();
+    let waves = wave.iter().copied().max().unwrap_or(0) as usize;
+    // The pairs by wave (a counting sort: ascending within a wave).
+    let mut start = vec![0usize; waves + 2];
+    for &w in &wave {
+        start[w as usize + 1] += 1;
+    }
+    for w in 1..start.len() {
+        start[w] += start[w - 1];
+    }
+    let mut order = vec![0usize; pairs.len()];
+    let mut fill = start.clone();
+    for (p, &w) in wave.iter().enumerate() {
+        order[fill[w as usize]] = p;
+        fill[w as usize] += 1;
+    }
+    let mut lost = vec![0.0; pairs.len()];
+    for w in 1..=waves {
+        let these = &order[start[w]..start[w + 1]];
+        let shared: &[[f64; 3]] = vel;
+        let found: Vec<(usize, Option<Impulse>)> = these
+            .par_iter()
+            .map(|&p| {
+                let (i, j) = pairs[p];
+                (p, impulse(i, j, pos, mass, before, shared, real))
+            })
+            .collect();
+        for (p, c) in found {
+            if let Some(c) = c {
+                let (i, j) = pairs[p];
+                apply(vel, i, j, &c);
+                lost[p] = c.lost;
+            }
+        }
+    }
+    // Summed in the pairs' order, as the sweep sums (a pair without an
+    // impulse adds +0, which changes no sum).
+    lost.iter().fold(0.0, |total, &l| total + l)
+}
+
+/// One Gauss-Seidel sweep over the pairs in their order: the plain twin of
+/// [`resolve_with_images`]'s waves, and its way below `PARALLEL_PAIRS`.
+fn sweep(
+    pairs: &[(usize, usize)],
+    pos: &[[f64; 3]],
+    mass: &[f64],
+    before: &[[f64; 3]],
+    vel: &mut [[f64; 3]],
+    real: usize,
+) -> f64 {
     let mut lost = 0.0;
     for &(i, j) in pairs {
-        let d = distance(&pos[i], &pos[j]);
-        if d == 0.0 {
-            continue;
+        if let Some(c) = impulse(i, j, pos, mass, before, vel, real) {
+            apply(vel, i, j, &c);
+            lost += c.lost;
         }
-        let n: [f64; 3] = std::array::from_fn(|k| (pos[j][k] - pos[i][k]) / d);
-        let vn: f64 = (0..3).map(|k| (vel[j][k] - vel[i][k]) * n[k]).sum();
-        if vn >= 0.0 {
-            continue;
-        }
-        let (mi, mj) = (mass[i], mass[j]);
-        let reduced = mi * mj / (mi + mj);
-        let impulse = reduced * vn;
-        for k in 0..3 {
-            vel[i][k] += impulse / mi * n[k];
-            vel[j][k] -= impulse / mj * n[k];
-        }
-        let arriving: f64 = (0..3)
-            .map(|k| (before[j][k] - before[i][k]) * n[k])
-            .sum::<f64>()
-            .min(0.0);
-        let share = if j >= real { 0.5 } else { 1.0 };
-        lost += share * 0.5 * reduced * arriving.powi(2).min(vn * vn);
     }
     lost
+}
+
+/// The pairs from which [`resolve_with_images`] resolves the impulses of
+/// each wave on the pool (below, one sweep).
+const PARALLEL_PAIRS: usize = 4096;
+
+/// The impulse of one approaching pair: the changes of the two nodes'
+/// velocities and the dissipation booked.
+struct Impulse {
+    dvi: [f64; 3],
+    dvj: [f64; 3],
+    lost: f64,
+}
+
+/// The impulse of the pair `(i, j)` at the velocities `vel`, or `None` if
+/// it does not approach (or the nodes coincide).
+fn impulse(
+    i: usize,
+    j: usize,
+    pos: &[[f64; 3]],
+    mass: &[f64],
+    before: &[[f64; 3]],
+    vel: &[[f64; 3]],
+    real: usize,
+) -> Option<Impulse> {
+    let d = distance(&pos[i], &pos[j]);
+    if d == 0.0 {
+        return None;
+    }
+    let n: [f64; 3] = std::array::from_fn(|k| (pos[j][k] - pos[i][k]) / d);
+    let vn: f64 = (0..3).map(|k| (vel[j][k] - vel[i][k]) * n[k]).sum();
+    if vn >= 0.0 {
+        return None;
+    }
+    let (mi, mj) = (mass[i], mass[j]);
+    let reduced = mi * mj / (mi + mj);
+    let impulse = reduced * vn;
+    let arriving: f64 = (0..3)
+        .map(|k| (before[j][k] - before[i][k]) * n[k])
+        .sum::<f64>()
+        .min(0.0);
+    let share = if j >= real { 0.5 } else { 1.0 };
+    Some(Impulse {
+        dvi: std::array::from_fn(|k| impulse / mi * n[k]),
+        dvj: std::array::from_fn(|k| impulse / mj * n[k]),
+        lost: share * 0.5 * reduced * arriving.powi(2).min(vn * vn),
+    })
+}
+
+/// Applies an impulse to the pair's velocities.
+fn apply(vel: &mut [[f64; 3]], i: usize, j: usize, c: &Impulse) {
+    for k in 0..3 {
+        vel[i][k] += c.dvi[k];
+        vel[j][k] -= c.dvj[k];
+    }
 }
 
 fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -338,5 +444,50 @@ mod tests {
         let faster = [[0.0; 3], [0.0, 0.0, -100.0], [0.0; 3]];
         assert_eq!(resolve(&[(0, 1)], &pos, &mass, &faster, &mut v), lost);
         assert_eq!(apart[1], [0.0, 0.0, 1.0]);
+    }
+
+    /// The waves are the sweep to the bit: 20 000 pairs among 3 000 nodes
+    /// (each node in about 13, images from node 2 500 on), on one thread
+    /// and two, give the sweep's velocities and dissipation.
+    #[test]
+    fn the_waves_are_the_sweep_to_the_bit() {
+        let mut uniform = crate::test_rng::rng(5);
+        let n = 3000;
+        let pos: Vec<[f64; 3]> = (0..n).map(|_| std::array::from_fn(|_| uniform())).collect();
+        let mass: Vec<f64> = (0..n).map(|_| 0.5 + uniform()).collect();
+        let v0: Vec<[f64; 3]> = (0..n)
+            .map(|_| std::array::from_fn(|_| uniform() - 0.5))
+            .collect();
+        let before: Vec<[f64; 3]> = v0.iter().map(|v| v.map(|x| 1.1 * x)).collect();
+        let mut pairs: Vec<(usize, usize)> = (0..20_000)
+            .map(|_| {
+                let i = (uniform() * n as f64) as usize % n;
+                let j = (uniform() * n as f64) as usize % n;
+                (i.min(j), i.max(j))
+            })
+            .filter(|(i, j)| i != j)
+            .collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        assert!(pairs.len() > PARALLEL_PAIRS);
+        let mut plain = v0.clone();
+        let lost = sweep(&pairs, &pos, &mass, &before, &mut plain, 2500);
+        assert!(lost > 0.0);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut v = v0.clone();
+            let l =
+                pool.install(|| resolve_with_images(&pairs, &pos, &mass, &before, &mut v, 2500));
+            assert_eq!(l.to_bits(), lost.to_bits(), "{threads} threads");
+            assert!(
+                v.iter()
+                    .zip(&plain)
+                    .all(|(a, b)| a.map(f64::to_bits) == b.map(f64::to_bits)),
+                "{threads} threads"
+            );
+        }
     }
 }
