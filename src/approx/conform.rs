@@ -22,7 +22,9 @@
 //! `p_J = (1, (x_J − x_i) / h_i)`, `λ_i = M_i⁻¹ Σ_K p_K μ_K` (`M_i = Σ_K p_K
 //! p_Kᵀ` over row `i`, `μ_K = 0` on the surfaces), and the multipliers `μ`
 //! solve the symmetric positive system `Σ_i V_i δ_iJ(μ) = −a_J` over the
-//! inner nodes, by conjugate gradients (Jacobi preconditioned). Each
+//! inner nodes, by conjugate gradients, preconditioned by Jacobi's
+//! diagonal or, as an option, by levels of groups of nodes as well
+//! ([`Preconditioner`]; `src/approx/conform_levels.rs`). Each
 //! iteration applies the system in two passes, one over the rows (the
 //! `λ_i`) and one over the columns, without forming the entries `δ_iJ`
 //! (`Fused`; its plain twin, the entries and then their column sums,
