@@ -732,7 +732,8 @@ impl Levels {
     /// `B_l r` of level `l`: `CYCLES` iterations of the symmetric V-cycle
     /// from zero (the last level solved exactly). Each cycle smooths with
     /// `ω D_l⁻¹` before and after the next level's correction: a fixed,
-    /// symmetric and positive map, close to `A_l⁻¹`.
+    /// symmetric and positive map that approximates `A_l⁻¹` (the first
+    /// level's inner iterations are preconditioned by it).
     fn solve(&self, l: usize, r: &[Coarse]) -> Vec<Coarse> {
         let level = &self.levels[l];
         if let Some(factor) = &level.factor {
