@@ -550,17 +550,19 @@ pub fn conform(
         Preconditioner::Jacobi => None,
         Preconditioner::Levels => {
             let jacobi: Vec<f64> = diag.iter().map(|d| d[0]).collect();
-            Levels::new(&Fine {
-                shapes: sys.shapes,
-                points,
-                volume,
-                inner,
-                g: &sys.g,
-                col_offsets: &columns.offsets,
-                col_entries: &columns.entries,
-                d: &fused.diag,
-                jacobi: &jacobi,
-            })
+            Levels::new(
+                &Fine {
+                    shapes: sys.shapes,
+                    points,
+                    volume,
+                    inner,
+                    g: &sys.g,
+                    col_offsets: &columns.offsets,
+                    col_entries: &columns.entries,
+                    d: &fused.diag,
+                },
+                jacobi,
+            )
         }
     };
     let precond = |r: &[[f64; 3]], z: &mut [[f64; 3]]| match &levels {

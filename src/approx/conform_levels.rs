@@ -93,8 +93,6 @@ pub(crate) struct Fine<'a> {
     pub col_entries: &'a [u64],
     /// `D_J = Σ_i V_i²` over column `J` (zero off the inner nodes).
     pub d: &'a [f64],
-    /// The Jacobi diagonal `A_JJ` (zero off the inner nodes).
-    pub jacobi: &'a [f64],
 }
 
 /// `(1, (x − centre) / h)`.
@@ -591,10 +589,11 @@ fn coarsen(
 }
 
 impl Levels {
-    /// The hierarchy of one build of the fine system `f`; `None` when it
+    /// The hierarchy of one build of the fine system `f`, with its Jacobi
+    /// diagonal `jacobi` (`A_JJ`, zero off the inner nodes); `None` when it
     /// has no inner node or a level's operator is not positive definite
     /// (the solver then keeps Jacobi's preconditioner).
-    pub(crate) fn new(f: &Fine) -> Option<Levels> {
+    pub(crate) fn new(f: &Fine, jacobi: Vec<f64>) -> Option<Levels> {
         let n = f.shapes.len();
         // The median row size.
         let mut sizes: Vec<f64> = (0..n)
@@ -620,13 +619,13 @@ impl Levels {
             return None;
         }
         let gr = grouping(f.points, f.inner, h);
-        let group_of = gr.of.clone();
         let a1 = first_operator(f, &gr, h);
         let c1: Vec<Block> = gr.t.iter().zip(&gr.gram).map(|(t, m)| tmul(t, m)).collect();
+        let group_of = gr.of;
         let mut levels = vec![Level {
-            offsets: gr.offsets.clone(),
-            members: gr.members.clone(),
-            t: gr.t.clone(),
+            offsets: gr.offsets,
+            members: gr.members,
+            t: gr.t,
             centre: gr.centre.clone(),
             to_finer: Vec::new(),
             parent: Vec::new(),
@@ -667,7 +666,7 @@ impl Levels {
             .collect();
         Some(Levels {
             levels,
-            jacobi: f.jacobi.to_vec(),
+            jacobi,
             group_of,
             mono,
         })
@@ -717,7 +716,7 @@ impl Levels {
         let group_of = &self.group_of;
         z.par_iter_mut().enumerate().for_each(|(j, zj)| {
             let a = group_of[j];
-            if a == u32::MAX || self.jacobi[j] <= 0.0 {
+            if a == u32::MAX || self.jacobi[j].is_nan() || self.jacobi[j] <= 0.0 {
                 *zj = [0.0; 3];
                 return;
             }
