@@ -58,7 +58,7 @@ pub fn naive<const D: usize>(points: &[[f64; D]], radius: f64) -> NeighbourList 
 
 /// Squared distance, summed over the axes in order.
 #[inline]
-fn dist2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+pub(crate) fn dist2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
     let mut s = 0.0;
     for d in 0..D {
         let x = a[d] - b[d];
@@ -178,6 +178,13 @@ pub(crate) struct Cells<'a, const D: usize> {
 /// Most cells in the grid (4 Mi: 32 MiB of cell starts).
 const MAX_CELLS: f64 = 4_194_304.0;
 
+/// Most cells a member of a grid over some of the points
+/// ([`Cells::members`]).
+const MEMBER_CELLS: f64 = 2.0;
+
+/// The fewest cells [`Cells::members`] may always use.
+const FEW_CELLS: f64 = 64.0;
+
 /// Points per task of the grid's parallel passes.
 const BLOCK: usize = 4096;
 
@@ -187,13 +194,36 @@ const CELL_CHUNK: usize = 1 << 16;
 impl<'a, const D: usize> Cells<'a, D> {
     /// The grid, or `None` for no points.
     pub(crate) fn new(points: &'a [[f64; D]], radius: f64) -> Option<Self> {
-        if points.is_empty() {
+        Self::build(points, None, radius, MAX_CELLS)
+    }
+
+    /// The grid over the points `members` (ascending indices into
+    /// `points`) only, or `None` for no members: its queries answer
+    /// indices into `points`. At most [`MEMBER_CELLS`] cells a member
+    /// (and never fewer than [`FEW_CELLS`] allowed): a few members far
+    /// apart with a small radius make the cells coarser, not the grid
+    /// large.
+    pub(crate) fn members(points: &'a [[f64; D]], members: &[usize], radius: f64) -> Option<Self> {
+        let most = (MEMBER_CELLS * members.len() as f64).clamp(FEW_CELLS, MAX_CELLS);
+        Self::build(points, Some(members), radius, most)
+    }
+
+    fn build(
+        points: &'a [[f64; D]],
+        members: Option<&[usize]>,
+        radius: f64,
+        most: f64,
+    ) -> Option<Self> {
+        let count = members.map_or(points.len(), <[usize]>::len);
+        if count == 0 {
             return None;
         }
+        let member = |k: usize| members.map_or(k, |m| m[k]);
         // The bounding box, on the pool (min and max are exact in any order).
-        let (lo, hi) = points
-            .par_iter()
+        let (lo, hi) = (0..count)
+            .into_par_iter()
             .with_min_len(BLOCK)
+            .map(|k| &points[member(k)])
             .fold(
                 || ([f64::INFINITY; D], [f64::NEG_INFINITY; D]),
                 |(mut lo, mut hi), p| {
@@ -219,12 +249,12 @@ impl<'a, const D: usize> Cells<'a, D> {
         // candidates), not the grid too large to allocate. At most about a
         // thousand doublings, from the smallest positive radius to 1e308.
         let mut cell = radius.max(f64::MIN_POSITIVE);
-        let count = |cell: f64| {
+        let cells = |cell: f64| {
             (0..D)
                 .map(|d| (hi[d] - lo[d]) / cell + 1.0)
                 .product::<f64>()
         };
-        while count(cell) > MAX_CELLS {
+        while cells(cell) > most {
             cell *= 2.0;
         }
         let dims: [usize; D] =
@@ -248,11 +278,13 @@ impl<'a, const D: usize> Cells<'a, D> {
             "Cells: {} points, at most 2^32",
             points.len()
         );
-        let mut keys: Vec<u64> = points
-            .par_iter()
-            .enumerate()
+        let mut keys: Vec<u64> = (0..count)
+            .into_par_iter()
             .with_min_len(BLOCK)
-            .map(|(i, p)| (grid.id(grid.cell_of(p)) as u64) << 32 | i as u64)
+            .map(|k| {
+                let i = member(k);
+                (grid.id(grid.cell_of(&points[i])) as u64) << 32 | i as u64
+            })
             .collect();
         keys.par_sort_unstable();
         grid.sorted = keys
@@ -288,13 +320,6 @@ impl<'a, const D: usize> Cells<'a, D> {
         out.sort_unstable();
     }
 
-    /// How many points within the radius of `p` pass `keep`.
-    pub(crate) fn count(&self, p: &[f64; D], mut keep: impl FnMut(usize) -> bool) -> usize {
-        let mut n = 0;
-        self.visit(p, |j| n += usize::from(keep(j)));
-        n
-    }
-
     fn cell_of(&self, p: &[f64; D]) -> [usize; D] {
         std::array::from_fn(|d| (((p[d] - self.lo[d]) / self.cell) as usize).min(self.dims[d] - 1))
     }
@@ -308,7 +333,7 @@ impl<'a, const D: usize> Cells<'a, D> {
     /// cell (not in index order). The cells next to each other along the
     /// first axis are numbered in a row, so their points are one slice.
     #[inline]
-    fn visit(&self, p: &[f64; D], mut f: impl FnMut(usize)) {
+    pub(crate) fn visit(&self, p: &[f64; D], mut f: impl FnMut(usize)) {
         let c = self.cell_of(p);
         let lo: [usize; D] = std::array::from_fn(|d| c[d].saturating_sub(1));
         let hi: [usize; D] = std::array::from_fn(|d| (c[d] + 1).min(self.dims[d] - 1));

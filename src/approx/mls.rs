@@ -15,7 +15,7 @@
 //! eq. (11) asks for `k + 1 ≥ m`. A node whose `k` nearest lie in a plane
 //! through it (nodes held in a symmetry plane can crowd so) names further
 //! nodes, nearest first, until one lies off the plane, so that the supports
-//! covering it are not all centred in that plane ([`spanning_count`]).
+//! covering it are not all centred in that plane ([`supports::spanning`]).
 //! [`Supports::recompute_reason`] says when the supports are recomputed.
 //!
 //! # The choice of `k` and the factor, by measurement
@@ -58,14 +58,17 @@
 use crate::approx::buffers::refill;
 use crate::approx::msph::{MAX_CONDITION, invert};
 use crate::isa::{Isa, hot};
-use crate::neighbours::Cells;
 use crate::{Error, Result};
 use rayon::prelude::*;
 
+mod covers;
+mod nearest;
 mod supports;
-pub(crate) use supports::candidates_of;
+pub(crate) use covers::Covers;
 #[cfg(test)]
-use supports::{Recompute, spanning_count};
+use supports::Recompute;
+#[cfg(test)]
+use supports::spanning_count;
 pub use supports::{SupportParams, Supports, candidates_first};
 
 /// Number of basis functions of the linear basis in 3-D, eq. (11), t = 1.
@@ -509,26 +512,28 @@ impl NodalShapes {
         rows: usize,
     ) -> Result<()> {
         refill(&mut self.offsets, rows + 1, 0);
-        let Some(grid) = Cells::new(points, 0.0 + supports.max_radius()) else {
+        if points.is_empty() {
             self.offsets.truncate(1);
             self.nodes.clear();
             self.phi.clear();
             self.grad.clear();
             return Ok(());
-        };
-        let group = &supports.group;
+        }
+        // The nodes of a row's body whose supports cover its node, by
+        // class of radius: the test is ShapeRow::evaluate's own.
+        let covers = Covers::new(points, &supports.radius, &supports.group, 0.0);
+        let radius = &supports.radius;
+        let covering =
+            |i: usize| move |j: usize| scaled_offset(points[i], points[j], radius[j]).1 < 1.0;
         let candidates =
-            |i: usize, out: &mut Vec<usize>| candidates_of(&grid, points, group, i, out);
+            |i: usize, out: &mut Vec<usize>| covers.sorted_into(&points[i], i, covering(i), out);
         // Pass 1: each row's length, into offsets[i + 1].
         self.offsets[1..]
             .par_iter_mut()
             .enumerate()
             .with_min_len(ROWS_PER_BLOCK)
             .for_each(|(i, len)| {
-                *len = grid.count(&points[i], |j| {
-                    (group.is_empty() || group[j] == group[i])
-                        && scaled_offset(points[i], points[j], supports.radius[j]).1 < 1.0
-                });
+                *len = covers.count(&points[i], i, covering(i));
             });
         for i in 0..rows {
             self.offsets[i + 1] += self.offsets[i];

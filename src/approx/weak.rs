@@ -13,12 +13,10 @@
 //! Stresses are stored as 6 components `[xx, yy, zz, xy, yz, zx]`.
 
 use crate::Result;
-use crate::approx::mls::{
-    PointShapes, ShapeRow, Supports, candidates_first, candidates_of, distance,
-};
+use crate::approx::mls::{Covers, PointShapes, ShapeRow, Supports, candidates_first, distance};
 use crate::approx::sphere::{SphereRule, TestSphere};
 use crate::isa::Isa;
-use crate::neighbours::Cells;
+use crate::neighbours::dist2;
 use rayon::prelude::*;
 
 /// The index in `[xx, yy, zz, xy, yz, zx]` of component `(a, b)`.
@@ -67,27 +65,30 @@ impl TractionOperator {
         let reach = spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
         // Each node's candidates (its row of `candidates_first`) are found
         // while the node is handled: no list of every node's candidates.
-        let Some(grid) = Cells::new(points, reach + supports.max_radius()) else {
+        if points.is_empty() {
             return Self::assemble(Vec::new(), spheres);
-        };
+        }
         let radius = &supports.radius;
+        // The candidates are those of one grid of cells `reach + max r_J`
+        // (the plain twin's), found by class of radius.
+        let within = reach + supports.max_radius();
+        let within2 = within * within;
+        let covers = Covers::new(points, radius, &supports.group, reach);
         let rows: Vec<Result<Row>> = (0..spheres.len())
             .into_par_iter()
             .map_init(
                 || (PointShapes::default(), Vec::new()),
                 |(ps, cand), i| {
-                    candidates_of(&grid, points, &supports.group, i, cand);
                     let xi = points[i];
                     let r0 = spheres[i].radius;
-                    ps.gather(
-                        cand.iter().copied().filter(|&j| {
-                            // A margin far above round-off: the narrowing only
-                            // has to keep every node that can cover a point.
-                            distance(&xi, &points[j]) <= (r0 + radius[j]) * (1.0 + 1e-9)
-                        }),
-                        points,
-                        radius,
-                    );
+                    // A margin far above round-off: the narrowing only has
+                    // to keep every node that can cover a point.
+                    let near = |j: usize| {
+                        dist2(&xi, &points[j]) <= within2
+                            && distance(&xi, &points[j]) <= (r0 + radius[j]) * (1.0 + 1e-9)
+                    };
+                    covers.sorted_into(&xi, i, near, cand);
+                    ps.gather(cand.iter().copied(), points, radius);
                     let mut failed = None;
                     spheres[i].for_each_point(xi, whole, cut, |x, n, w| {
                         if failed.is_some() {

@@ -4,14 +4,10 @@
 
 use crate::Error;
 use crate::approx::mls::BASIS;
-use crate::approx::mls::ROWS_PER_BLOCK;
 use crate::approx::mls::distance;
 use crate::error::Result;
-use crate::neighbours::Cells;
 use crate::neighbours::NeighbourList;
 use crate::neighbours::cell_list_first;
-use rayon::iter::IntoParallelIterator;
-use rayon::iter::ParallelIterator;
 /// The choices behind the support sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SupportParams {
@@ -104,7 +100,6 @@ impl Supports {
         params: SupportParams,
     ) -> Result<Self> {
         let k = params.neighbours;
-        let same = |i: usize, j: usize| group.is_empty() || group[i] == group[j];
         // A place that is not a number is never within a radius: the search
         // below would double it for ever.
         if let Some(particle) = points.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
@@ -151,7 +146,7 @@ impl Supports {
         let extent: f64 = extents.iter().copied().fold(0.0, f64::max);
         let fill = (k + 1) as f64 / points.len() as f64;
         let bulk = (extents[0] * extents[1] * extents[2] * fill).cbrt();
-        let mut search = if bulk > 1e-3 * extent {
+        let search = if bulk > 1e-3 * extent {
             bulk
         } else {
             thin_start(extents, fill)
@@ -160,80 +155,14 @@ impl Supports {
         // Each row is found from the grid while it is handled, a block of
         // rows at a time: no list of every node's candidates is held
         // (BENCHMARKS.md, memory). A row with k others or fewer within
-        // the search radius doubles the radius for all.
-        let blocks = loop {
-            let grid = Cells::new(points, search).expect("more than k points");
-            let blocks: Vec<Option<NamedBlock>> = (0..rows.div_ceil(ROWS_PER_BLOCK))
-                .into_par_iter()
-                .map_init(
-                    || (Vec::new(), Vec::new()),
-                    |(list, row), b| {
-                        let mut block = NamedBlock::default();
-                        for i in b * ROWS_PER_BLOCK..rows.min((b + 1) * ROWS_PER_BLOCK) {
-                            grid.sorted_into(&points[i], list);
-                            if list.iter().filter(|&&j| same(i, j)).count() <= k {
-                                return None;
-                            }
-                            row.clear();
-                            row.extend(
-                                list.iter()
-                                    .filter(|&&j| j != i && same(i, j))
-                                    .map(|&j| (distance(&points[i], &points[j]), j)),
-                            );
-                            row.sort_unstable_by(|a: &(f64, usize), b| {
-                                a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
-                            });
-                            let named = spanning_count(&points[i], row, k, |j| points[j]);
-                            block.kth.push(row[k - 1].0);
-                            block.len.push(named);
-                            block.named.extend_from_slice(&row[..named]);
-                        }
-                        Some(block)
-                    },
-                )
-                .collect();
-            if blocks.iter().all(Option::is_some) {
-                break blocks.into_iter().flatten().collect::<Vec<_>>();
-            }
-            search *= 2.0;
-            // Every body holds more than k nodes (checked above), so a
-            // radius past the box finds them, unless a place is not a
-            // number or overflows: then stop rather than double for ever.
-            if !search.is_finite() {
-                let particle = points
-                    .iter()
-                    .position(|p| !p.iter().all(|x| x.is_finite()))
-                    .unwrap_or(0);
-                return Err(Error::NonFinite {
-                    field: "position",
-                    particle,
-                    time: f64::NAN,
-                });
-            }
-        };
-        let mut radius: Vec<f64> = Vec::with_capacity(points.len());
-        for block in &blocks {
-            radius.extend_from_slice(&block.kth);
-        }
+        // the search radius is found again at twice the radius
+        // (`nearest.rs`).
+        let found = super::nearest::named_rows(points, group, rows, k, search)?;
+        let (named, named_distance) = (found.named, found.distance);
+        let mut radius = found.kth;
         radius.resize(points.len(), 0.0);
-        let entries = blocks.iter().map(|b| b.named.len()).sum();
-        let mut named = NeighbourList {
-            offsets: Vec::with_capacity(rows + 1),
-            indices: Vec::with_capacity(entries),
-        };
-        let mut named_distance = Vec::with_capacity(entries);
-        named.offsets.push(0);
-        for block in &blocks {
-            let mut at = 0;
-            for &len in &block.len {
-                for &(d, j) in &block.named[at..at + len] {
-                    radius[j] = radius[j].max(d);
-                    named.indices.push(j);
-                    named_distance.push(d);
-                }
-                at += len;
-                named.offsets.push(named.indices.len());
-            }
+        for (&j, &d) in named.indices.iter().zip(&named_distance) {
+            radius[j] = radius[j].max(d);
         }
         for r in &mut radius {
             *r *= params.factor;
@@ -284,27 +213,27 @@ impl Supports {
     }
 }
 
-/// The named pairs of a block of rows of [`Supports::compute_rows`].
-#[derive(Default)]
-struct NamedBlock {
-    /// Each row's `k`-th nearest distance.
-    kth: Vec<f64>,
-    /// Each row's number of named nodes.
-    len: Vec<usize>,
-    /// The rows' (distance, node) pairs, nearest first in each row.
-    named: Vec<(f64, usize)>,
-}
-
 /// How flat a node's named neighbourhood may be, as the determinant of the
 /// second moment `M = Σ d dᵀ` of the offsets `d` to its named nodes over
 /// `(tr M / 3)³` (1 for an isotropic set, 0 for a coplanar one).
 const FLAT: f64 = 1e-9;
 
+/// [`spanning`] with its `k` for a flat row.
+#[cfg(test)]
+pub(super) fn spanning_count(
+    x: &[f64; 3],
+    row: &[(f64, usize)],
+    k: usize,
+    at: impl Fn(usize) -> [f64; 3],
+) -> usize {
+    spanning(x, row, k, at).unwrap_or(k)
+}
+
 /// How many of the `row` (distance, node) pairs, nearest first, a node at
 /// `x` names: its `k` nearest, and, when these lie in a plane or on a line
 /// through it ([`FLAT`]), as many more as it takes to name a node off
-/// that plane (still `k` if the row holds none: a flat set of nodes stays
-/// flat, and its moment matrices are the named error).
+/// that plane; `None` if the row holds none (the caller names `k`: a flat
+/// set of nodes stays flat, and its moment matrices are the named error).
 ///
 /// Nodes held in a plane, those of a quarter model's symmetry planes, can
 /// crowd together while the nodes beside the plane draw away from it: the
@@ -316,12 +245,12 @@ const FLAT: f64 = 1e-9;
 /// that node's support over it ([`Supports`]: a node's radius reaches every
 /// node that names it), so the node's moment matrix is regular again. A
 /// neighbourhood that spans the space keeps its `k`: no other run changes.
-pub(super) fn spanning_count(
+pub(super) fn spanning(
     x: &[f64; 3],
     row: &[(f64, usize)],
     k: usize,
     at: impl Fn(usize) -> [f64; 3],
-) -> usize {
+) -> Option<usize> {
     let mut m = [[0.0f64; 3]; 3];
     for (count, &(_, j)) in row.iter().enumerate() {
         let p = at(j);
@@ -337,11 +266,11 @@ pub(super) fn spanning_count(
                 - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
                 + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
             if det > FLAT * trace * trace * trace {
-                return count + 1;
+                return Some(count + 1);
             }
         }
     }
-    k
+    None
 }
 
 /// Componentwise bounds of a point set.
@@ -376,24 +305,6 @@ pub(super) fn thin_start(extents: [f64; 3], fill: f64) -> f64 {
         }
     }
     e[0] * fill
-}
-
-/// Writes into `out` the row of node `i` of [`candidates_first`] from its
-/// `grid` (cells of side `reach + supports.max_radius()` over `points`):
-/// every node within the radius, of `i`'s body, ascending. One row at a
-/// time, so that no list of every node's candidates is held
-/// (BENCHMARKS.md, memory).
-pub(crate) fn candidates_of(
-    grid: &Cells<3>,
-    points: &[[f64; 3]],
-    group: &[u8],
-    i: usize,
-    out: &mut Vec<usize>,
-) {
-    grid.sorted_into(&points[i], out);
-    if !group.is_empty() {
-        out.retain(|&j| group[j] == group[i]);
-    }
 }
 
 /// Candidate nodes for points within `reach` of each node: the cell-list

@@ -1,0 +1,342 @@
+//! The named nodes of every row of [`super::Supports::compute_rows`]: each
+//! row's `k` nearest of its body (and more where these are flat,
+//! [`spanning`]), found from a grid of cells one search radius wide.
+//!
+//! A row that holds `k` others or fewer within the search radius is found
+//! again at twice the radius, and so on. The rows were once all found
+//! again at the radius the last row needed: in `penetration` one node at
+//! the crater's edge doubled the radius for all, and every row's list grew
+//! from about 90 candidates to about 600 (8 across, quarter model). Now
+//! only the rows that need it are found again. A row found at a smaller
+//! radius than the final one keeps that answer only where the final
+//! radius could not change it: its named nodes lie strictly inside the
+//! smaller radius (so every node beyond it sorts after them) and they
+//! span the space (so [`spanning`] stopped within them). Any other
+//! row is found again at the final radius. The rows are the ones the
+//! search at the final radius gives, to the bit.
+
+use super::supports::spanning;
+use crate::Error;
+use crate::approx::mls::ROWS_PER_BLOCK;
+use crate::approx::mls::distance;
+use crate::error::Result;
+use crate::neighbours::Cells;
+use crate::neighbours::NeighbourList;
+use rayon::iter::IntoParallelIterator;
+use rayon::iter::ParallelIterator;
+use rayon::slice::ParallelSlice;
+
+/// The named pairs of every row, in row order.
+pub(super) struct Named {
+    /// Each row's `k`-th nearest distance.
+    pub(super) kth: Vec<f64>,
+    /// Each row's named nodes, nearest first.
+    pub(super) named: NeighbourList,
+    /// The distance of each named pair.
+    pub(super) distance: Vec<f64>,
+    /// The final search radius: the one at which the last row was found.
+    #[cfg(test)]
+    search: f64,
+}
+
+/// The rows of one block of a pass.
+#[derive(Default)]
+struct Found {
+    /// The rows found, ascending; empty in the first pass, whose block
+    /// holds an entry for each of its rows (a short row's of length 0).
+    row: Vec<usize>,
+    kth: Vec<f64>,
+    len: Vec<usize>,
+    pairs: Vec<(f64, usize)>,
+    /// The rows that hold `k` others or fewer within the radius.
+    short: Vec<usize>,
+    /// The rows found here whose answer a larger radius could change.
+    unsure: Vec<usize>,
+}
+
+/// How one row came out at one radius.
+enum Row {
+    /// `k` others or fewer of its body within the radius.
+    Short,
+    /// Found: its named count, and whether a larger radius gives the same.
+    Named(usize, bool),
+}
+
+/// Below this fraction of the radius a named node lies strictly inside it,
+/// far above the round-off of the distances (the nodes beyond the radius
+/// are at least the radius away, to round-off).
+const INSIDE: f64 = 1.0 - 1e-9;
+
+/// The row of node `i` from `grid` (radius `search`): its others of the
+/// same body by (distance, index) into `row`.
+fn find(
+    grid: &Cells<3>,
+    search: f64,
+    points: &[[f64; 3]],
+    same: impl Fn(usize, usize) -> bool,
+    k: usize,
+    i: usize,
+    (list, row): (&mut Vec<usize>, &mut Vec<(f64, usize)>),
+) -> Row {
+    grid.sorted_into(&points[i], list);
+    if list.iter().filter(|&&j| same(i, j)).count() <= k {
+        return Row::Short;
+    }
+    row.clear();
+    row.extend(
+        list.iter()
+            .filter(|&&j| j != i && same(i, j))
+            .map(|&j| (distance(&points[i], &points[j]), j)),
+    );
+    row.sort_unstable_by(|a: &(f64, usize), b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    match spanning(&points[i], row, k, |j| points[j]) {
+        Some(named) => Row::Named(named, row[named - 1].0 < INSIDE * search),
+        None => Row::Named(k, false),
+    }
+}
+
+/// One block of rows at the radius of `grid`, `search`; `first`: the
+/// first pass's block (an entry for every row).
+#[allow(clippy::too_many_arguments)]
+fn block(
+    grid: &Cells<3>,
+    search: f64,
+    points: &[[f64; 3]],
+    group: &[u8],
+    k: usize,
+    rows: impl Iterator<Item = usize>,
+    first: bool,
+    scratch: &mut (Vec<usize>, Vec<(f64, usize)>),
+) -> Found {
+    let same = |i: usize, j: usize| group.is_empty() || group[i] == group[j];
+    let mut f = Found::default();
+    for i in rows {
+        let (list, row) = (&mut scratch.0, &mut scratch.1);
+        match find(grid, search, points, same, k, i, (list, row)) {
+            Row::Short => {
+                f.short.push(i);
+                if first {
+                    f.kth.push(f64::NAN);
+                    f.len.push(0);
+                }
+            }
+            Row::Named(named, sure) => {
+                if !sure {
+                    f.unsure.push(i);
+                }
+                if !first {
+                    f.row.push(i);
+                }
+                f.kth.push(row[k - 1].0);
+                f.len.push(named);
+                f.pairs.extend_from_slice(&row[..named]);
+            }
+        }
+    }
+    f
+}
+
+/// The rows `rows` (ascending) at the radius of `grid`, `search`, a block
+/// at a time on the pool.
+fn again(
+    grid: &Cells<3>,
+    search: f64,
+    points: &[[f64; 3]],
+    group: &[u8],
+    k: usize,
+    rows: &[usize],
+) -> Vec<Found> {
+    rows.par_chunks(ROWS_PER_BLOCK)
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |scratch, chunk| {
+                let rows = chunk.iter().copied();
+                block(grid, search, points, group, k, rows, false, scratch)
+            },
+        )
+        .collect()
+}
+
+/// The named pairs of the first `rows` of `points` (each of its body),
+/// starting from the radius `search`. Fails when the radius overflows
+/// (a place that is not a number).
+pub(super) fn named_rows(
+    points: &[[f64; 3]],
+    group: &[u8],
+    rows: usize,
+    k: usize,
+    mut search: f64,
+) -> Result<Named> {
+    let blocks: Vec<Found> = {
+        let grid = Cells::new(points, search).expect("more than k points");
+        (0..rows.div_ceil(ROWS_PER_BLOCK))
+            .into_par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |scratch, b| {
+                    let rows = b * ROWS_PER_BLOCK..rows.min((b + 1) * ROWS_PER_BLOCK);
+                    block(&grid, search, points, group, k, rows, true, scratch)
+                },
+            )
+            .collect()
+    };
+    let mut todo: Vec<usize> = blocks
+        .iter()
+        .flat_map(|f| f.short.iter().copied())
+        .collect();
+    let mut unsure: Vec<(usize, usize)> = blocks
+        .iter()
+        .flat_map(|f| f.unsure.iter().map(|&i| (i, 0)))
+        .collect();
+    // The rows found at larger radii, pass by pass.
+    let mut later: Vec<Found> = Vec::new();
+    let mut level = 0;
+    while !todo.is_empty() {
+        search *= 2.0;
+        level += 1;
+        // Every body holds more than k nodes (checked by the caller), so
+        // a radius past the box finds them, unless a place is not a
+        // number or overflows: then stop rather than double for ever.
+        if !search.is_finite() {
+            let particle = points
+                .iter()
+                .position(|p| !p.iter().all(|x| x.is_finite()))
+                .unwrap_or(0);
+            return Err(Error::NonFinite {
+                field: "position",
+                particle,
+                time: f64::NAN,
+            });
+        }
+        let grid = Cells::new(points, search).expect("more than k points");
+        let found = again(&grid, search, points, group, k, &todo);
+        todo = found.iter().flat_map(|f| f.short.iter().copied()).collect();
+        unsure.extend(
+            found
+                .iter()
+                .flat_map(|f| f.unsure.iter().map(|&i| (i, level))),
+        );
+        // The rows a larger radius could change, found again at the
+        // final one.
+        if todo.is_empty() {
+            let mut redo: Vec<usize> = unsure
+                .iter()
+                .filter(|&&(_, l)| l < level)
+                .map(|&(i, _)| i)
+                .collect();
+            redo.sort_unstable();
+            later.extend(found);
+            later.extend(again(&grid, search, points, group, k, &redo));
+        } else {
+            later.extend(found);
+        }
+    }
+    // The rows found later, by row, the last answer of each: (row,
+    // block, entry, start of its pairs).
+    let mut over: Vec<(usize, u32, u32, usize)> = Vec::new();
+    for (f, found) in later.iter().enumerate() {
+        let mut start = 0;
+        for (e, (&i, &len)) in found.row.iter().zip(&found.len).enumerate() {
+            over.push((i, f as u32, e as u32, start));
+            start += len;
+        }
+    }
+    over.sort_by_key(|o| o.0);
+    let over: Vec<(usize, u32, u32, usize)> = over
+        .iter()
+        .enumerate()
+        .filter(|&(q, o)| over.get(q + 1).is_none_or(|next| next.0 != o.0))
+        .map(|(_, o)| *o)
+        .collect();
+    // Each row's answer: from the first pass, or its last from later.
+    // The rows come in order: `start` runs through the block of row `i`
+    // (a row found again still holds its first entry there).
+    let answer = |i: usize, next: &mut usize, start: &mut usize| -> (&Found, usize, usize) {
+        let (b, e) = (i / ROWS_PER_BLOCK, i % ROWS_PER_BLOCK);
+        if e == 0 {
+            *start = 0;
+        }
+        let s = *start;
+        *start += blocks[b].len[e];
+        if let Some(&(row, f, e, s)) = over.get(*next)
+            && row == i
+        {
+            *next += 1;
+            return (&later[f as usize], e as usize, s);
+        }
+        (&blocks[b], e, s)
+    };
+    let mut named = Named {
+        kth: Vec::with_capacity(rows),
+        named: NeighbourList {
+            offsets: Vec::with_capacity(rows + 1),
+            indices: Vec::new(),
+        },
+        distance: Vec::new(),
+        #[cfg(test)]
+        search,
+    };
+    for pass in 0..2 {
+        let (mut next, mut start) = (0, 0);
+        let mut entries = 0;
+        for i in 0..rows {
+            let (found, e, s) = answer(i, &mut next, &mut start);
+            let len = found.len[e];
+            if pass == 0 {
+                entries += len;
+                continue;
+            }
+            named.kth.push(found.kth[e]);
+            for &(d, j) in &found.pairs[s..s + len] {
+                named.named.indices.push(j);
+                named.distance.push(d);
+            }
+            named.named.offsets.push(named.named.indices.len());
+        }
+        if pass == 0 {
+            named.named.indices.reserve_exact(entries);
+            named.distance.reserve_exact(entries);
+            named.named.offsets.push(0);
+        }
+    }
+    Ok(named)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Against the search of every row at the final radius (the rows as
+    /// they were found before): a cube of nodes, a plane of nodes crowded
+    /// in z = 0 beside it (flat rows), and a few nodes far off (they
+    /// double the radius several times), in two bodies.
+    #[test]
+    fn the_rows_are_those_of_the_final_radius_to_the_bit() {
+        let mut next = crate::test_rng::rng(11);
+        let mut points: Vec<[f64; 3]> = (0..2000).map(|_| [next(), next(), next()]).collect();
+        points.extend((0..400).map(|_| [1.2 + 0.3 * next(), 0.3 * next(), 0.0]));
+        points.extend((0..12).map(|q| [5.0 + q as f64 * 0.4, 3.0, -2.0]));
+        // Interleaved, so that the rows found again lie among others in
+        // their blocks.
+        for q in (1..points.len()).rev() {
+            points.swap(q, (next() * (q + 1) as f64) as usize);
+        }
+        let group: Vec<u8> = (0..points.len()).map(|j| u8::from(j % 5 == 0)).collect();
+        let k = 10;
+        for group in [&group[..], &[][..]] {
+            let start = 0.15;
+            let got = named_rows(&points, group, points.len(), k, start).unwrap();
+            assert!(got.search >= 8.0 * start, "the far nodes double the radius");
+            let want = named_rows(&points, group, points.len(), k, got.search).unwrap();
+            assert_eq!(want.search, got.search);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got.kth), bits(&want.kth));
+            assert_eq!(got.named, want.named);
+            assert!(
+                (0..got.named.len()).any(|i| got.named.of(i).len() > k),
+                "some rows are flat and name more"
+            );
+            assert_eq!(bits(&got.distance), bits(&want.distance));
+        }
+    }
+}
