@@ -20,6 +20,18 @@ pub(crate) fn refill<T: Clone + Send>(v: &mut Vec<T>, len: usize, value: T) {
     v.par_extend(rayon::iter::repeat_n(value, len));
 }
 
+/// `v.resize(len, value)`, the new entries written on the pool: a large
+/// buffer's first fill (and its pages' first touch) is not serial.
+pub(crate) fn fit<T: Clone + Send>(v: &mut Vec<T>, len: usize, value: T) {
+    if v.len() >= len {
+        v.truncate(len);
+        return;
+    }
+    let more = len - v.len();
+    v.reserve(more);
+    v.par_extend(rayon::iter::repeat_n(value, more));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -31,7 +31,7 @@
 //! and the scenes are the solvers' (`src/solver/`), built on these pieces;
 //! nothing here imports a solver, a material or a scene.
 
-mod buffers;
+pub(crate) mod buffers;
 pub mod conform;
 mod conform_levels;
 pub mod lattice;

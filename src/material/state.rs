@@ -136,7 +136,7 @@ pub struct MaterialState {
 impl MaterialState {
     /// Sizes the state for `n` particles (new ones start empty).
     pub fn fit(&mut self, n: usize) {
-        self.points.resize(n, PointState::default());
+        crate::approx::buffers::fit(&mut self.points, n, PointState::default());
     }
 
     /// The particles' states, to be cut into chunks.

@@ -22,6 +22,7 @@ use crate::approx::mls::distance;
 use crate::error::Result;
 use crate::neighbours::Cells;
 use crate::neighbours::NeighbourList;
+use rayon::iter::IndexedParallelIterator;
 use rayon::iter::IntoParallelIterator;
 use rayon::iter::ParallelIterator;
 use rayon::slice::ParallelSlice;
@@ -53,6 +54,10 @@ struct Found {
     /// The rows found here whose answer a larger radius could change.
     unsure: Vec<usize>,
 }
+
+/// What visits each row's answer: its pass's block, its entry there and
+/// the start of its pairs.
+type Visit<'a> = Box<dyn FnMut(&Found, usize, usize) + 'a>;
 
 /// How one row came out at one radius.
 enum Row {
@@ -248,57 +253,81 @@ pub(super) fn named_rows(
         .filter(|&(q, o)| over.get(q + 1).is_none_or(|next| next.0 != o.0))
         .map(|(_, o)| *o)
         .collect();
-    // Each row's answer: from the first pass, or its last from later.
-    // The rows come in order: `start` runs through the block of row `i`
-    // (a row found again still holds its first entry there).
-    let answer = |i: usize, next: &mut usize, start: &mut usize| -> (&Found, usize, usize) {
-        let (b, e) = (i / ROWS_PER_BLOCK, i % ROWS_PER_BLOCK);
-        if e == 0 {
-            *start = 0;
+    // Each row's answer: from the first pass, or its last from later. The
+    // rows of a block come in order: `start` runs through the block's
+    // pairs (a row found again still holds its first entry there).
+    let walk = |b: usize, mut visit: Visit<'_>| {
+        let (first, last) = (b * ROWS_PER_BLOCK, rows.min((b + 1) * ROWS_PER_BLOCK));
+        let mut next = over.partition_point(|o| o.0 < first);
+        let mut start = 0;
+        for i in first..last {
+            let e = i - first;
+            let s = start;
+            start += blocks[b].len[e];
+            match over.get(next) {
+                Some(&(row, f, e, s)) if row == i => {
+                    next += 1;
+                    visit(&later[f as usize], e as usize, s);
+                }
+                _ => visit(&blocks[b], e, s),
+            }
         }
-        let s = *start;
-        *start += blocks[b].len[e];
-        if let Some(&(row, f, e, s)) = over.get(*next)
-            && row == i
-        {
-            *next += 1;
-            return (&later[f as usize], e as usize, s);
-        }
-        (&blocks[b], e, s)
     };
+    // The entries of each block, then the blocks filled on the pool.
+    let counts: Vec<usize> = (0..blocks.len())
+        .into_par_iter()
+        .map(|b| {
+            let mut count = 0;
+            walk(b, Box::new(|found, e, _| count += found.len[e]));
+            count
+        })
+        .collect();
+    let entries = counts.iter().sum();
     let mut named = Named {
-        kth: Vec::with_capacity(rows),
+        kth: vec![0.0; rows],
         named: NeighbourList {
-            offsets: Vec::with_capacity(rows + 1),
-            indices: Vec::new(),
+            offsets: vec![0; rows + 1],
+            indices: vec![0; entries],
         },
-        distance: Vec::new(),
+        distance: vec![0.0; entries],
         #[cfg(test)]
         search,
     };
-    for pass in 0..2 {
-        let (mut next, mut start) = (0, 0);
-        let mut entries = 0;
-        for i in 0..rows {
-            let (found, e, s) = answer(i, &mut next, &mut start);
-            let len = found.len[e];
-            if pass == 0 {
-                entries += len;
-                continue;
-            }
-            named.kth.push(found.kth[e]);
-            for &(d, j) in &found.pairs[s..s + len] {
-                named.named.indices.push(j);
-                named.distance.push(d);
-            }
-            named.named.offsets.push(named.named.indices.len());
-        }
-        if pass == 0 {
-            named.named.indices.reserve_exact(entries);
-            named.distance.reserve_exact(entries);
-            named.named.offsets.push(0);
-        }
+    let mut parts = Vec::with_capacity(blocks.len());
+    let (mut indices, mut distance) = (&mut named.named.indices[..], &mut named.distance[..]);
+    let mut base = 0;
+    for ((kth, offsets), &count) in named
+        .kth
+        .chunks_mut(ROWS_PER_BLOCK)
+        .zip(named.named.offsets[1..].chunks_mut(ROWS_PER_BLOCK))
+        .zip(&counts)
+    {
+        let (i, rest_i) = indices.split_at_mut(count);
+        let (d, rest_d) = distance.split_at_mut(count);
+        parts.push((kth, offsets, i, d, base));
+        (indices, distance) = (rest_i, rest_d);
+        base += count;
     }
+    parts
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(b, (kth, offsets, indices, distance, base))| {
+            let (mut r, mut at) = (0, 0);
+            walk(
+                b,
+                Box::new(|found, e, s| {
+                    let len = found.len[e];
+                    kth[r] = found.kth[e];
+                    for (q, &(d, j)) in found.pairs[s..s + len].iter().enumerate() {
+                        indices[at + q] = j;
+                        distance[at + q] = d;
+                    }
+                    at += len;
+                    offsets[r] = base + at;
+                    r += 1;
+                }),
+            );
+        });
     Ok(named)
 }
 

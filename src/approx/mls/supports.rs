@@ -8,6 +8,8 @@ use crate::approx::mls::distance;
 use crate::error::Result;
 use crate::neighbours::NeighbourList;
 use crate::neighbours::cell_list_first;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 /// The choices behind the support sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SupportParams {
@@ -159,14 +161,25 @@ impl Supports {
         // (`nearest.rs`).
         let found = super::nearest::named_rows(points, group, rows, k, search)?;
         let (named, named_distance) = (found.named, found.distance);
-        let mut radius = found.kth;
-        radius.resize(points.len(), 0.0);
-        for (&j, &d) in named.indices.iter().zip(&named_distance) {
-            radius[j] = radius[j].max(d);
-        }
-        for r in &mut radius {
-            *r *= params.factor;
-        }
+        // Each node's radius reaches every node that names it: maxima of
+        // distances (not negative: their bits order as they do), taken on
+        // the pool, the same in any order.
+        let radius: Vec<AtomicU64> = (0..points.len())
+            .into_par_iter()
+            .map(|j| AtomicU64::new(found.kth.get(j).map_or(0, |r| r.to_bits())))
+            .collect();
+        named
+            .indices
+            .par_iter()
+            .zip(&named_distance)
+            .for_each(|(&j, &d)| {
+                radius[j].fetch_max(d.to_bits(), Ordering::Relaxed);
+            });
+        let mut radius: Vec<f64> = radius
+            .into_par_iter()
+            .map(|r| f64::from_bits(r.into_inner()))
+            .collect();
+        radius.par_iter_mut().for_each(|r| *r *= params.factor);
         Ok(Supports {
             radius,
             named,

@@ -3,6 +3,7 @@
 
 use super::shift::Freedom;
 use crate::Error;
+use crate::approx::buffers::fit;
 /// The buffers of a step, reused from step to step (not saved), one group
 /// per pass.
 #[derive(Debug, Clone, Default)]
@@ -118,25 +119,25 @@ pub(super) struct Move {
 impl Scratch {
     /// Every buffer at `n` entries (allocates only when `n` grows).
     pub(super) fn fit(&mut self, n: usize) {
-        self.forces.total.resize(n, [0.0; 6]);
-        self.forces.force.resize(n, [0.0; 3]);
-        self.kicks.resize(n, Kick::default());
-        self.smoothing.smooth.resize(n, [0.0; 3]);
-        self.smoothing.defect.resize(n, [0.0; 3]);
-        self.smoothing.pass.resize(n, [0.0; 3]);
-        self.moves.resize(n, Move::default());
-        self.grad.resize(n, [[0.0; 3]; 3]);
-        self.forces.volume.resize(n, 0.0);
-        self.results.resize(n, Ok(Tally::default()));
+        fit(&mut self.forces.total, n, [0.0; 6]);
+        fit(&mut self.forces.force, n, [0.0; 3]);
+        fit(&mut self.kicks, n, Kick::default());
+        fit(&mut self.smoothing.smooth, n, [0.0; 3]);
+        fit(&mut self.smoothing.defect, n, [0.0; 3]);
+        fit(&mut self.smoothing.pass, n, [0.0; 3]);
+        fit(&mut self.moves, n, Move::default());
+        fit(&mut self.grad, n, [[0.0; 3]; 3]);
+        fit(&mut self.forces.volume, n, 0.0);
+        fit(&mut self.results, n, Ok(Tally::default()));
     }
 
     /// The shifting buffers at `n` entries.
     pub(super) fn fit_shift(&mut self, n: usize) {
         let s = &mut self.shifting;
-        s.shift.resize(n, [0.0; 3]);
-        s.free.resize(n, Freedom::Fixed);
-        s.carried.resize(n, [0.0; CARRIED]);
-        s.carried_out.resize(n, [0.0; CARRIED]);
+        fit(&mut s.shift, n, [0.0; 3]);
+        fit(&mut s.free, n, Freedom::Fixed);
+        fit(&mut s.carried, n, [0.0; CARRIED]);
+        fit(&mut s.carried_out, n, [0.0; CARRIED]);
     }
 
     /// The heap bytes of the buffers counted per node in the memory by
