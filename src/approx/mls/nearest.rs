@@ -55,10 +55,6 @@ struct Found {
     unsure: Vec<usize>,
 }
 
-/// What visits each row's answer: its pass's block, its entry there and
-/// the start of its pairs.
-type Visit<'a> = Box<dyn FnMut(&Found, usize, usize) + 'a>;
-
 /// How one row came out at one radius.
 enum Row {
     /// `k` others or fewer of its body within the radius.
@@ -72,94 +68,126 @@ enum Row {
 /// are at least the radius away, to round-off).
 const INSIDE: f64 = 1.0 - 1e-9;
 
-/// The row of node `i` from `grid` (radius `search`): its others of the
-/// same body by (distance, index) into `row`.
-fn find(
-    grid: &Cells<3>,
+/// The search at one radius: its grid over the points, each row's `k`
+/// nearest of its body.
+struct Radius<'a> {
+    grid: Cells<'a, 3>,
     search: f64,
-    points: &[[f64; 3]],
-    same: impl Fn(usize, usize) -> bool,
+    points: &'a [[f64; 3]],
+    group: &'a [u8],
     k: usize,
-    i: usize,
-    (list, row): (&mut Vec<usize>, &mut Vec<(f64, usize)>),
-) -> Row {
-    grid.sorted_into(&points[i], list);
-    if list.iter().filter(|&&j| same(i, j)).count() <= k {
-        return Row::Short;
-    }
-    row.clear();
-    row.extend(
-        list.iter()
-            .filter(|&&j| j != i && same(i, j))
-            .map(|&j| (distance(&points[i], &points[j]), j)),
-    );
-    row.sort_unstable_by(|a: &(f64, usize), b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    match spanning(&points[i], row, k, |j| points[j]) {
-        Some(named) => Row::Named(named, row[named - 1].0 < INSIDE * search),
-        None => Row::Named(k, false),
-    }
 }
 
-/// One block of rows at the radius of `grid`, `search`; `first`: the
-/// first pass's block (an entry for every row).
-#[allow(clippy::too_many_arguments)]
-fn block(
-    grid: &Cells<3>,
-    search: f64,
-    points: &[[f64; 3]],
-    group: &[u8],
-    k: usize,
-    rows: impl Iterator<Item = usize>,
-    first: bool,
-    scratch: &mut (Vec<usize>, Vec<(f64, usize)>),
-) -> Found {
-    let same = |i: usize, j: usize| group.is_empty() || group[i] == group[j];
-    let mut f = Found::default();
-    for i in rows {
-        let (list, row) = (&mut scratch.0, &mut scratch.1);
-        match find(grid, search, points, same, k, i, (list, row)) {
-            Row::Short => {
-                f.short.push(i);
-                if first {
-                    f.kth.push(f64::NAN);
-                    f.len.push(0);
-                }
-            }
-            Row::Named(named, sure) => {
-                if !sure {
-                    f.unsure.push(i);
-                }
-                if !first {
-                    f.row.push(i);
-                }
-                f.kth.push(row[k - 1].0);
-                f.len.push(named);
-                f.pairs.extend_from_slice(&row[..named]);
-            }
+/// A row's buffers: the candidates, and the (distance, node) pairs.
+type Scratch = (Vec<usize>, Vec<(f64, usize)>);
+
+impl<'a> Radius<'a> {
+    fn new(points: &'a [[f64; 3]], group: &'a [u8], k: usize, search: f64) -> Self {
+        Radius {
+            grid: Cells::new(points, search).expect("more than k points"),
+            search,
+            points,
+            group,
+            k,
         }
     }
-    f
+
+    /// The row of node `i`: its others of the same body by (distance,
+    /// index) into `row`.
+    fn find(&self, i: usize, (list, row): &mut Scratch) -> Row {
+        let (points, k) = (self.points, self.k);
+        let same = |j: usize| self.group.is_empty() || self.group[i] == self.group[j];
+        self.grid.sorted_into(&points[i], list);
+        if list.iter().filter(|&&j| same(j)).count() <= k {
+            return Row::Short;
+        }
+        row.clear();
+        row.extend(
+            list.iter()
+                .filter(|&&j| j != i && same(j))
+                .map(|&j| (distance(&points[i], &points[j]), j)),
+        );
+        row.sort_unstable_by(|a: &(f64, usize), b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        match spanning(&points[i], row, k, |j| points[j]) {
+            Some(named) => Row::Named(named, row[named - 1].0 < INSIDE * self.search),
+            None => Row::Named(k, false),
+        }
+    }
+
+    /// One block of rows; `first`: the first pass's block (an entry for
+    /// every row).
+    fn block(
+        &self,
+        rows: impl Iterator<Item = usize>,
+        first: bool,
+        scratch: &mut Scratch,
+    ) -> Found {
+        let mut f = Found::default();
+        for i in rows {
+            match self.find(i, scratch) {
+                Row::Short => {
+                    f.short.push(i);
+                    if first {
+                        f.kth.push(f64::NAN);
+                        f.len.push(0);
+                    }
+                }
+                Row::Named(named, sure) => {
+                    if !sure {
+                        f.unsure.push(i);
+                    }
+                    if !first {
+                        f.row.push(i);
+                    }
+                    let row = &scratch.1;
+                    f.kth.push(row[self.k - 1].0);
+                    f.len.push(named);
+                    f.pairs.extend_from_slice(&row[..named]);
+                }
+            }
+        }
+        f
+    }
+
+    /// The rows `rows` (ascending), a block at a time on the pool.
+    fn again(&self, rows: &[usize]) -> Vec<Found> {
+        rows.par_chunks(ROWS_PER_BLOCK)
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |scratch, chunk| self.block(chunk.iter().copied(), false, scratch),
+            )
+            .collect()
+    }
 }
 
-/// The rows `rows` (ascending) at the radius of `grid`, `search`, a block
-/// at a time on the pool.
-fn again(
-    grid: &Cells<3>,
-    search: f64,
-    points: &[[f64; 3]],
-    group: &[u8],
-    k: usize,
-    rows: &[usize],
-) -> Vec<Found> {
-    rows.par_chunks(ROWS_PER_BLOCK)
-        .map_init(
-            || (Vec::new(), Vec::new()),
-            |scratch, chunk| {
-                let rows = chunk.iter().copied();
-                block(grid, search, points, group, k, rows, false, scratch)
-            },
-        )
-        .collect()
+/// Visits the answers of block `b`'s rows in order (`visit(found, entry,
+/// start of its pairs)`): from the first pass, or a row's last from
+/// `later` (`over`: by row, (row, found, entry, start)). `start` runs
+/// through the block's pairs (a row found again still holds its first
+/// entry there).
+fn walk(
+    b: usize,
+    rows: usize,
+    blocks: &[Found],
+    later: &[Found],
+    over: &[(usize, u32, u32, usize)],
+    mut visit: impl FnMut(&Found, usize, usize),
+) {
+    let (first, last) = (b * ROWS_PER_BLOCK, rows.min((b + 1) * ROWS_PER_BLOCK));
+    let mut next = over.partition_point(|o| o.0 < first);
+    let mut start = 0;
+    for i in first..last {
+        let e = i - first;
+        let s = start;
+        start += blocks[b].len[e];
+        match over.get(next) {
+            Some(&(row, f, e, s)) if row == i => {
+                next += 1;
+                visit(&later[f as usize], e as usize, s);
+            }
+            _ => visit(&blocks[b], e, s),
+        }
+    }
 }
 
 /// The named pairs of the first `rows` of `points` (each of its body),
@@ -173,14 +201,14 @@ pub(super) fn named_rows(
     mut search: f64,
 ) -> Result<Named> {
     let blocks: Vec<Found> = {
-        let grid = Cells::new(points, search).expect("more than k points");
+        let at = Radius::new(points, group, k, search);
         (0..rows.div_ceil(ROWS_PER_BLOCK))
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new()),
                 |scratch, b| {
                     let rows = b * ROWS_PER_BLOCK..rows.min((b + 1) * ROWS_PER_BLOCK);
-                    block(&grid, search, points, group, k, rows, true, scratch)
+                    at.block(rows, true, scratch)
                 },
             )
             .collect()
@@ -213,8 +241,8 @@ pub(super) fn named_rows(
                 time: f64::NAN,
             });
         }
-        let grid = Cells::new(points, search).expect("more than k points");
-        let found = again(&grid, search, points, group, k, &todo);
+        let at = Radius::new(points, group, k, search);
+        let found = at.again(&todo);
         todo = found.iter().flat_map(|f| f.short.iter().copied()).collect();
         unsure.extend(
             found
@@ -231,7 +259,7 @@ pub(super) fn named_rows(
                 .collect();
             redo.sort_unstable();
             later.extend(found);
-            later.extend(again(&grid, search, points, group, k, &redo));
+            later.extend(at.again(&redo));
         } else {
             later.extend(found);
         }
@@ -253,32 +281,15 @@ pub(super) fn named_rows(
         .filter(|&(q, o)| over.get(q + 1).is_none_or(|next| next.0 != o.0))
         .map(|(_, o)| *o)
         .collect();
-    // Each row's answer: from the first pass, or its last from later. The
-    // rows of a block come in order: `start` runs through the block's
-    // pairs (a row found again still holds its first entry there).
-    let walk = |b: usize, mut visit: Visit<'_>| {
-        let (first, last) = (b * ROWS_PER_BLOCK, rows.min((b + 1) * ROWS_PER_BLOCK));
-        let mut next = over.partition_point(|o| o.0 < first);
-        let mut start = 0;
-        for i in first..last {
-            let e = i - first;
-            let s = start;
-            start += blocks[b].len[e];
-            match over.get(next) {
-                Some(&(row, f, e, s)) if row == i => {
-                    next += 1;
-                    visit(&later[f as usize], e as usize, s);
-                }
-                _ => visit(&blocks[b], e, s),
-            }
-        }
-    };
+    // Each row's answer: from the first pass, or its last from later.
     // The entries of each block, then the blocks filled on the pool.
     let counts: Vec<usize> = (0..blocks.len())
         .into_par_iter()
         .map(|b| {
             let mut count = 0;
-            walk(b, Box::new(|found, e, _| count += found.len[e]));
+            walk(b, rows, &blocks, &later, &over, |found, e, _| {
+                count += found.len[e]
+            });
             count
         })
         .collect();
@@ -313,20 +324,17 @@ pub(super) fn named_rows(
         .enumerate()
         .for_each(|(b, (kth, offsets, indices, distance, base))| {
             let (mut r, mut at) = (0, 0);
-            walk(
-                b,
-                Box::new(|found, e, s| {
-                    let len = found.len[e];
-                    kth[r] = found.kth[e];
-                    for (q, &(d, j)) in found.pairs[s..s + len].iter().enumerate() {
-                        indices[at + q] = j;
-                        distance[at + q] = d;
-                    }
-                    at += len;
-                    offsets[r] = base + at;
-                    r += 1;
-                }),
-            );
+            walk(b, rows, &blocks, &later, &over, |found, e, s| {
+                let len = found.len[e];
+                kth[r] = found.kth[e];
+                for (q, &(d, j)) in found.pairs[s..s + len].iter().enumerate() {
+                    indices[at + q] = j;
+                    distance[at + q] = d;
+                }
+                at += len;
+                offsets[r] = base + at;
+                r += 1;
+            });
         });
     Ok(named)
 }
