@@ -36,6 +36,7 @@
 //! Every sum runs in a fixed order: the same bits for any number of
 //! threads.
 
+use crate::approx::buffers::{filled, fit};
 use crate::approx::conform_levels::{Fine, Levels};
 use crate::approx::mls::NodalShapes;
 use crate::approx::nodal::{entry_parts, for_segments, transpose};
@@ -411,7 +412,7 @@ impl Fused {
             .collect();
         Fused {
             diag,
-            w: vec![[[0.0; 4]; 4]; sys.shapes.len()],
+            w: filled(sys.shapes.len(), [[0.0; 4]; 4]),
         }
     }
 
@@ -518,7 +519,7 @@ pub fn conform(
     let columns = Columns::of(shapes, n);
     let sys = System::new(shapes, points, volume, inner, &columns);
     // a_J over every node, for the scale of the stop.
-    let mut a = vec![[0.0; 3]; n];
+    let mut a = filled(n, [0.0; 3]);
     {
         let c = &sys.columns;
         a.par_iter_mut().enumerate().for_each(|(j, aj)| {
@@ -530,7 +531,7 @@ pub fn conform(
             }
         });
     }
-    let largest = a.iter().map(|&v| norm3(v)).fold(0.0, f64::max);
+    let largest = a.par_iter().map(|&v| norm3(v)).reduce(|| 0.0, f64::max);
     // The loops of the conjugate gradients run on the pool: each entry is
     // its own, and a largest value is the same in any order; only the dot
     // products stay in order (their sums would move the bits).
@@ -549,7 +550,7 @@ pub fn conform(
     let levels = match preconditioner {
         Preconditioner::Jacobi => None,
         Preconditioner::Levels => {
-            let jacobi: Vec<f64> = diag.iter().map(|d| d[0]).collect();
+            let jacobi: Vec<f64> = diag.par_iter().map(|d| d[0]).collect();
             Levels::new(
                 &Fine {
                     shapes: sys.shapes,
@@ -579,9 +580,10 @@ pub fn conform(
     // start is zero).
     if mu.len() != n {
         mu.clear();
-        mu.resize(n, [0.0; 3]);
+        fit(mu, n, [0.0; 3]);
     }
     let mut r: Vec<[f64; 3]> = (0..n)
+        .into_par_iter()
         .map(|j| {
             if inner[j] {
                 [-a[j][0], -a[j][1], -a[j][2]]
@@ -590,8 +592,8 @@ pub fn conform(
             }
         })
         .collect();
-    let mut ap = vec![[0.0; 3]; n];
-    if mu.iter().flatten().any(|&m| m != 0.0) {
+    let mut ap = filled(n, [0.0; 3]);
+    if mu.par_iter().any(|m| m.iter().any(|&m| m != 0.0)) {
         fused.apply(isa, &sys, mu, &mut ap);
         let warm: Vec<[f64; 3]> = r
             .par_iter()
@@ -600,16 +602,16 @@ pub fn conform(
             .collect();
         // A start no better than zero (or not finite: a garbled saved
         // state) is dropped.
-        if warm.iter().flatten().all(|x| x.is_finite()) && inner_max(&warm) < before {
+        if warm.par_iter().all(|w| w.iter().all(|x| x.is_finite())) && inner_max(&warm) < before {
             r = warm;
         } else {
-            mu.iter_mut().for_each(|m| *m = [0.0; 3]);
+            mu.par_iter_mut().for_each(|m| *m = [0.0; 3]);
         }
     }
     let start = inner_max(&r);
-    let mut z = vec![[0.0; 3]; n];
+    let mut z = filled(n, [0.0; 3]);
     precond(&r, &mut z);
-    let mut p = z.clone();
+    let mut p: Vec<[f64; 3]> = z.par_iter().copied().collect();
     let mut rz = dot(&r, &z);
     let mut iterations = 0;
     let flexible = levels.as_ref().is_some_and(|l| !l.linear());

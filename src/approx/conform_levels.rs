@@ -38,10 +38,13 @@
 //! multipliers, so one hierarchy serves the three. Every sum runs in a
 //! fixed order: the same bits for any number of threads.
 
+use crate::approx::buffers::filled;
 use crate::approx::mls::NodalShapes;
 use crate::approx::nodal::entry_parts;
+use crate::approx::nodal::for_segments;
 use crate::calibrate::linalg::{Mat, cholesky, cholesky_solve, symmetric_eigen};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A 4 × 4 block: the linear functions of two groups.
 type Block = [[f64; 4]; 4];
@@ -188,25 +191,38 @@ fn group(x: &[Option<[f64; 3]>], h: f64) -> (Vec<u32>, Vec<usize>, Vec<usize>) {
         let k = |d: usize| (((p[d] - lo[d]) / h).floor().max(0.0) as u64).min(0x1f_ffff);
         (k(0) << 42) | (k(1) << 21) | k(2)
     };
+    // Every point keyed (those without a cell last), so that the collect
+    // is indexed and written on the pool; then the keyless cut off.
     let mut keys: Vec<(u64, usize)> = x
         .par_iter()
         .enumerate()
-        .filter_map(|(j, p)| p.map(|p| (cell(p), j)))
+        .map(|(j, p)| (p.map_or(u64::MAX, cell), j))
         .collect();
     keys.par_sort_unstable();
-    let mut of = vec![u32::MAX; x.len()];
-    let mut offsets = vec![0];
-    let mut members = Vec::with_capacity(keys.len());
-    for (k, &(key, j)) in keys.iter().enumerate() {
-        if k > 0 && key != keys[k - 1].0 {
-            offsets.push(members.len());
+    let with = keys.partition_point(|&(key, _)| key != u64::MAX);
+    keys.truncate(with);
+    // On the pool: at 10^6 nodes a serial numbering was a serial part of
+    // every build (each entry is its own: the same result in any order).
+    let mut offsets: Vec<usize> = (0..keys.len())
+        .into_par_iter()
+        .filter(|&k| k == 0 || keys[k].0 != keys[k - 1].0)
+        .collect();
+    if !keys.is_empty() {
+        offsets.push(keys.len());
+    } else {
+        offsets.push(0);
+    }
+    let members: Vec<usize> = keys.par_iter().map(|&(_, j)| j).collect();
+    let of: Vec<AtomicU32> = (0..x.len())
+        .into_par_iter()
+        .map(|_| AtomicU32::new(u32::MAX))
+        .collect();
+    offsets.par_windows(2).enumerate().for_each(|(g, w)| {
+        for &j in &members[w[0]..w[1]] {
+            of[j].store(g as u32, Ordering::Relaxed);
         }
-        of[j] = (offsets.len() - 1) as u32;
-        members.push(j);
-    }
-    if !members.is_empty() {
-        offsets.push(members.len());
-    }
+    });
+    let of = of.into_par_iter().map(AtomicU32::into_inner).collect();
     (of, offsets, members)
 }
 
@@ -223,15 +239,26 @@ impl Blocks {
     }
 
     fn of(rows: Vec<Vec<(usize, Block)>>) -> Blocks {
-        let mut offsets = vec![0];
-        let (mut cols, mut blocks) = (Vec::new(), Vec::new());
-        for row in rows {
-            for (c, b) in row {
-                cols.push(c);
-                blocks.push(b);
-            }
-            offsets.push(cols.len());
+        let mut offsets = Vec::with_capacity(rows.len() + 1);
+        offsets.push(0);
+        for row in &rows {
+            offsets.push(offsets.last().copied().unwrap_or(0) + row.len());
         }
+        // Filled on the pool, row by row (the first level's blocks are
+        // tens of megabytes at 10^6 nodes).
+        let total = offsets.last().copied().unwrap_or(0);
+        let mut cols = filled(total, 0usize);
+        let mut blocks = filled(total, [[0.0; 4]; 4]);
+        for_segments(&mut cols, &offsets, &|r, out| {
+            for (o, e) in out.iter_mut().zip(&rows[r]) {
+                *o = e.0;
+            }
+        });
+        for_segments(&mut blocks, &offsets, &|r, out| {
+            for (o, e) in out.iter_mut().zip(&rows[r]) {
+                *o = e.1;
+            }
+        });
         Blocks {
             offsets,
             cols,
@@ -301,6 +328,7 @@ struct Grouping {
 
 fn grouping(points: &[[f64; 3]], inner: &[bool], h: f64) -> Grouping {
     let x: Vec<Option<[f64; 3]>> = (0..inner.len())
+        .into_par_iter()
         .map(|j| inner[j].then_some(points[j]))
         .collect();
     let (of, offsets, members) = group(&x, h);
@@ -747,10 +775,10 @@ impl Levels {
             }
             return out;
         }
-        let mut x = vec![[[0.0; 3]; 4]; r.len()];
+        let mut x = filled(r.len(), [[0.0; 3]; 4]);
         for cycle in 0..CYCLES {
             let res = if cycle == 0 {
-                r.to_vec()
+                copied(r)
             } else {
                 level.residual(r, &x)
             };
@@ -776,23 +804,19 @@ impl Levels {
                     .sum::<f64>()
             })
         };
-        let zero = vec![[[0.0; 3]; 4]; r.len()];
-        let mut x = zero.clone();
-        let mut res = r.to_vec();
+        // The level's vectors are made on the pool (copies of a few
+        // megabytes at 10^6 nodes, several an outer iteration).
+        let mut x = filled(r.len(), [[0.0; 3]; 4]);
+        let mut res = copied(r);
         let mut z = self.solve(0, &res);
-        let mut p = z.clone();
+        let mut p = copied(&z);
         let mut rz = dot(&res, &z);
         let start = rz;
         for _ in 0..INNER_ITERATIONS {
             if rz.is_nan() || rz <= INNER_TOLERANCE * INNER_TOLERANCE * start {
                 break;
             }
-            // A p = −(0 − A p).
-            let ap: Vec<Coarse> = level
-                .residual(&zero, &p)
-                .into_iter()
-                .map(|c| c.map(|v| v.map(|x| -x)))
-                .collect();
+            let ap = level.product(&p);
             let pap = dot(&p, &ap);
             if pap.is_nan() || pap <= 0.0 {
                 break;
@@ -864,6 +888,27 @@ impl Levels {
 }
 
 impl Level {
+    /// `A x`, row by row (the negative of [`Level::residual`] from zero,
+    /// to the bit: each sum is the same sum of the same terms).
+    fn product(&self, x: &[Coarse]) -> Vec<Coarse> {
+        let a = &self.a;
+        (0..a.rows())
+            .into_par_iter()
+            .map(|i| {
+                let mut y = [[0.0; 3]; 4];
+                for k in a.offsets[i]..a.offsets[i + 1] {
+                    let ax = times(&a.blocks[k], &x[a.cols[k]]);
+                    for b in 0..4 {
+                        for d in 0..3 {
+                            y[b][d] += ax[b][d];
+                        }
+                    }
+                }
+                y
+            })
+            .collect()
+    }
+
     /// `r − A x`, row by row.
     fn residual(&self, r: &[Coarse], x: &[Coarse]) -> Vec<Coarse> {
         let a = &self.a;
@@ -883,6 +928,11 @@ impl Level {
             })
             .collect()
     }
+}
+
+/// A copy of `x`, made on the pool.
+fn copied(x: &[Coarse]) -> Vec<Coarse> {
+    x.par_iter().copied().collect()
 }
 
 /// `x += f y`.

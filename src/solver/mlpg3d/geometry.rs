@@ -9,6 +9,7 @@ use super::util::at_time;
 use super::util::extended;
 use super::util::norm;
 use crate::Error;
+use crate::approx::buffers::copy_from;
 use crate::approx::conform::CONFORM_TOLERANCE;
 use crate::approx::conform::{Stop, conform};
 use crate::approx::mirror;
@@ -30,6 +31,7 @@ use crate::solver::mlpg3d::State3d;
 use crate::solver::mlpg3d::scheme::Forces;
 use crate::solver::mlpg3d::scheme::SmoothingOrder;
 use rayon::iter::IntoParallelIterator;
+use rayon::iter::IntoParallelRefIterator;
 use rayon::iter::ParallelIterator;
 /// What follows from the positions at the last build: supports, nodal
 /// shapes, test spheres and the traction operator. Rebuilt, never saved.
@@ -154,19 +156,24 @@ pub(super) fn build_geometry(
     g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
     pipe.profile.lap(Phase::Shapes, &mut watch);
     if setup.rod.scheme.forces == Forces::Conforming {
-        let volume: Vec<f64> = (0..n).map(|i| setup.mass[i] / state.built_rho[i]).collect();
+        // Node-wise arrays made on the pool: at 10^6 nodes a serial fill
+        // is a serial part of every build.
+        let volume: Vec<f64> = (0..n)
+            .into_par_iter()
+            .map(|i| setup.mass[i] / state.built_rho[i])
+            .collect();
         let inner: Vec<bool> = setup
             .lattice
             .surfaces
-            .iter()
+            .par_iter()
             .map(|s| s.interior())
             .collect();
         // The start: the last build's multipliers in this process, or
         // the saved start of a restored run's last build.
         if !g.multipliers.is_empty() {
-            state.built_multipliers.clone_from(&g.multipliers);
+            copy_from(&mut state.built_multipliers, &g.multipliers);
         }
-        g.multipliers.clone_from(&state.built_multipliers);
+        copy_from(&mut g.multipliers, &state.built_multipliers);
         let c = conform(
             pipe.isa,
             &mut g.shapes,
