@@ -146,7 +146,7 @@ pub fn explore_taylor3d_stop() {
 
 /// Exploration: the phase profile of `taylor3d` run to its end
 /// (`PARTICLES_RADIAL`, default 6; `PRECONDITIONER`, the
-/// `conform_preconditioner`, default 0), or for `STEPS` steps when that is set,
+/// `conform_preconditioner`, default the scene's), or for `STEPS` steps when that is set,
 /// printed with the wall time of the construction and of the loop per
 /// node-step, and each phase's serial time (BENCHMARKS.md, "3-D MLPG
 /// speed"); with `MI_SCENE_FILE` or `MI_SET` set, of that scene instead
@@ -163,7 +163,7 @@ pub fn explore_taylor3d_profile() {
             particles_radial: across,
             conform_preconditioner: std::env::var("PRECONDITIONER")
                 .map(|s| s.parse().unwrap())
-                .unwrap_or(0.0),
+                .unwrap_or(Taylor3dParams::default().conform_preconditioner),
             ..Taylor3dParams::default()
         };
         p.build().unwrap()

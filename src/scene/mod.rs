@@ -190,6 +190,13 @@ pub fn builtin_names() -> Vec<String> {
         .collect()
 }
 
+/// Parameters whose default moved after scenes without them were saved,
+/// with the value such a scene ran with: `conform_preconditioner` was
+/// added with Jacobi's (0) as its default on 2026-11-30 and became the
+/// levels (1) the same day; a state or checkpoint saved before names no
+/// preconditioner and ran with Jacobi's.
+const SAVED_WITHOUT: &[(&str, f64)] = &[("conform_preconditioner", 0.0)];
+
 /// A [`Scene`] as saved: its kind's parameters by name, under the kind's
 /// name with a capital (`{"Taylor": {"impact_speed": 181.0, ...}}`).
 #[derive(Serialize, Deserialize)]
@@ -242,6 +249,15 @@ impl<'de> Deserialize<'de> for Scene {
         let mut scene = Scene::default_of(kind);
         scene.title = saved.title;
         scene.reference = saved.reference;
+        // A scene saved before a parameter existed ran with the value it
+        // had then, not with today's default.
+        for &(name, then) in SAVED_WITHOUT {
+            if !params.contains_key(name)
+                && let Ok(k) = scene.index(name)
+            {
+                scene.values[k] = then;
+            }
+        }
         // Values are put as they are (a restored state is checked whole
         // afterwards); names must be the kind's.
         for (name, v) in params {

@@ -180,11 +180,12 @@ pub(crate) const WEAK_FORM: ParamSpec = spec(
 pub(crate) const CONFORM_PRECONDITIONER: ParamSpec = spec(
     "conform_preconditioner",
     "1",
-    0.0,
+    1.0,
     Range::integer(0.0, 1.0),
     "preconditioner of the conjugate gradients of the conforming correction (weak_form = 2): 0 = Jacobi's (the \
      iterations grow as the spacing shrinks), 1 = Jacobi's plus levels of groups of nodes whose linear functions take \
-     the smooth modes (README, 3-D MLPG); moves the answer within the correction's tolerance",
+     the smooth modes, whose iterations do not (README, 3-D MLPG); the two answers differ within the correction's \
+     tolerance",
 );
 
 /// The `lattice` row of the 3-D scenes: 0 the ring lattice with every

@@ -48,6 +48,13 @@
 //! thirteen columns was measured to be the one recorded before
 //! (0x635f_d715_8818_dc4f); the history's checksum below covers the sixteen.
 //!
+//! On 2026-11-30 (issue 69) the default `taylor3d` case was re-recorded
+//! when the conforming correction's preconditioner became the levels
+//! (`conform_preconditioner = 1`, was Jacobi's): the iterations stop at the
+//! same tolerance from another path, and the finals moved by 1e-7 to
+//! 1.1e-5 relative (the correction's stop is 1e-4 of the largest column
+//! sum). The paper's case (test spheres, no correction) kept its bits.
+//!
 //! Each case is a digest: the bits of every final observable, and an FNV-1a
 //! checksum over the bits of every recorded time and value. Every case runs
 //! in each compiled copy of the hot loops this processor has (AVX-512,
@@ -189,24 +196,24 @@ fn cases() -> Vec<Golden> {
             scene: "taylor3d",
             sets: &[("particles_radial", 4.0), ("end_time", 5e-6)],
             finals: &[
-                0x3fa2_f97b_47a3_5af1,
-                0x3f72_242d_6919_88e8,
-                0x3f95_d450_cd35_4519,
-                0x4066_92e2_e3ff_6d12,
+                0x3fa2_f97b_0d52_131a,
+                0x3f72_242f_07b4_bfef,
+                0x3f95_d44b_d2b4_a48d,
+                0x4066_92e2_7d9b_ff9b,
                 0x0000_0000_0000_0000,
-                0x3fd7_a74a_5ddf_6fff,
-                0x4079_fc41_610d_b044,
-                0x4064_c3a6_df5a_5ced,
-                0x4048_c658_3206_6830,
-                0x3ff2_b3c2_bf1d_1980,
-                0x4012_39db_873d_effb,
-                0x3f6b_fce7_494b_6f93,
+                0x3fd7_a744_37cf_8376,
+                0x4079_fc3f_5f2e_9322,
+                0x4064_c3a3_c8be_f44d,
+                0x4048_c664_7566_41ba,
+                0x3ff2_b3bd_2783_dd00,
+                0x4012_39db_6ac4_a8a6,
+                0x3f6b_fcd2_96ed_2a78,
                 0x0000_0000_0000_0000,
-                0x3f7c_2552_bbf7_ec6c,
+                0x3f7c_255d_0c5d_8bab,
                 0x0000_0000_0000_0000,
-                0x4047_4daf_8101_65a6,
+                0x4047_4dbc_15f1_17f4,
             ],
-            history: 0x39df_b079_317b_eb33,
+            history: 0xa7bd_ddb3_ca9a_9326,
             rows: 51,
         },
         Golden {

@@ -153,7 +153,12 @@ impl MlpgScheme {
             smoothing: get("smoothing_coefficient")?,
             shifting: get("shifting")?,
             lattice,
-            preconditioner: if get("conform_preconditioner")? >= 0.5 {
+            // Only the conforming correction has iterations to precondition:
+            // with the other forms the scheme keeps Jacobi's, the value that
+            // is not written, so their setups' digests do not depend on a
+            // parameter they do not read.
+            preconditioner: if forces == Forces::Conforming && get("conform_preconditioner")? >= 0.5
+            {
                 Preconditioner::Levels
             } else {
                 Preconditioner::Jacobi
