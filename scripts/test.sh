@@ -40,13 +40,19 @@ venv_log=$(mktemp)
 # ecos, one of the FMI hosts of the FMU checks (tests/fmu/test_hosts.py),
 # loads Debian's libtbb12 (measured: 6 s with `apt-get update`), installed
 # beside the venv's downloads when missing and the command runs as root.
+# MPICH for the run across ranks (cargo feature `mpi`, the last step),
+# with libclang for its bindings (measured: 12 s once the lists are read).
+debs=()
+ldconfig -p | grep -q 'libtbb\.so\.12 ' || debs+=(libtbb12)
+dpkg -s mpich libmpich-dev libclang-dev > /dev/null 2>&1 ||
+  debs+=(mpich libmpich-dev libclang-dev)
 ( bash scripts/venv.sh
-  if ! ldconfig -p | grep -q 'libtbb\.so\.12 '; then
-    echo "== apt-get install libtbb12 (ecos)"
+  if [ ${#debs[@]} -gt 0 ]; then
+    echo "== apt-get install ${debs[*]}"
     if [ "$(id -u)" = 0 ]; then
-      apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libtbb12 > /dev/null
+      apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${debs[@]}" > /dev/null
     else
-      echo "not root: install libtbb12 (apt-get install libtbb12) for the ecos checks"
+      echo "not root: install ${debs[*]} (apt-get install ${debs[*]})"
     fi
   fi ) > "$venv_log" 2>&1 &
 venv_pid=$!
@@ -100,7 +106,7 @@ if [ -f examples_c/Makefile ]; then
 fi
 if ! wait $venv_pid; then
   cat "$venv_log"
-  echo "== the Python virtual environment (scripts/venv.sh) or libtbb12 failed"
+  echo "== the Python virtual environment (scripts/venv.sh) or the Debian packages failed"
   exit 1
 fi
 cat "$venv_log"
@@ -126,4 +132,10 @@ tail -n 5 "$fuzz_log"
 # workspace's default members: python/tests/run.sh).
 echo "== Python package"
 bash python/tests/run.sh
+# Last, as it builds the library once more with the feature `mpi` (the
+# C examples, the FMUs and the Python package above link the one built
+# without it): its lints, then the runs across 1 to 4 ranks (tests/mpi.rs).
+echo "== MPI (cargo feature mpi: clippy, tests/mpi.rs)"
+cargo clippy --all-targets --profile ci --features mpi -- -D warnings
+cargo test --profile ci --features mpi --test mpi
 echo "== all tests passed"

@@ -95,6 +95,7 @@ mod model;
 mod neighbours;
 mod observe;
 mod params;
+pub mod ranks;
 mod rod;
 mod scene;
 mod sim;

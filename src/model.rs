@@ -122,6 +122,20 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// without compiled copies ignores it.
     fn set_isa(&mut self, _isa: Isa) {}
 
+    /// Shares this run's passes over its particles among `ranks` (the
+    /// processes of an MPI run, [`crate::ranks`]), with the same bits on
+    /// any number of ranks. A solver that runs on one process only refuses
+    /// more than one rank.
+    fn set_ranks(&mut self, ranks: crate::ranks::Handle) -> std::result::Result<(), String> {
+        if ranks.size() > 1 {
+            return Err(format!(
+                "this solver runs on one rank only, not on {}: the 3-D scenes (taylor3d, penetration) run on several",
+                ranks.size()
+            ));
+        }
+        Ok(())
+    }
+
     /// Replaces the state of this run, a new run of its scene, with the
     /// saved one (of [`ModelState::save`] or [`ModelState::save_compact`]),
     /// read but not yet checked ([`Model::check_restored`]). The message

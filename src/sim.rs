@@ -302,6 +302,16 @@ impl Simulation {
         self.solver.set_isa(isa);
     }
 
+    /// Shares the run's passes over its particles among `ranks` (the
+    /// processes of an MPI run, [`crate::ranks`]); the same bits on any
+    /// number of ranks. Refused, with the reason, by the scenes whose
+    /// solver runs on one rank only (all but `taylor3d` and `penetration`).
+    pub fn set_ranks(&mut self, ranks: crate::ranks::Handle) -> std::result::Result<(), String> {
+        self.solver
+            .set_ranks(ranks)
+            .map_err(|e| format!("scene `{}`: {e}", self.kind().name()))
+    }
+
     /// A built-in scene by name with default parameters.
     pub fn builtin(name: &str) -> Result<Self> {
         Simulation::new(Scene::builtin(name)?)

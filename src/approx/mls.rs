@@ -511,6 +511,22 @@ impl NodalShapes {
         supports: &Supports,
         rows: usize,
     ) -> Result<()> {
+        self.rebuild_rows_on(points, supports, rows, &crate::ranks::Alone)
+    }
+
+    /// [`NodalShapes::rebuild_rows`] shared among `ranks`: each computes
+    /// the rows of its share ([`crate::ranks::share`], whole blocks of
+    /// rows), and the rows are gathered so that every rank holds them all,
+    /// with the same bits as one rank. A failing row is agreed over the
+    /// ranks: the first in index order, which every rank then evaluates
+    /// itself, names the error on all.
+    pub fn rebuild_rows_on(
+        &mut self,
+        points: &[[f64; 3]],
+        supports: &Supports,
+        rows: usize,
+        ranks: &dyn crate::ranks::Ranks,
+    ) -> Result<()> {
         refill(&mut self.offsets, rows + 1, 0);
         if points.is_empty() {
             self.offsets.truncate(1);
@@ -527,14 +543,19 @@ impl NodalShapes {
             |i: usize| move |j: usize| scaled_offset(points[i], points[j], radius[j]).1 < 1.0;
         let candidates =
             |i: usize, out: &mut Vec<usize>| covers.sorted_into(&points[i], i, covering(i), out);
-        // Pass 1: each row's length, into offsets[i + 1].
-        self.offsets[1..]
+        // Pass 1: each row's length, into offsets[i + 1] (this rank's
+        // share, then every rank's).
+        let shares = crate::ranks::shares(ranks, rows, ROWS_PER_BLOCK);
+        let own = shares[ranks.rank()].clone();
+        self.offsets[1 + own.start..1 + own.end]
             .par_iter_mut()
             .enumerate()
             .with_min_len(ROWS_PER_BLOCK)
-            .for_each(|(i, len)| {
+            .for_each(|(k, len)| {
+                let i = own.start + k;
                 *len = covers.count(&points[i], i, covering(i));
             });
+        crate::ranks::gather_parts(ranks, &shares, &mut self.offsets[1..]);
         for i in 0..rows {
             self.offsets[i + 1] += self.offsets[i];
         }
@@ -552,11 +573,13 @@ impl NodalShapes {
             let (n, rest_n) = nodes.split_at_mut(len);
             let (p, rest_p) = phi.split_at_mut(len);
             let (g, rest_g) = grad.split_at_mut(len);
-            blocks.push((first..last, n, p, g));
+            if own.contains(&first) {
+                blocks.push((first..last, n, p, g));
+            }
             (nodes, phi, grad) = (rest_n, rest_p, rest_g);
         }
         let offsets = &self.offsets;
-        let errors: Vec<Option<Error>> = blocks
+        let errors: Vec<Option<(usize, Error)>> = blocks
             .into_par_iter()
             .map_init(
                 || (ShapeRow::default(), Vec::new()),
@@ -567,7 +590,7 @@ impl NodalShapes {
                         if let Err(e) =
                             row.evaluate(points[i], list, points, &supports.radius, true, i)
                         {
-                            return Some(e);
+                            return Some((i, e));
                         }
                         let at = offsets[i] - base..offsets[i + 1] - base;
                         debug_assert_eq!(at.len(), row.nodes.len());
@@ -579,10 +602,39 @@ impl NodalShapes {
                 },
             )
             .collect();
-        match errors.into_iter().flatten().next() {
-            Some(e) => Err(e),
-            None => Ok(()),
+        let first = errors.into_iter().flatten().next();
+        if ranks.size() == 1 {
+            return first.map_or(Ok(()), |(_, e)| Err(e));
         }
+        // The first failing row over the ranks, evaluated by every rank.
+        let failing = ranks.all_min(first.as_ref().map_or(i64::MAX, |(i, _)| *i as i64));
+        if failing != i64::MAX {
+            let i = failing as usize;
+            if let Some((j, e)) = first
+                && j == i
+            {
+                return Err(e);
+            }
+            let mut list = Vec::new();
+            candidates(i, &mut list);
+            let mut row = ShapeRow::default();
+            return Err(row
+                .evaluate(points[i], &list, points, &supports.radius, true, i)
+                .err()
+                .unwrap_or(Error::NonFinite {
+                    field: "shape row (agreed over the ranks)",
+                    particle: i,
+                    time: 0.0,
+                }));
+        }
+        let entries: Vec<std::ops::Range<usize>> = shares
+            .iter()
+            .map(|r| self.offsets[r.start]..self.offsets[r.end])
+            .collect();
+        crate::ranks::gather_parts(ranks, &entries, &mut self.nodes);
+        crate::ranks::gather_parts(ranks, &entries, &mut self.phi);
+        crate::ranks::gather_parts(ranks, &entries, &mut self.grad);
+        Ok(())
     }
 
     /// Number of nodes.
@@ -607,6 +659,18 @@ impl NodalShapes {
         out.par_iter_mut()
             .enumerate()
             .for_each(|(i, l)| *l = self.gradient(i, velocity));
+    }
+
+    /// [`NodalShapes::velocity_gradients`] shared among `ranks`: each
+    /// computes its share of the nodes, then every rank holds them all
+    /// (the same bits).
+    pub fn velocity_gradients_on(
+        &self,
+        ranks: &dyn crate::ranks::Ranks,
+        velocity: &[[f64; 3]],
+        out: &mut [[[f64; 3]; 3]],
+    ) {
+        crate::ranks::each_row(ranks, out, |i, l| *l = self.gradient(i, velocity));
     }
 
     /// The collocated gradient (eq. 4) of the nodal vector field `field`

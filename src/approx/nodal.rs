@@ -206,7 +206,19 @@ impl NodalOperator {
     /// `stress` (`[xx, yy, zz, xy, yz, zx]`) on the nodal volumes
     /// `volume`, written into `out`.
     pub fn apply(&self, stress: &[[f64; 6]], volume: &[f64], out: &mut [[f64; 3]]) {
-        out.par_iter_mut().enumerate().for_each(|(j, f)| {
+        self.apply_on(&crate::ranks::Alone, stress, volume, out);
+    }
+
+    /// [`NodalOperator::apply`] shared among `ranks`: each computes its
+    /// share of the columns, then every rank holds them all (the same bits).
+    pub fn apply_on(
+        &self,
+        ranks: &dyn crate::ranks::Ranks,
+        stress: &[[f64; 6]],
+        volume: &[f64],
+        out: &mut [[f64; 3]],
+    ) {
+        crate::ranks::each_row(ranks, out, |j, f| {
             *f = [0.0; 3];
             for q in self.offsets[j]..self.offsets[j + 1] {
                 let i = self.nodes[q];

@@ -6,7 +6,9 @@ use super::output::{check_output_dir, check_output_file, final_json, write_json,
 use super::resume::{RunHost, begin};
 use super::signals;
 use super::stop::{Stop, errln, outcome, outln};
+use super::team;
 use indicatif::{ProgressBar, ProgressStyle};
+use meshless_impact::ranks::Handle;
 use meshless_impact::{Error, Isa, Simulation};
 use std::io::{IsTerminal, Write};
 use std::time::{Duration, Instant};
@@ -20,10 +22,36 @@ pub(crate) fn fmt_duration(s: f64) -> String {
 }
 
 pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
-    let (mut sim, mut host) = begin(&a)?;
-    if let Some(name) = &a.isa {
-        sim.set_isa(Isa::named(name).map_err(|e| Stop::failed(format!("--isa: {e}")))?);
+    let team = team::join()?;
+    let r = run_on(&team, a);
+    team::quiet_unless_root(&*team, r)
+}
+
+/// The run on the ranks of `team` (one alone without MPI): every rank
+/// steps the whole run, the passes over the nodes shared
+/// ([`meshless_impact::ranks`]); rank 0 writes the outputs and prints.
+fn run_on(team: &Handle, mut a: RunArgs) -> Result<(), Stop> {
+    let began = begin(&a).and_then(|(mut sim, host)| {
+        if let Some(name) = &a.isa {
+            sim.set_isa(Isa::named(name).map_err(|e| Stop::failed(format!("--isa: {e}")))?);
+        }
+        if team.size() > 1 {
+            sim.set_ranks(team.clone()).map_err(Stop::failed)?;
+        }
+        Ok((sim, host))
+    });
+    let (sim, mut host) = team::agree(&**team, began)?;
+    if team.rank() > 0 {
+        // Rank 0 writes and prints; the others hold the same run.
+        (host.json, host.csv, host.checkpoint) = (None, None, None);
+        (host.profile, host.vtk_dir) = (None, None);
+        a.quiet = true;
     }
+    run_sim(team, sim, host, &a)
+}
+
+/// The loop of [`run_on`] and the outputs of its end.
+fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -> Result<(), Stop> {
     let end_time = sim.end_time();
     // Every output is checked before the run, so that a typo does not cost
     // the results of a long run.
@@ -71,15 +99,25 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
     // Snapshots need the state between steps, so the loop is written out here.
     let mut status = Ok(());
     let mut interrupted = None;
+    // Another rank's failure at a step this rank passed (`team::diverged`).
+    let mut diverged = None;
     // The whole loop runs on a worker of the thread pool, so a step does not
     // wake a worker from this thread and wait to be woken in turn.
     rayon::scope(|_| {
         while !sim.finished() {
-            if let Some(sig) = signals::received() {
+            let signal = team::agree_signal(&**team, signals::received_number());
+            if let Some(sig) = signals::named(signal) {
                 interrupted = Some(sig);
                 break;
             }
-            if let Err(e) = sim.step() {
+            let stepped = sim.step();
+            if let Some(stop) =
+                team::diverged(&**team, stepped.as_ref().err().map(|e| e.to_string()))
+            {
+                diverged = Some(stop);
+                break;
+            }
+            if let Err(e) = stepped {
                 status = Err(e);
                 break;
             }
@@ -134,6 +172,9 @@ pub(crate) fn run(a: RunArgs) -> Result<(), Stop> {
     });
     if let Some(b) = bar {
         b.finish_and_clear();
+    }
+    if let Some(stop) = diverged {
+        return Err(stop);
     }
     let wall = wall_before + start.elapsed().as_secs_f64();
     host.wall_s = wall;

@@ -54,9 +54,15 @@ pub(crate) fn install() -> std::io::Result<()> {
     Ok(())
 }
 
-/// The signal that asked the run to stop, if one has.
-pub(crate) fn received() -> Option<&'static str> {
-    match FIRST.load(Ordering::SeqCst) {
+/// The number of the signal that asked the run to stop (0: none; its
+/// name: [`named`]).
+pub(crate) fn received_number() -> i32 {
+    FIRST.load(Ordering::SeqCst)
+}
+
+/// The name of signal `number` (`None` for 0).
+pub(crate) fn named(number: i32) -> Option<&'static str> {
+    match number {
         0 => None,
         libc::SIGTERM => Some("SIGTERM"),
         libc::SIGINT => Some("SIGINT"),

@@ -153,7 +153,9 @@ pub(super) fn build_geometry(
     let sup = g.supports.as_ref().expect("computed above");
     let mut buf = Vec::new();
     let pts = extended(&g.mirror, &state.built_at, &mut buf, mirror::vector);
-    g.shapes.rebuild_rows(pts, sup, n).map_err(stamp)?;
+    g.shapes
+        .rebuild_rows_on(pts, sup, n, &*pipe.ranks)
+        .map_err(stamp)?;
     pipe.profile.lap(Phase::Shapes, &mut watch);
     if setup.rod.scheme.forces == Forces::Conforming {
         // Node-wise arrays made on the pool: at 10^6 nodes a serial fill

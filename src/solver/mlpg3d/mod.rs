@@ -304,6 +304,9 @@ struct Pipeline3d {
     profile: PhaseTimes,
     /// The compiled copy of the hot loops (the best one by default).
     isa: Isa,
+    /// The ranks that share the passes over the nodes ([`crate::ranks`];
+    /// one alone by default).
+    ranks: crate::ranks::Handle,
 }
 
 /// The run's state is all it saves.

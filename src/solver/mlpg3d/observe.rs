@@ -134,6 +134,12 @@ impl Mlpg3d {
         self.pipe.isa = isa;
     }
 
+    /// Shares the passes over the nodes among `ranks` ([`crate::ranks`]):
+    /// the same bits on any number of ranks.
+    pub fn set_ranks(&mut self, ranks: crate::ranks::Handle) {
+        self.pipe.ranks = ranks;
+    }
+
     /// The heap bytes the run holds, by part (capacities, not lengths):
     /// node fields (with the reference lattice and the material state),
     /// the step's buffers, the supports, the shapes at the nodes, the test
@@ -421,5 +427,9 @@ impl crate::model::Model for Mlpg3d {
     }
     fn set_isa(&mut self, isa: Isa) {
         self.set_isa(isa);
+    }
+    fn set_ranks(&mut self, ranks: crate::ranks::Handle) -> std::result::Result<(), String> {
+        self.set_ranks(ranks);
+        Ok(())
     }
 }

@@ -642,4 +642,8 @@ impl crate::model::Model for Penetration {
     fn set_isa(&mut self, isa: crate::isa::Isa) {
         self.run.set_isa(isa);
     }
+    fn set_ranks(&mut self, ranks: crate::ranks::Handle) -> std::result::Result<(), String> {
+        self.run.set_ranks(ranks);
+        Ok(())
+    }
 }

@@ -53,7 +53,7 @@ pub(super) fn step_with(
         &mut scratch.forces.total,
     );
     forces(
-        g,
+        (g, &*pipe.ranks),
         nodal,
         (&setup.mass, &state.rho),
         &mut scratch.forces,
@@ -146,7 +146,8 @@ pub(super) fn step_with(
         &mut scratch.images.vel,
         mirror::vector,
     );
-    g.shapes.velocity_gradients(vel_ext, &mut scratch.grad);
+    g.shapes
+        .velocity_gradients_on(&*pipe.ranks, vel_ext, &mut scratch.grad);
     pipe.profile.lap(Phase::Gradients, &mut watch);
     update::update_material(
         &MaterialInputs {
@@ -286,7 +287,7 @@ fn total_stress(dev: &[Full], pressure: &[f64], visc: &[Full], total: &mut [[f64
 /// form (the adjoint of the gradients, the images' columns folded onto
 /// their nodes) or the seed's traction operator over the test spheres.
 fn forces(
-    g: &Geometry,
+    (g, ranks): (&Geometry, &dyn crate::ranks::Ranks),
     nodal: bool,
     (mass, rho): (&[f64], &[f64]),
     buffers: &mut ForceBuffers,
@@ -305,7 +306,7 @@ fn forces(
             .par_iter_mut()
             .zip(mass.par_iter().zip(rho.par_iter()))
             .for_each(|(v, (m, r))| *v = m / r);
-        g.nodal.apply(total, volume, force);
+        g.nodal.apply_on(ranks, total, volume, force);
         images.fold(n, force);
     } else {
         let total = extended(images, total, ext_total, mirror::tensor);

@@ -1,0 +1,131 @@
+//! The program's ranks over MPI (cargo feature `mpi`: rsmpi over MPICH):
+//! the library's [`Ranks`] on `MPI_COMM_WORLD`. Only the program knows
+//! MPI; the library, the C ABI and the FMUs are built without it.
+
+use meshless_impact::ranks::Ranks;
+use mpi::collective::SystemOperation;
+use mpi::datatype::PartitionMut;
+use mpi::environment::Universe;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::{Communicator, CommunicatorCollectives, Root};
+
+/// The bytes one rank sends in one round of [`Ranks::all_gather`]: MPI
+/// counts and displacements are 32-bit, so a larger gather (the shapes
+/// of 10^6 nodes are about a gigabyte) goes in rounds.
+const ROUND_BYTES: usize = 1 << 28;
+
+/// MPI_COMM_WORLD of an initialised MPI, with its universe (finalised when
+/// dropped, at the end of `main`).
+pub(crate) struct MpiRanks {
+    world: SimpleCommunicator,
+    rank: usize,
+    size: usize,
+    _universe: Universe,
+}
+
+impl std::fmt::Debug for MpiRanks {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MpiRanks {{ rank: {}, size: {} }}", self.rank, self.size)
+    }
+}
+
+// SAFETY: MPI is initialised with `Threading::Serialized` or more (checked
+// in `init`), and the solver calls the collectives from one thread at a
+// time (the step's sequential parts, never inside a parallel pass), which
+// is what that level allows.
+unsafe impl Send for MpiRanks {}
+// SAFETY: as above.
+unsafe impl Sync for MpiRanks {}
+
+/// MPI initialised for calls from one thread at a time (the run loop runs
+/// on a worker of the thread pool); `None` when it was already initialised
+/// or refuses that level.
+pub(crate) fn init() -> Result<MpiRanks, String> {
+    let (universe, level) = mpi::initialize_with_threading(mpi::Threading::Serialized)
+        .ok_or("MPI was initialised twice")?;
+    if level < mpi::Threading::Serialized {
+        return Err(format!(
+            "MPI gives threading level {level:?}; the solver needs Serialized (one thread at a time)"
+        ));
+    }
+    let world = universe.world();
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    Ok(MpiRanks {
+        world,
+        rank,
+        size,
+        _universe: universe,
+    })
+}
+
+impl Ranks for MpiRanks {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+    fn size(&self) -> usize {
+        self.size
+    }
+    fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]) {
+        debug_assert_eq!(local.len(), counts[self.rank]);
+        let starts: Vec<usize> = counts
+            .iter()
+            .scan(0, |s, &c| {
+                let at = *s;
+                *s += c;
+                Some(at)
+            })
+            .collect();
+        let rounds = counts
+            .iter()
+            .map(|c| c.div_ceil(ROUND_BYTES))
+            .max()
+            .unwrap_or(0);
+        let mut buf = Vec::new();
+        for k in 0..rounds {
+            let piece = |c: usize| (k * ROUND_BYTES).min(c)..((k + 1) * ROUND_BYTES).min(c);
+            let sizes: Vec<usize> = counts.iter().map(|&c| piece(c).len()).collect();
+            let displs: Vec<i32> = sizes
+                .iter()
+                .scan(0usize, |s, &c| {
+                    let at = *s;
+                    *s += c;
+                    Some(at as i32)
+                })
+                .collect();
+            let total: usize = sizes.iter().sum();
+            buf.clear();
+            buf.resize(total, 0u8);
+            let counts32: Vec<i32> = sizes.iter().map(|&c| c as i32).collect();
+            {
+                let mut part = PartitionMut::new(&mut buf[..], &counts32[..], &displs[..]);
+                self.world
+                    .all_gather_varcount_into(&local[piece(local.len())], &mut part);
+            }
+            for (r, &c) in counts.iter().enumerate() {
+                let p = piece(c);
+                let from = displs[r] as usize;
+                out[starts[r] + p.start..starts[r] + p.end]
+                    .copy_from_slice(&buf[from..from + p.len()]);
+            }
+        }
+    }
+    fn all_min(&self, value: i64) -> i64 {
+        let mut out = 0i64;
+        self.world
+            .all_reduce_into(&value, &mut out, SystemOperation::min());
+        out
+    }
+    fn all_max(&self, value: i64) -> i64 {
+        let mut out = 0i64;
+        self.world
+            .all_reduce_into(&value, &mut out, SystemOperation::max());
+        out
+    }
+    fn broadcast(&self, root: usize, bytes: &mut Vec<u8>) {
+        let root = self.world.process_at_rank(root as i32);
+        let mut len = bytes.len() as u64;
+        root.broadcast_into(&mut len);
+        bytes.resize(len as usize, 0);
+        root.broadcast_into(&mut bytes[..]);
+    }
+}

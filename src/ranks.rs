@@ -1,0 +1,223 @@
+//! The processes of one run (MPI's ranks) as the solver sees them: who I
+//! am, how many we are, and the few collective exchanges the 3-D solver
+//! needs. The core knows no MPI: the program built with the cargo feature
+//! `mpi` supplies an implementation over MPICH (`src/cli/mpi.rs`), and
+//! every other build runs [`Alone`].
+//!
+//! # Owner computes, the same bits on any number of ranks
+//!
+//! Every rank holds the whole state (replicated). A pass over the nodes
+//! that writes one value per node (a row of the shapes, a node's velocity
+//! gradient, its force) is split into contiguous shares of the rows,
+//! [`share`]; each rank computes its own share, and the shares are then
+//! gathered so that every rank holds every row ([`each_row`],
+//! [`Ranks::all_gather`]). A row's value depends only on the replicated
+//! state, never on who computed it, so a run gives the same bits on any
+//! number of ranks (and of threads within each). Sums over the nodes are
+//! taken after the gather, on every rank, in the fixed order of
+//! `approx::sums`.
+//!
+//! # Errors never hang
+//!
+//! A pass that can fail at a row agrees on the first failing row over all
+//! ranks ([`Ranks::all_min`]), and every rank then evaluates that row
+//! itself, so that all stop with the same named error at the same step.
+
+// The node fields travel as their bytes ([`Plain`]): two casts of a
+// slice, kept here with the marker trait that makes them sound.
+#![allow(unsafe_code)]
+
+use std::fmt::Debug;
+use std::ops::Range;
+
+/// The ranks of a run: this process's place among them and the collective
+/// exchanges. Every rank must make the same calls in the same order.
+pub trait Ranks: Debug + Send + Sync {
+    /// This rank, `0..size()`.
+    fn rank(&self) -> usize;
+
+    /// The number of ranks.
+    fn size(&self) -> usize;
+
+    /// Every rank's `local` bytes, concatenated in rank order into `out`,
+    /// whose length is the sum of `counts` (rank `r` gives `counts[r]`
+    /// bytes; `local.len() == counts[self.rank()]`).
+    fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]);
+
+    /// The smallest of every rank's `value`. (Signed: MPICH's reduction of
+    /// `MPI_UINT64_T` through rsmpi took 2^64 − 1 for the minimum of 0 and
+    /// 2^64 − 1, measured; `i64::MAX` is the "none" of a minimum here.)
+    fn all_min(&self, value: i64) -> i64;
+
+    /// The largest of every rank's `value`.
+    fn all_max(&self, value: i64) -> i64;
+
+    /// `bytes` of rank `root` on every rank (resized to its length).
+    fn broadcast(&self, root: usize, bytes: &mut Vec<u8>);
+}
+
+/// One process alone: every exchange is the identity.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Alone;
+
+impl Ranks for Alone {
+    fn rank(&self) -> usize {
+        0
+    }
+    fn size(&self) -> usize {
+        1
+    }
+    fn all_gather(&self, local: &[u8], _counts: &[usize], out: &mut [u8]) {
+        out.copy_from_slice(local);
+    }
+    fn all_min(&self, value: i64) -> i64 {
+        value
+    }
+    fn all_max(&self, value: i64) -> i64 {
+        value
+    }
+    fn broadcast(&self, _root: usize, _bytes: &mut Vec<u8>) {}
+}
+
+/// A shared handle on the ranks of a run, [`Alone`] by default: what a
+/// solver's workspace holds (cloned with it, never saved).
+#[derive(Debug, Clone)]
+pub struct Handle(std::sync::Arc<dyn Ranks>);
+
+impl Handle {
+    /// A handle on `ranks`.
+    pub fn new(ranks: std::sync::Arc<dyn Ranks>) -> Self {
+        Handle(ranks)
+    }
+}
+
+impl Default for Handle {
+    fn default() -> Self {
+        Handle(std::sync::Arc::new(Alone))
+    }
+}
+
+impl std::ops::Deref for Handle {
+    type Target = dyn Ranks;
+    fn deref(&self) -> &(dyn Ranks + 'static) {
+        &*self.0
+    }
+}
+
+/// Values that travel between ranks as their bytes: plain numbers and
+/// arrays of them, with no padding and no invalid bit patterns.
+///
+/// # Safety
+///
+/// Every bit pattern of `size_of::<Self>()` bytes must be a valid value,
+/// and the type must have no padding.
+pub unsafe trait Plain: Copy + Send + Sync + 'static {}
+
+// SAFETY: integers and floats: every bit pattern is a value, no padding.
+unsafe impl Plain for f64 {}
+// SAFETY: as above.
+unsafe impl Plain for u64 {}
+// SAFETY: as above.
+unsafe impl Plain for usize {}
+// SAFETY: an array of a plain type has its elements' bytes, no padding.
+unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
+
+/// The bytes of `v`.
+fn bytes<T: Plain>(v: &[T]) -> &[u8] {
+    // SAFETY: `T: Plain` has no padding, so every byte is initialised;
+    // the length is the slice's size in bytes.
+    unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
+}
+
+/// The bytes of `v`, writable.
+fn bytes_mut<T: Plain>(v: &mut [T]) -> &mut [u8] {
+    // SAFETY: as in `bytes`; any bytes written make valid `T`s (`Plain`).
+    unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
+}
+
+/// Rank `rank`'s share of `n` rows among `size` ranks: contiguous, in rank
+/// order, as equal as whole multiples of `align` rows allow (the last rank
+/// takes the remainder).
+pub fn share(n: usize, rank: usize, size: usize, align: usize) -> Range<usize> {
+    let align = align.max(1);
+    let units = n.div_ceil(align);
+    let at = |r: usize| (units * r / size * align).min(n);
+    at(rank)..at(rank + 1)
+}
+
+/// Every rank's share of `n` rows ([`share`]).
+pub fn shares(ranks: &dyn Ranks, n: usize, align: usize) -> Vec<Range<usize>> {
+    (0..ranks.size())
+        .map(|r| share(n, r, ranks.size(), align))
+        .collect()
+}
+
+/// After each rank has written its own part `parts[rank]` of `out`, every
+/// rank's parts gathered into `out` on every rank. `parts` are contiguous,
+/// in rank order, and cover `out`.
+pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &mut [T]) {
+    if ranks.size() == 1 {
+        return;
+    }
+    debug_assert_eq!(parts.last().map_or(0, |p| p.end), out.len());
+    let size = std::mem::size_of::<T>();
+    let counts: Vec<usize> = parts.iter().map(|p| p.len() * size).collect();
+    let own = bytes(&out[parts[ranks.rank()].clone()]).to_vec();
+    ranks.all_gather(&own, &counts, bytes_mut(out));
+}
+
+/// `f(i, &mut out[i])` for the rows of this rank's share (on the pool),
+/// then the shares gathered so that every rank holds every row.
+pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
+    use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
+    if ranks.size() == 1 {
+        // Alone: the plain pass, allocating nothing (a step between
+        // rebuilds allocates nothing, tests/mlpg_alloc.rs).
+        out.par_iter_mut().enumerate().for_each(|(i, v)| f(i, v));
+        return;
+    }
+    let parts = shares(ranks, out.len(), 1);
+    let own = parts[ranks.rank()].clone();
+    let start = own.start;
+    out[own]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(k, v)| f(start + k, v));
+    gather_parts(ranks, &parts, out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shares cover the rows once, in order, on their alignment, for
+    /// every count of rows and ranks tried.
+    #[test]
+    fn the_shares_cover_every_row_once_in_order() {
+        for size in 1..=5 {
+            for n in [0, 1, 2, 7, 255, 256, 257, 1000, 4097] {
+                for align in [1, 256] {
+                    let s: Vec<_> = (0..size).map(|r| share(n, r, size, align)).collect();
+                    assert_eq!(s[0].start, 0);
+                    assert_eq!(s[size - 1].end, n, "n {n} size {size} align {align}");
+                    for w in s.windows(2) {
+                        assert_eq!(w[0].end, w[1].start);
+                        assert!(w[0].end % align == 0 || w[0].end == n);
+                    }
+                }
+            }
+        }
+        // Equal shares where the rows divide.
+        assert_eq!(share(12, 1, 3, 1), 4..8);
+    }
+
+    /// Alone, a pass over the rows is the plain pass.
+    #[test]
+    fn alone_each_row_is_the_plain_pass() {
+        let mut out = vec![[0.0; 2]; 1001];
+        each_row(&Alone, &mut out, |i, v| *v = [i as f64, 2.0 * i as f64]);
+        for (i, v) in out.iter().enumerate() {
+            assert_eq!(*v, [i as f64, 2.0 * i as f64]);
+        }
+    }
+}
