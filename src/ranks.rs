@@ -166,6 +166,46 @@ pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &m
     ranks.all_gather(&own, &counts, bytes_mut(out));
 }
 
+/// [`gather_parts`] for values that are not [`Plain`]: each rank's part
+/// travels as the postcard encoding of its values mapped by `to`, and is
+/// written back on the other ranks by `from`.
+pub fn gather_encoded<T, W>(
+    ranks: &dyn Ranks,
+    parts: &[Range<usize>],
+    out: &mut [T],
+    to: impl Fn(&T) -> W,
+    from: impl Fn(&mut T, W),
+) where
+    W: serde::Serialize + serde::de::DeserializeOwned,
+{
+    if ranks.size() == 1 {
+        return;
+    }
+    let me = ranks.rank();
+    let wire: Vec<W> = out[parts[me].clone()].iter().map(to).collect();
+    let own = postcard::to_allocvec(&wire).expect("values encode into a vector");
+    let mut lengths = vec![0u64; ranks.size()];
+    lengths[me] = own.len() as u64;
+    let each: Vec<Range<usize>> = (0..ranks.size()).map(|r| r..r + 1).collect();
+    gather_parts(ranks, &each, &mut lengths);
+    let counts: Vec<usize> = lengths.iter().map(|&l| l as usize).collect();
+    let mut all = vec![0u8; counts.iter().sum()];
+    ranks.all_gather(&own, &counts, &mut all);
+    let mut at = 0;
+    for (r, part) in parts.iter().enumerate() {
+        let bytes = &all[at..at + counts[r]];
+        at += counts[r];
+        if r == me {
+            continue;
+        }
+        // The same program encoded them: a failure is a fault, not input.
+        let values: Vec<W> = postcard::from_bytes(bytes).expect("a rank's values decode");
+        for (slot, v) in out[part.clone()].iter_mut().zip(values) {
+            from(slot, v);
+        }
+    }
+}
+
 /// `f(i, &mut out[i])` for the rows of this rank's share (on the pool),
 /// then the shares gathered so that every rank holds every row.
 pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {

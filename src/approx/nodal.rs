@@ -189,7 +189,19 @@ impl NodalOperator {
     /// `(Φ v)_i = Σ_J φ_J(x_i) v_J`: `out_J = y_J − Σ_i φ_J(x_i) y_i`
     /// (`y_J = 0` for a column past `y`, a mirror image).
     pub fn defect_transpose(&self, y: &[[f64; 3]], out: &mut [[f64; 3]]) {
-        out.par_iter_mut().enumerate().for_each(|(j, o)| {
+        self.defect_transpose_on(&crate::ranks::Alone, y, out);
+    }
+
+    /// [`NodalOperator::defect_transpose`] shared among `ranks`: each
+    /// computes its share of the columns, then every rank holds them all
+    /// (the same bits).
+    pub fn defect_transpose_on(
+        &self,
+        ranks: &dyn crate::ranks::Ranks,
+        y: &[[f64; 3]],
+        out: &mut [[f64; 3]],
+    ) {
+        crate::ranks::each_row(ranks, out, |j, o| {
             let mut m = [0.0; 3];
             for q in self.offsets[j]..self.offsets[j + 1] {
                 let (yi, p) = (y[self.nodes[q]], self.phi[q]);

@@ -10,8 +10,9 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives, Root};
 
 /// The bytes one rank sends in one round of [`Ranks::all_gather`]: MPI
-/// counts and displacements are 32-bit, so a larger gather (the shapes
-/// of 10^6 nodes are about a gigabyte) goes in rounds.
+/// counts and displacements are 32-bit, so a gather past 2^31 bytes (the
+/// shapes of 10^6 nodes are about a gigabyte) goes in rounds through a
+/// buffer; a smaller one goes in one call, straight into its place.
 const ROUND_BYTES: usize = 1 << 28;
 
 /// MPI_COMM_WORLD of an initialised MPI, with its universe (finalised when
@@ -75,6 +76,14 @@ impl Ranks for MpiRanks {
                 Some(at)
             })
             .collect();
+        if out.len() <= i32::MAX as usize {
+            // One call, straight into `out`.
+            let counts32: Vec<i32> = counts.iter().map(|&c| c as i32).collect();
+            let displs: Vec<i32> = starts.iter().map(|&s| s as i32).collect();
+            let mut part = PartitionMut::new(out, &counts32[..], &displs[..]);
+            self.world.all_gather_varcount_into(local, &mut part);
+            return;
+        }
         let rounds = counts
             .iter()
             .map(|c| c.div_ceil(ROUND_BYTES))

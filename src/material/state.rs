@@ -144,6 +144,41 @@ impl MaterialState {
         &mut self.points
     }
 
+    /// After each rank of `ranks` has stepped the points of its part
+    /// `parts[rank]`, every rank's damage variables on every rank
+    /// ([`crate::ranks`]). The caches stay each rank's own: they give the
+    /// same bits whether kept or rebuilt.
+    pub fn gather(
+        points: &mut [PointState],
+        ranks: &dyn crate::ranks::Ranks,
+        parts: &[std::ops::Range<usize>],
+    ) {
+        /// The damage variables as they travel.
+        #[derive(serde::Serialize, serde::Deserialize)]
+        enum Wire {
+            None,
+            Ceramic(CeramicVars),
+            Jh2(Jh2Point),
+        }
+        crate::ranks::gather_encoded(
+            ranks,
+            parts,
+            points,
+            |p| match p.vars {
+                Vars::None => Wire::None,
+                Vars::Ceramic(c) => Wire::Ceramic(c),
+                Vars::Jh2(j) => Wire::Jh2(j),
+            },
+            |p, w| {
+                p.vars = match w {
+                    Wire::None => Vars::None,
+                    Wire::Ceramic(c) => Vars::Ceramic(c),
+                    Wire::Jh2(j) => Vars::Jh2(j),
+                }
+            },
+        );
+    }
+
     /// Whether some point holds damage variables.
     pub fn has_damage(&self) -> bool {
         self.points.iter().any(|p| p.vars != Vars::None)

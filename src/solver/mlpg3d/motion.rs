@@ -44,6 +44,8 @@ pub(super) struct Frame<'a> {
     pub(super) plane: &'a [u8],
     /// The nodes held still (else empty).
     pub(super) held: &'a [bool],
+    /// The ranks that share the passes over the nodes ([`crate::ranks`]).
+    pub(super) ranks: &'a dyn crate::ranks::Ranks,
 }
 
 /// The velocities `v += dt F / inertia`; a node on the anvil is held while
@@ -140,7 +142,7 @@ pub(super) fn smooth(
     } else {
         &mut buffers.defect
     };
-    weighted.par_iter_mut().enumerate().for_each(|(i, out)| {
+    crate::ranks::each_row(frame.ranks, weighted, |i, out| {
         let mut m = [0.0; 3];
         for q in shapes.row(i) {
             let vj = vel_ext[shapes.nodes[q]];
@@ -153,7 +155,8 @@ pub(super) fn smooth(
     });
     if order2 {
         buffers.defect.resize(n + images.len(), [0.0; 3]);
-        g.nodal.defect_transpose(&buffers.pass, &mut buffers.defect);
+        g.nodal
+            .defect_transpose_on(frame.ranks, &buffers.pass, &mut buffers.defect);
         images.fold(n, &mut buffers.defect);
     }
     let defect = &buffers.defect;

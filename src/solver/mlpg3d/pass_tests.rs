@@ -91,6 +91,7 @@ fn frame<'a>(g: &'a Geometry, mass: &'a [f64], rho: &'a [f64], group: &'a [u8]) 
         group,
         plane: &[],
         held: &[],
+        ranks: &crate::ranks::Alone,
     }
 }
 
@@ -158,6 +159,7 @@ fn material_pass(
     };
     let mut states = vec![PointState::default(); n];
     update_material(
+        &crate::ranks::Alone,
         &MaterialInputs {
             dt: DT,
             damping_time,
@@ -167,6 +169,7 @@ fn material_pass(
             mass,
             vel,
             grad,
+            damaging: false,
         },
         MaterialFields {
             dev: &mut out.dev,

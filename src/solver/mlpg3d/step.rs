@@ -77,6 +77,7 @@ pub(super) fn step_with(
         group: &setup.group,
         plane: &setup.plane,
         held: &setup.held,
+        ranks: &*pipe.ranks,
     };
     motion::kick(
         &frame,
@@ -150,6 +151,7 @@ pub(super) fn step_with(
         .velocity_gradients_on(&*pipe.ranks, vel_ext, &mut scratch.grad);
     pipe.profile.lap(Phase::Gradients, &mut watch);
     update::update_material(
+        &*pipe.ranks,
         &MaterialInputs {
             dt,
             damping_time: setup.damping_time,
@@ -159,6 +161,7 @@ pub(super) fn step_with(
             mass: &setup.mass,
             vel: &state.vel,
             grad: &scratch.grad,
+            damaging,
         },
         MaterialFields {
             dev: &mut state.dev,

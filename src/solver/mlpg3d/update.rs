@@ -36,6 +36,9 @@ pub(super) struct MaterialInputs<'a> {
     pub(super) vel: &'a [[f64; 3]],
     /// The velocity gradient `L = ∂v/∂x` at each node.
     pub(super) grad: &'a [[[f64; 3]; 3]],
+    /// Some material damages (its points hold damage variables, which
+    /// ranks that share the pass exchange).
+    pub(super) damaging: bool,
 }
 
 /// The node fields the material pass updates.
@@ -54,9 +57,142 @@ pub(super) struct MaterialFields<'a> {
 /// first error met at it: the compression limit, a non-finite field) to
 /// `results`.
 pub(super) fn update_material(
+    ranks: &dyn crate::ranks::Ranks,
     input: &MaterialInputs,
     fields: MaterialFields,
     results: &mut [std::result::Result<Tally, (usize, Error)>],
+) {
+    if ranks.size() == 1 {
+        update_rows(input, fields, results, 0);
+        return;
+    }
+    // Each rank steps its share of the points, then every rank holds
+    // every point's fields, damage variables and result ([`crate::ranks`]).
+    use crate::ranks::gather_parts;
+    let parts = crate::ranks::shares(ranks, results.len(), 1);
+    let own = parts[ranks.rank()].clone();
+    let MaterialFields {
+        dev,
+        pressure,
+        eps_p,
+        temp,
+        rho,
+        visc,
+        states,
+    } = fields;
+    update_rows(
+        input,
+        MaterialFields {
+            dev: &mut dev[own.clone()],
+            pressure: &mut pressure[own.clone()],
+            eps_p: &mut eps_p[own.clone()],
+            temp: &mut temp[own.clone()],
+            rho: &mut rho[own.clone()],
+            visc: &mut visc[own.clone()],
+            states: &mut states[own.clone()],
+        },
+        &mut results[own.clone()],
+        own.start,
+    );
+    gather_parts(ranks, &parts, dev);
+    gather_parts(ranks, &parts, pressure);
+    gather_parts(ranks, &parts, eps_p);
+    gather_parts(ranks, &parts, temp);
+    gather_parts(ranks, &parts, rho);
+    gather_parts(ranks, &parts, visc);
+    if input.damaging {
+        crate::material::MaterialState::gather(states, ranks, &parts);
+    }
+    let mut wire: Vec<[f64; 8]> = results.iter().map(encode).collect();
+    gather_parts(ranks, &parts, &mut wire);
+    for (k, r) in results.iter_mut().enumerate() {
+        if !own.contains(&k) {
+            *r = decode(&wire[k]);
+        }
+    }
+}
+
+/// The fields of a non-finite value, as [`encode`] numbers them.
+const NON_FINITE_FIELDS: [&str; 4] = ["velocity", "density", "stress", "temperature"];
+
+/// A point's result as it travels between ranks: `[0, the tally]`, or
+/// `[1, point, compression, limit]` for [`Error::CompressionLimit`], or
+/// `[2, point, field]` for [`Error::NonFinite`] (the only errors of the
+/// pass).
+fn encode(r: &std::result::Result<Tally, (usize, Error)>) -> [f64; 8] {
+    match r {
+        Ok(t) => [
+            0.0,
+            t.internal,
+            t.plastic,
+            t.damping,
+            t.kinetic,
+            t.momentum,
+            t.mass,
+            t.worst_speed,
+        ],
+        Err((
+            i,
+            Error::CompressionLimit {
+                compression, limit, ..
+            },
+        )) => [1.0, *i as f64, *compression, *limit, 0.0, 0.0, 0.0, 0.0],
+        Err((i, e)) => {
+            let field = match e {
+                Error::NonFinite { field, .. } => NON_FINITE_FIELDS
+                    .iter()
+                    .position(|f| f == field)
+                    .unwrap_or(NON_FINITE_FIELDS.len()),
+                _ => NON_FINITE_FIELDS.len(),
+            };
+            [2.0, *i as f64, field as f64, 0.0, 0.0, 0.0, 0.0, 0.0]
+        }
+    }
+}
+
+/// The result of [`encode`].
+fn decode(w: &[f64; 8]) -> std::result::Result<Tally, (usize, Error)> {
+    let i = w[1] as usize;
+    match w[0] as u8 {
+        0 => Ok(Tally {
+            internal: w[1],
+            plastic: w[2],
+            damping: w[3],
+            kinetic: w[4],
+            momentum: w[5],
+            mass: w[6],
+            worst_speed: w[7],
+        }),
+        1 => Err((
+            i,
+            Error::CompressionLimit {
+                particle: i,
+                time: 0.0,
+                compression: w[2],
+                limit: w[3],
+            },
+        )),
+        _ => Err((
+            i,
+            Error::NonFinite {
+                field: NON_FINITE_FIELDS
+                    .get(w[2] as usize)
+                    .copied()
+                    .unwrap_or("material state"),
+                particle: i,
+                time: 0.0,
+            },
+        )),
+    }
+}
+
+/// The material pass over the points of `fields` and `results`, the first
+/// of them point `start`.
+fn update_rows(
+    input: &MaterialInputs,
+    fields: MaterialFields,
+    results: &mut [std::result::Result<Tally, (usize, Error)>],
+    start: usize,
 ) {
     let MaterialInputs {
         dt,
@@ -67,6 +203,7 @@ pub(super) fn update_material(
         mass,
         vel,
         grad,
+        damaging: _,
     } = *input;
     fields
         .dev
@@ -80,7 +217,8 @@ pub(super) fn update_material(
         .zip(results.par_iter_mut())
         .enumerate()
         .for_each(
-            |(i, (((((((dev, p), eps), temp), rho), visc), state), out))| {
+            |(k, (((((((dev, p), eps), temp), rho), visc), state), out))| {
+                let i = start + k;
                 *out = (|| {
                     let material = material_of(rod_material, others, group, i);
                     let l = &grad[i];
