@@ -44,6 +44,7 @@ pub enum Freedom {
 /// any number of threads).
 #[allow(clippy::too_many_arguments)]
 pub fn shifts(
+    ranks: &dyn crate::ranks::Ranks,
     pos: &[[f64; 3]],
     shapes: &NodalShapes,
     free: &[Freedom],
@@ -54,7 +55,7 @@ pub fn shifts(
     out: &mut [[f64; 3]],
 ) {
     let range2 = range * range;
-    out.par_iter_mut().enumerate().for_each(|(i, d)| {
+    crate::ranks::each_row(ranks, out, |i, d| {
         *d = [0.0; 3];
         if free[i] == Freedom::Fixed {
             return;
@@ -109,12 +110,13 @@ pub fn shifts(
 /// test 7 at 600 m/s; README, "Particle shifting"). Nodes in parallel, from
 /// `f` before any moves.
 pub fn carry<const K: usize>(
+    ranks: &dyn crate::ranks::Ranks,
     shapes: &NodalShapes,
     f: &[[f64; K]],
     d: &[[f64; 3]],
     out: &mut [[f64; K]],
 ) {
-    out.par_iter_mut().enumerate().for_each(|(i, o)| {
+    crate::ranks::each_row(ranks, out, |i, o| {
         *o = f[i];
         let di = d[i];
         if di == [0.0; 3] {
@@ -243,7 +245,7 @@ mod tests {
             d[i] = [0.03, -0.02 * k as f64, 0.04];
         }
         let mut out = vec![[0.0; 2]; pts.len()];
-        carry(&shapes, &f, &d, &mut out);
+        carry(&crate::ranks::Alone, &shapes, &f, &d, &mut out);
         for i in 0..pts.len() {
             let x: [f64; 3] = std::array::from_fn(|k| pts[i][k] + d[i][k]);
             let want = lin(x);
@@ -342,7 +344,7 @@ mod tests {
             .sum();
         assert!(f[i][0] + 0.05 * g < 0.0, "the gradient is one-sided: {g}");
         let mut out = vec![[0.0; 1]; pts.len()];
-        carry(&shapes, &f, &d, &mut out);
+        carry(&crate::ranks::Alone, &shapes, &f, &d, &mut out);
         assert_eq!(out[i][0], 0.0);
     }
 
@@ -361,12 +363,32 @@ mod tests {
         let free = vec![Freedom::Free; n];
         let (beta, range) = (0.1, 0.5);
         let mut d = vec![[1.0; 3]; n];
-        shifts(&pts, &shapes, &free, 1.0, range, beta, 1.0, &mut d);
+        shifts(
+            &crate::ranks::Alone,
+            &pts,
+            &shapes,
+            &free,
+            1.0,
+            range,
+            beta,
+            1.0,
+            &mut d,
+        );
         assert!(d.iter().all(|d| *d == [0.0; 3]));
         // Node b = (2, 2, 3) brought to 0.2 above a = (2, 2, 2).
         let (a, b) = (2 + 5 * 2 + 25, 2 + 5 * 2 + 50);
         pts[b][2] = pts[a][2] + 0.2;
-        shifts(&pts, &shapes, &free, 1.0, range, beta, 1.0, &mut d);
+        shifts(
+            &crate::ranks::Alone,
+            &pts,
+            &shapes,
+            &free,
+            1.0,
+            range,
+            beta,
+            1.0,
+            &mut d,
+        );
         let push = beta * (1.0f64 - 0.2 / 0.5).powi(2);
         assert!((d[b][2] - push).abs() < 1e-15 && d[b][0] == 0.0 && d[b][1] == 0.0);
         assert!((d[a][2] + push).abs() < 1e-15 && d[a][0] == 0.0 && d[a][1] == 0.0);
@@ -375,12 +397,32 @@ mod tests {
                 .enumerate()
                 .all(|(i, d)| i == a || i == b || *d == [0.0; 3])
         );
-        shifts(&pts, &shapes, &free, 1.0, range, beta, 0.01, &mut d);
+        shifts(
+            &crate::ranks::Alone,
+            &pts,
+            &shapes,
+            &free,
+            1.0,
+            range,
+            beta,
+            0.01,
+            &mut d,
+        );
         assert!((d[b][2] - 0.01).abs() < 1e-15);
         let mut some = free.clone();
         some[a] = Freedom::Fixed;
         some[b] = Freedom::InPlane([0.0, 0.0, 1.0]);
-        shifts(&pts, &shapes, &some, 1.0, range, beta, 1.0, &mut d);
+        shifts(
+            &crate::ranks::Alone,
+            &pts,
+            &shapes,
+            &some,
+            1.0,
+            range,
+            beta,
+            1.0,
+            &mut d,
+        );
         assert_eq!((d[a], d[b]), ([0.0; 3], [0.0; 3]));
     }
 
@@ -397,14 +439,34 @@ mod tests {
         // a at 0.1 above the anvil: its image is 0.2 away.
         pts[a][2] = 0.1;
         let mut d = vec![[0.0; 3]; n];
-        shifts(&pts, &shapes, &free, 1.0, 0.5, 0.1, 1.0, &mut d);
+        shifts(
+            &crate::ranks::Alone,
+            &pts,
+            &shapes,
+            &free,
+            1.0,
+            0.5,
+            0.1,
+            1.0,
+            &mut d,
+        );
         let push = 0.1 * (1.0f64 - 0.2 / 0.5).powi(2);
         assert!((d[a][2] - push).abs() < 1e-15, "{:?}", d[a]);
         // b brought to 0.01 above a at 0.05: b pushes a down by 0.96 and
         // its image up by 0.64, past the plane, where it stops.
         pts[a][2] = 0.05;
         pts[b][2] = 0.06;
-        shifts(&pts, &shapes, &free, 1.0, 0.5, 1.0, 1.0, &mut d);
+        shifts(
+            &crate::ranks::Alone,
+            &pts,
+            &shapes,
+            &free,
+            1.0,
+            0.5,
+            1.0,
+            1.0,
+            &mut d,
+        );
         assert_eq!(d[a][2], -0.05);
     }
 }

@@ -61,7 +61,7 @@ use rayon::iter::ParallelIterator;
 pub(super) fn shift(
     setup: &Setup3d,
     state: &mut State3d,
-    g: &Geometry,
+    (g, ranks): (&Geometry, &dyn crate::ranks::Ranks),
     scratch: &mut Scratch,
 ) -> Result<()> {
     let frame = ShiftFrame {
@@ -85,6 +85,7 @@ pub(super) fn shift(
     let pos = extended(images, &state.pos, &mut ext.pos, mirror::vector);
     let (spacing, step_scale) = (frame.spacing, setup.rod.step_scale());
     shifts(
+        ranks,
         pos,
         &g.shapes,
         &buffers.free,
@@ -121,7 +122,13 @@ pub(super) fn shift(
     };
     pack(&fields, frame.points, &mut buffers.carried);
     let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
-    carry(&g.shapes, carried, &buffers.shift, &mut buffers.carried_out);
+    carry(
+        ranks,
+        &g.shapes,
+        carried,
+        &buffers.shift,
+        &mut buffers.carried_out,
+    );
     let conservative = setup.rod.conservative_carry;
     let mut ke = [0.0; 2];
     if conservative {

@@ -134,7 +134,7 @@ pub(super) fn step_with(
     pipe.profile.lap(Phase::Move, &mut watch);
     if setup.rod.scheme.shifting > 0.0 {
         let g = pipe.geometry.as_ref().expect("built before the step");
-        shifting::shift(setup, state, g, scratch)?;
+        shifting::shift(setup, state, (g, &*pipe.ranks), scratch)?;
     }
     pipe.profile.lap(Phase::Shift, &mut watch);
     // 4. The geometry follows the body.

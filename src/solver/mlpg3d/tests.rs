@@ -139,7 +139,13 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             scratch.fit(n);
             scratch.fit_shift(n);
             let g = run.pipe.geometry.as_ref().unwrap();
-            super::shifting::shift(&run.setup, &mut run.state, g, &mut scratch).unwrap();
+            super::shifting::shift(
+                &run.setup,
+                &mut run.state,
+                (g, &crate::ranks::Alone),
+                &mut scratch,
+            )
+            .unwrap();
             let moved = (0..n).filter(|&i| run.state.pos[i] != pos0[i]).count();
             assert!(moved >= 3, "{moved} nodes moved");
             let (p1, _) = momentum(&run);
