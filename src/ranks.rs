@@ -206,6 +206,19 @@ pub fn gather_encoded<T, W>(
     }
 }
 
+/// The largest of every rank's `value` by [`f64::max`] in rank order (a
+/// NaN loses, as in a serial `fold` by `f64::max`).
+pub fn all_max_f64(ranks: &dyn Ranks, value: f64) -> f64 {
+    if ranks.size() == 1 {
+        return value;
+    }
+    let mut all = vec![0.0; ranks.size()];
+    all[ranks.rank()] = value;
+    let each: Vec<Range<usize>> = (0..ranks.size()).map(|r| r..r + 1).collect();
+    gather_parts(ranks, &each, &mut all);
+    all.into_iter().fold(0.0, f64::max)
+}
+
 /// `f(i, &mut out[i])` for the rows of this rank's share (on the pool),
 /// then the shares gathered so that every rank holds every row.
 pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {

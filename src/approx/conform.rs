@@ -418,15 +418,46 @@ impl Fused {
 
     /// `y = A mu`, in the compiled copy `isa` (every copy gives the same
     /// bits: [`crate::isa`]).
+    #[cfg(test)]
     fn apply(&mut self, isa: Isa, sys: &System, mu: &[[f64; 3]], y: &mut [[f64; 3]]) {
-        self.w
+        self.apply_on(&crate::ranks::Alone, isa, sys, mu, y);
+    }
+
+    /// [`Fused::apply`] shared among `ranks`: each computes the rows of
+    /// its share (whole tasks of [`ROWS`]), the rows are gathered, then
+    /// each computes its share of the columns, and the columns are
+    /// gathered (the same bits on any number of ranks).
+    fn apply_on(
+        &mut self,
+        ranks: &dyn crate::ranks::Ranks,
+        isa: Isa,
+        sys: &System,
+        mu: &[[f64; 3]],
+        y: &mut [[f64; 3]],
+    ) {
+        let n = self.w.len();
+        let parts = if ranks.size() == 1 {
+            Vec::new()
+        } else {
+            crate::ranks::shares(ranks, n, ROWS)
+        };
+        let own = parts.get(ranks.rank()).cloned().unwrap_or(0..n);
+        let first = own.start;
+        self.w[own.clone()]
             .par_chunks_mut(ROWS)
             .enumerate()
-            .for_each(|(k, w)| row_pass(isa, sys, mu, k * ROWS, w));
+            .for_each(|(k, w)| row_pass(isa, sys, mu, first + k * ROWS, w));
+        if !parts.is_empty() {
+            crate::ranks::gather_parts(ranks, &parts, &mut self.w);
+        }
         let (diag, w) = (&self.diag[..], &self.w[..]);
-        y.par_chunks_mut(ROWS)
+        y[own]
+            .par_chunks_mut(ROWS)
             .enumerate()
-            .for_each(|(k, y)| column_pass(isa, sys, diag, w, mu, k * ROWS, y));
+            .for_each(|(k, y)| column_pass(isa, sys, diag, w, mu, first + k * ROWS, y));
+        if !parts.is_empty() {
+            crate::ranks::gather_parts(ranks, &parts, y);
+        }
     }
 }
 
@@ -502,7 +533,7 @@ hot! {
 /// (on `taylor3d` at 10 across the start's residual is on average a sixth
 /// of the cold one, from 0.02 to 0.93 of it).
 pub fn conform(
-    isa: Isa,
+    (isa, ranks): (Isa, &dyn crate::ranks::Ranks),
     shapes: &mut NodalShapes,
     points: &[[f64; 3]],
     volume: &[f64],
@@ -594,7 +625,7 @@ pub fn conform(
         .collect();
     let mut ap = filled(n, [0.0; 3]);
     if mu.par_iter().any(|m| m.iter().any(|&m| m != 0.0)) {
-        fused.apply(isa, &sys, mu, &mut ap);
+        fused.apply_on(ranks, isa, &sys, mu, &mut ap);
         let warm: Vec<[f64; 3]> = r
             .par_iter()
             .zip(&ap)
@@ -616,7 +647,7 @@ pub fn conform(
     let mut iterations = 0;
     let flexible = levels.as_ref().is_some_and(|l| !l.linear());
     while inner_max(&r) > goal && iterations < CONFORM_ITERATIONS {
-        fused.apply(isa, &sys, &p, &mut ap);
+        fused.apply_on(ranks, isa, &sys, &p, &mut ap);
         let pap = dot(&p, &ap);
         if pap <= 0.0 {
             break;
@@ -653,24 +684,51 @@ pub fn conform(
     let levels = levels.map(|l| l.sizes()).unwrap_or_default();
     // g_q += V_i e_q, row by row in place (no buffer of the 3 nnz e_q):
     // the λ_i first, while the system holds the shapes.
-    let lambda: Vec<[[f64; 3]; 4]> = (0..n).into_par_iter().map(|i| sys.lambda(i, mu)).collect();
+    // Shared among the ranks: each corrects the rows of its share, the
+    // rows' entries are gathered, and each measures its share of the
+    // columns (the largest over the ranks' largest).
+    let parts = if ranks.size() == 1 {
+        Vec::new()
+    } else {
+        crate::ranks::shares(ranks, n, ROWS)
+    };
+    let own = parts.get(ranks.rank()).cloned().unwrap_or(0..n);
+    let lambda: Vec<[[f64; 3]; 4]> = own
+        .clone()
+        .into_par_iter()
+        .map(|i| sys.lambda(i, mu))
+        .collect();
     let (offsets, nodes) = (&shapes.offsets, &shapes.nodes);
-    for_segments(&mut shapes.grad, offsets, &|i, grad| {
-        let v = volume[i];
-        for (g, q) in grad.iter_mut().zip(offsets[i]..offsets[i + 1]) {
-            let j = nodes[q];
-            let p = offset(points[j], points[i]);
-            let e = entry(p, inner[j], mu[j], &lambda[i]);
-            for d in 0..3 {
-                g[d] += v * e[d];
+    let first = own.start;
+    for_segments(
+        &mut shapes.grad,
+        &offsets[own.start..=own.end],
+        &|k, grad| {
+            let i = first + k;
+            let v = volume[i];
+            for (g, q) in grad.iter_mut().zip(offsets[i]..offsets[i + 1]) {
+                let j = nodes[q];
+                let p = offset(points[j], points[i]);
+                let e = entry(p, inner[j], mu[j], &lambda[k]);
+                for d in 0..3 {
+                    g[d] += v * e[d];
+                }
             }
-        }
-    });
+        },
+    );
+    if !parts.is_empty() {
+        let entries: Vec<std::ops::Range<usize>> = parts
+            .iter()
+            .map(|r| shapes.offsets[r.start]..shapes.offsets[r.end])
+            .collect();
+        crate::ranks::gather_parts(ranks, &entries, &mut shapes.grad);
+    }
     // The constraint after, measured afresh (the largest is the same in
     // any order).
     let cols = &columns;
     let grad = &shapes.grad;
-    let after = (0..n)
+    let after = own
+        .clone()
         .into_par_iter()
         .filter(|&j| inner[j])
         .map(|j| {
@@ -684,6 +742,7 @@ pub fn conform(
             norm3(s)
         })
         .reduce(|| 0.0, f64::max);
+    let after = crate::ranks::all_max_f64(ranks, after);
     Conformed {
         iterations,
         before,
@@ -785,7 +844,7 @@ mod tests {
         let plain = inner_force(&shapes, &lat);
         let inner: Vec<bool> = lat.surfaces.iter().map(|s| s.interior()).collect();
         let c = conform(
-            Isa::best(),
+            (Isa::best(), &crate::ranks::Alone),
             &mut shapes,
             pts,
             &lat.volume,
@@ -842,7 +901,7 @@ mod tests {
         let solve = |pts: &[[f64; 3]], mu: &mut Vec<[f64; 3]>| {
             let mut shapes = NodalShapes::build(pts, &sup).unwrap();
             let c = conform(
-                Isa::best(),
+                (Isa::best(), &crate::ranks::Alone),
                 &mut shapes,
                 pts,
                 &lat.volume,
@@ -918,7 +977,7 @@ mod tests {
             .unwrap();
         let c = pool.install(|| {
             conform(
-                Isa::best(),
+                (Isa::best(), &crate::ranks::Alone),
                 &mut shapes,
                 pts,
                 &lat.volume,

@@ -177,7 +177,7 @@ pub(super) fn build_geometry(
         }
         copy_from(&mut g.multipliers, &state.built_multipliers);
         let c = conform(
-            pipe.isa,
+            (pipe.isa, &*pipe.ranks),
             &mut g.shapes,
             pts,
             &volume,
