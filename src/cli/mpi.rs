@@ -8,6 +8,7 @@ use mpi::datatype::PartitionMut;
 use mpi::environment::Universe;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives, Root};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The bytes one rank sends in one round of [`Ranks::all_gather`]: MPI
 /// counts and displacements are 32-bit, so a gather past 2^31 bytes (the
@@ -21,7 +22,26 @@ pub(crate) struct MpiRanks {
     world: SimpleCommunicator,
     rank: usize,
     size: usize,
+    /// Collective calls made and bytes this rank received in gathers and
+    /// broadcasts: the communication's measure (`MI_MPI_STATS=1` prints
+    /// them at the end).
+    calls: AtomicU64,
+    received: AtomicU64,
     _universe: Universe,
+}
+
+impl Drop for MpiRanks {
+    fn drop(&mut self) {
+        if std::env::var_os("MI_MPI_STATS").is_some() {
+            eprintln!(
+                "mpi: rank {} of {}: {} collective calls, {} bytes received",
+                self.rank,
+                self.size,
+                self.calls.load(Ordering::Relaxed),
+                self.received.load(Ordering::Relaxed)
+            );
+        }
+    }
 }
 
 impl std::fmt::Debug for MpiRanks {
@@ -55,6 +75,8 @@ pub(crate) fn init() -> Result<MpiRanks, String> {
         world,
         rank,
         size,
+        calls: AtomicU64::new(0),
+        received: AtomicU64::new(0),
         _universe: universe,
     })
 }
@@ -68,6 +90,9 @@ impl Ranks for MpiRanks {
     }
     fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]) {
         debug_assert_eq!(local.len(), counts[self.rank]);
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.received
+            .fetch_add((out.len() - local.len()) as u64, Ordering::Relaxed);
         let starts: Vec<usize> = counts
             .iter()
             .scan(0, |s, &c| {
@@ -119,12 +144,14 @@ impl Ranks for MpiRanks {
         }
     }
     fn all_min(&self, value: i64) -> i64 {
+        self.calls.fetch_add(1, Ordering::Relaxed);
         let mut out = 0i64;
         self.world
             .all_reduce_into(&value, &mut out, SystemOperation::min());
         out
     }
     fn all_max(&self, value: i64) -> i64 {
+        self.calls.fetch_add(1, Ordering::Relaxed);
         let mut out = 0i64;
         self.world
             .all_reduce_into(&value, &mut out, SystemOperation::max());
@@ -136,5 +163,8 @@ impl Ranks for MpiRanks {
         root.broadcast_into(&mut len);
         bytes.resize(len as usize, 0);
         root.broadcast_into(&mut bytes[..]);
+        self.calls.fetch_add(2, Ordering::Relaxed);
+        self.received
+            .fetch_add(bytes.len() as u64, Ordering::Relaxed);
     }
 }
