@@ -23,6 +23,9 @@ pub(crate) fn join() -> Result<Handle, Stop> {
 /// first failing rank, on every rank (printed by rank 0 alone: the others
 /// give the same exit status with no lines).
 pub(crate) fn agree<T>(team: &dyn Ranks, r: Result<T, Stop>) -> Result<T, Stop> {
+    if team.size() == 1 {
+        return r;
+    }
     let mine = r.as_ref().err().map(encode);
     match first_failure(team, mine) {
         None => r,
@@ -37,9 +40,6 @@ pub(crate) fn agree<T>(team: &dyn Ranks, r: Result<T, Stop>) -> Result<T, Stop> 
 /// `None` when no rank's is (one exchange, and a broadcast when some
 /// rank's is).
 fn first_failure(team: &dyn Ranks, mine: Option<Vec<u8>>) -> Option<(i64, Vec<u8>)> {
-    if team.size() == 1 {
-        return mine.map(|m| (0, m));
-    }
     let me = team.rank() as i64;
     let failed = team.all_min(if mine.is_some() { me } else { i64::MAX });
     if failed == i64::MAX {
