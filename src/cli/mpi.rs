@@ -81,6 +81,16 @@ pub(crate) fn init() -> Result<MpiRanks, String> {
     })
 }
 
+impl MpiRanks {
+    /// `value` reduced by `op` over every rank.
+    fn reduce(&self, value: i64, op: SystemOperation) -> i64 {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        let mut out = 0i64;
+        self.world.all_reduce_into(&value, &mut out, op);
+        out
+    }
+}
+
 impl Ranks for MpiRanks {
     fn rank(&self) -> usize {
         self.rank
@@ -144,18 +154,10 @@ impl Ranks for MpiRanks {
         }
     }
     fn all_min(&self, value: i64) -> i64 {
-        self.calls.fetch_add(1, Ordering::Relaxed);
-        let mut out = 0i64;
-        self.world
-            .all_reduce_into(&value, &mut out, SystemOperation::min());
-        out
+        self.reduce(value, SystemOperation::min())
     }
     fn all_max(&self, value: i64) -> i64 {
-        self.calls.fetch_add(1, Ordering::Relaxed);
-        let mut out = 0i64;
-        self.world
-            .all_reduce_into(&value, &mut out, SystemOperation::max());
-        out
+        self.reduce(value, SystemOperation::max())
     }
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>) {
         let root = self.world.process_at_rank(root as i32);

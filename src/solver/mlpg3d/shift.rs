@@ -34,17 +34,10 @@ pub enum Freedom {
     Unbounded,
 }
 
-/// The shift of each node: `beta D Σ_j (1 − r_ij / l)² e_ij` over the nodes
-/// `j` of row `i` of `shapes` (the nodes whose supports covered `x_i` at the
-/// last build, a superset of those within `l`) closer than `l = range` now
-/// (`e_ij` the unit vector from `j` to `i`, `D = spacing`), projected on the
-/// directions the node is free in, limited to `cap` in length and so that
-/// the node does not pass below the anvil plane. Written into `out`; nodes
-/// in parallel, each from the positions before any moves (the same bits for
-/// any number of threads).
+/// [`shifts_on`] on one rank alone (the tests' form).
 #[allow(clippy::too_many_arguments)]
+#[cfg(test)]
 pub fn shifts(
-    ranks: &dyn crate::ranks::Ranks,
     pos: &[[f64; 3]],
     shapes: &NodalShapes,
     free: &[Freedom],
@@ -52,6 +45,33 @@ pub fn shifts(
     range: f64,
     beta: f64,
     cap: f64,
+    out: &mut [[f64; 3]],
+) {
+    shifts_on(
+        &crate::ranks::Alone,
+        pos,
+        shapes,
+        free,
+        (spacing, range, beta, cap),
+        out,
+    );
+}
+
+/// The shift of each node: `beta D Σ_j (1 − r_ij / l)² e_ij` over the nodes
+/// `j` of row `i` of `shapes` (the nodes whose supports covered `x_i` at the
+/// last build, a superset of those within `l`) closer than `l = range` now
+/// (`e_ij` the unit vector from `j` to `i`, `D = spacing`; the tuple is `(spacing, range, beta, cap)`), projected on the
+/// directions the node is free in, limited to `cap` in length and so that
+/// the node does not pass below the anvil plane. Written into `out`; nodes
+/// in parallel, each from the positions before any moves (the same bits for
+/// any number of threads). Shared among `ranks`: each computes its share
+/// of the nodes, then every rank holds them all (the same bits).
+pub fn shifts_on(
+    ranks: &dyn crate::ranks::Ranks,
+    pos: &[[f64; 3]],
+    shapes: &NodalShapes,
+    free: &[Freedom],
+    (spacing, range, beta, cap): (f64, f64, f64, f64),
     out: &mut [[f64; 3]],
 ) {
     let range2 = range * range;
@@ -99,6 +119,17 @@ pub fn shifts(
     });
 }
 
+/// [`carry_on`] on one rank alone (the tests' form).
+#[cfg(test)]
+pub fn carry<const K: usize>(
+    shapes: &NodalShapes,
+    f: &[[f64; K]],
+    d: &[[f64; 3]],
+    out: &mut [[f64; K]],
+) {
+    carry_on(&crate::ranks::Alone, shapes, f, d, out);
+}
+
 /// `f_i + d_i · ∇f_i` for the nodes with a shift `d_i` (the others keep
 /// `f_i`), written into `out`: `∇f_i = Σ_J ∇φ_J(x_i) f_J` over row `i` of
 /// `shapes` (the collocated MLS gradient of eq. 4, exact for linear
@@ -108,8 +139,9 @@ pub fn shifts(
 /// extrapolates without bound, and shifting repeats it step after step
 /// (the axisymmetric solver measured 1060 plastic strain at one particle of
 /// test 7 at 600 m/s; README, "Particle shifting"). Nodes in parallel, from
-/// `f` before any moves.
-pub fn carry<const K: usize>(
+/// `f` before any moves. Shared among `ranks`: each computes its share
+/// of the nodes, then every rank holds them all (the same bits).
+pub fn carry_on<const K: usize>(
     ranks: &dyn crate::ranks::Ranks,
     shapes: &NodalShapes,
     f: &[[f64; K]],
@@ -245,7 +277,7 @@ mod tests {
             d[i] = [0.03, -0.02 * k as f64, 0.04];
         }
         let mut out = vec![[0.0; 2]; pts.len()];
-        carry(&crate::ranks::Alone, &shapes, &f, &d, &mut out);
+        carry(&shapes, &f, &d, &mut out);
         for i in 0..pts.len() {
             let x: [f64; 3] = std::array::from_fn(|k| pts[i][k] + d[i][k]);
             let want = lin(x);
@@ -344,7 +376,7 @@ mod tests {
             .sum();
         assert!(f[i][0] + 0.05 * g < 0.0, "the gradient is one-sided: {g}");
         let mut out = vec![[0.0; 1]; pts.len()];
-        carry(&crate::ranks::Alone, &shapes, &f, &d, &mut out);
+        carry(&shapes, &f, &d, &mut out);
         assert_eq!(out[i][0], 0.0);
     }
 
@@ -363,32 +395,12 @@ mod tests {
         let free = vec![Freedom::Free; n];
         let (beta, range) = (0.1, 0.5);
         let mut d = vec![[1.0; 3]; n];
-        shifts(
-            &crate::ranks::Alone,
-            &pts,
-            &shapes,
-            &free,
-            1.0,
-            range,
-            beta,
-            1.0,
-            &mut d,
-        );
+        shifts(&pts, &shapes, &free, 1.0, range, beta, 1.0, &mut d);
         assert!(d.iter().all(|d| *d == [0.0; 3]));
         // Node b = (2, 2, 3) brought to 0.2 above a = (2, 2, 2).
         let (a, b) = (2 + 5 * 2 + 25, 2 + 5 * 2 + 50);
         pts[b][2] = pts[a][2] + 0.2;
-        shifts(
-            &crate::ranks::Alone,
-            &pts,
-            &shapes,
-            &free,
-            1.0,
-            range,
-            beta,
-            1.0,
-            &mut d,
-        );
+        shifts(&pts, &shapes, &free, 1.0, range, beta, 1.0, &mut d);
         let push = beta * (1.0f64 - 0.2 / 0.5).powi(2);
         assert!((d[b][2] - push).abs() < 1e-15 && d[b][0] == 0.0 && d[b][1] == 0.0);
         assert!((d[a][2] + push).abs() < 1e-15 && d[a][0] == 0.0 && d[a][1] == 0.0);
@@ -397,32 +409,12 @@ mod tests {
                 .enumerate()
                 .all(|(i, d)| i == a || i == b || *d == [0.0; 3])
         );
-        shifts(
-            &crate::ranks::Alone,
-            &pts,
-            &shapes,
-            &free,
-            1.0,
-            range,
-            beta,
-            0.01,
-            &mut d,
-        );
+        shifts(&pts, &shapes, &free, 1.0, range, beta, 0.01, &mut d);
         assert!((d[b][2] - 0.01).abs() < 1e-15);
         let mut some = free.clone();
         some[a] = Freedom::Fixed;
         some[b] = Freedom::InPlane([0.0, 0.0, 1.0]);
-        shifts(
-            &crate::ranks::Alone,
-            &pts,
-            &shapes,
-            &some,
-            1.0,
-            range,
-            beta,
-            1.0,
-            &mut d,
-        );
+        shifts(&pts, &shapes, &some, 1.0, range, beta, 1.0, &mut d);
         assert_eq!((d[a], d[b]), ([0.0; 3], [0.0; 3]));
     }
 
@@ -439,34 +431,14 @@ mod tests {
         // a at 0.1 above the anvil: its image is 0.2 away.
         pts[a][2] = 0.1;
         let mut d = vec![[0.0; 3]; n];
-        shifts(
-            &crate::ranks::Alone,
-            &pts,
-            &shapes,
-            &free,
-            1.0,
-            0.5,
-            0.1,
-            1.0,
-            &mut d,
-        );
+        shifts(&pts, &shapes, &free, 1.0, 0.5, 0.1, 1.0, &mut d);
         let push = 0.1 * (1.0f64 - 0.2 / 0.5).powi(2);
         assert!((d[a][2] - push).abs() < 1e-15, "{:?}", d[a]);
         // b brought to 0.01 above a at 0.05: b pushes a down by 0.96 and
         // its image up by 0.64, past the plane, where it stops.
         pts[a][2] = 0.05;
         pts[b][2] = 0.06;
-        shifts(
-            &crate::ranks::Alone,
-            &pts,
-            &shapes,
-            &free,
-            1.0,
-            0.5,
-            1.0,
-            1.0,
-            &mut d,
-        );
+        shifts(&pts, &shapes, &free, 1.0, 0.5, 1.0, 1.0, &mut d);
         assert_eq!(d[a][2], -0.05);
     }
 }

@@ -8,9 +8,9 @@ use super::scratch::CARRIED;
 use super::scratch::Scratch;
 use super::scratch::{ImageBuffers, ShiftBuffers};
 use super::shift::Freedom;
-use super::shift::carry;
+use super::shift::carry_on;
 use super::shift::exchange;
-use super::shift::shifts;
+use super::shift::shifts_on;
 use super::spheres::nanson;
 use super::spheres::radial;
 use super::util::extended;
@@ -84,15 +84,17 @@ pub(super) fn shift(
     freedoms(&frame, reference, &mut buffers.free);
     let pos = extended(images, &state.pos, &mut ext.pos, mirror::vector);
     let (spacing, step_scale) = (frame.spacing, setup.rod.step_scale());
-    shifts(
+    shifts_on(
         ranks,
         pos,
         &g.shapes,
         &buffers.free,
-        spacing,
-        SHIFT_RANGE * spacing,
-        setup.rod.scheme.shifting * step_scale,
-        SHIFT_CAP * spacing * step_scale,
+        (
+            spacing,
+            SHIFT_RANGE * spacing,
+            setup.rod.scheme.shifting * step_scale,
+            SHIFT_CAP * spacing * step_scale,
+        ),
         &mut buffers.shift,
     );
     // A node on a symmetry plane moves in it; a held node stays.
@@ -122,7 +124,7 @@ pub(super) fn shift(
     };
     pack(&fields, frame.points, &mut buffers.carried);
     let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
-    carry(
+    carry_on(
         ranks,
         &g.shapes,
         carried,

@@ -103,7 +103,11 @@ pub(super) fn update_material(
     if input.damaging {
         crate::material::MaterialState::gather(states, ranks, &parts);
     }
-    let mut wire: Vec<[f64; 8]> = results.iter().map(encode).collect();
+    // Only this rank's results are encoded; the others' arrive.
+    let mut wire = vec![[0.0; 8]; results.len()];
+    for k in own.clone() {
+        wire[k] = encode(&results[k]);
+    }
     gather_parts(ranks, &parts, &mut wire);
     for (k, r) in results.iter_mut().enumerate() {
         if !own.contains(&k) {
