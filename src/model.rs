@@ -118,6 +118,12 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
         None
     }
 
+    /// The wall time of each phase of the steps taken in this process, as a
+    /// table, where the solver keeps it (the 3-D solver).
+    fn phase_table(&self) -> Option<String> {
+        None
+    }
+
     /// Runs the hot loops in the compiled copy `isa` from now on; a solver
     /// without compiled copies ignores it.
     fn set_isa(&mut self, _isa: Isa) {}

@@ -239,9 +239,118 @@ pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &m
     gather_parts(ranks, &parts, out);
 }
 
+/// `f(i, &mut out[i])` for the rows of this rank's share aligned to
+/// `align` ([`share`]), on the pool; the other rows are left as they were
+/// (a pass whose next reader reads only this rank's rows of the same
+/// share). Alone, every row.
+pub fn each_own_row<T: Send>(
+    ranks: &dyn Ranks,
+    out: &mut [T],
+    align: usize,
+    f: impl Fn(usize, &mut T) + Sync,
+) {
+    use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
+    let own = share(out.len(), ranks.rank(), ranks.size(), align);
+    let start = own.start;
+    out[own]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(k, v)| f(start + k, v));
+}
+
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+    use std::sync::{Arc, Barrier, Mutex};
+
+    /// Ranks as threads of one process (a test's stand-in for MPI): each
+    /// exchange puts every rank's part in a common slot between two
+    /// barriers.
+    #[derive(Debug)]
+    struct Threads {
+        rank: usize,
+        size: usize,
+        slots: Arc<(Mutex<Vec<Vec<u8>>>, Barrier)>,
+    }
+
+    impl Threads {
+        /// Every rank's `mine`, in rank order.
+        fn exchange(&self, mine: Vec<u8>) -> Vec<Vec<u8>> {
+            let (slots, barrier) = &*self.slots;
+            slots.lock().unwrap()[self.rank] = mine;
+            barrier.wait();
+            let all = slots.lock().unwrap().clone();
+            barrier.wait();
+            all
+        }
+    }
+
+    impl Ranks for Threads {
+        fn rank(&self) -> usize {
+            self.rank
+        }
+        fn size(&self) -> usize {
+            self.size
+        }
+        fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]) {
+            assert_eq!(local.len(), counts[self.rank]);
+            let all = self.exchange(local.to_vec());
+            assert_eq!(all.iter().map(Vec::len).collect::<Vec<_>>(), counts);
+            out.copy_from_slice(&all.concat());
+        }
+        fn all_min(&self, value: i64) -> i64 {
+            let all = self.exchange(value.to_le_bytes().to_vec());
+            all.iter()
+                .map(|b| i64::from_le_bytes(b[..8].try_into().unwrap()))
+                .min()
+                .unwrap()
+        }
+        fn all_max(&self, value: i64) -> i64 {
+            -self.all_min(-value)
+        }
+        fn broadcast(&self, root: usize, bytes: &mut Vec<u8>) {
+            let all = self.exchange(bytes.clone());
+            *bytes = all[root].clone();
+        }
+    }
+
+    /// `f` on `size` ranks, each a thread; their results in rank order.
+    pub(crate) fn on_threads<R: Send>(size: usize, f: impl Fn(&dyn Ranks) -> R + Sync) -> Vec<R> {
+        let slots = Arc::new((Mutex::new(vec![Vec::new(); size]), Barrier::new(size)));
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (0..size)
+                .map(|rank| {
+                    let ranks = Threads {
+                        rank,
+                        size,
+                        slots: slots.clone(),
+                    };
+                    let f = &f;
+                    s.spawn(move || f(&ranks))
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        })
+    }
+
+    /// On ranks as threads, a pass over the rows gives every rank every
+    /// row, as the plain pass does; the largest and smallest agree.
+    #[test]
+    fn on_threads_each_row_gives_every_rank_the_plain_pass() {
+        for size in [2, 3] {
+            let got = on_threads(size, |ranks| {
+                let mut out = vec![0.0; 1001];
+                each_row(ranks, &mut out, |i, v| *v = (i * i) as f64);
+                let top = ranks.all_max(ranks.rank() as i64);
+                let low = ranks.all_min(ranks.rank() as i64 - 5);
+                (out, top, low)
+            });
+            for (out, top, low) in got {
+                assert!(out.iter().enumerate().all(|(i, v)| *v == (i * i) as f64));
+                assert_eq!((top, low), (size as i64 - 1, -5));
+            }
+        }
+    }
 
     /// The shares cover the rows once, in order, on their alignment, for
     /// every count of rows and ranks tried.

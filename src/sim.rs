@@ -372,6 +372,12 @@ impl Simulation {
         self.solver.min_spacing_ratio()
     }
 
+    /// The wall time of each phase of the steps taken in this process, as a
+    /// table, where the solver keeps it (the 3-D scenes).
+    pub fn phase_table(&self) -> Option<String> {
+        self.solver.phase_table()
+    }
+
     /// Names, units and meanings of this scene's observables.
     pub fn observable_specs(&self) -> &'static [ObservableSpec] {
         self.kind().observable_specs()

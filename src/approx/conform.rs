@@ -229,6 +229,7 @@ impl<'a> System<'a> {
     /// `points`) with its columns: each row's `G_i`, from the row's size
     /// `h_i` (its farthest node) and `M_i⁻¹`.
     fn new(
+        ranks: &dyn crate::ranks::Ranks,
         shapes: &'a NodalShapes,
         points: &'a [[f64; 3]],
         volume: &'a [f64],
@@ -236,9 +237,9 @@ impl<'a> System<'a> {
         columns: &'a Columns,
     ) -> Self {
         let n = shapes.len();
-        let g: Vec<[[f64; 4]; 4]> = (0..n)
-            .into_par_iter()
-            .map(|i| {
+        let mut g = filled(n, [[0.0; 4]; 4]);
+        crate::ranks::each_row(ranks, &mut g, |i, out| {
+            *out = {
                 let h = shapes
                     .row(i)
                     .map(|q| {
@@ -259,8 +260,8 @@ impl<'a> System<'a> {
                 let minv = invert4(m);
                 let d = [1.0, 1.0 / h, 1.0 / h, 1.0 / h];
                 std::array::from_fn(|a| std::array::from_fn(|b| d[a] * minv[a][b] * d[b]))
-            })
-            .collect();
+            };
+        });
         System {
             shapes,
             points,
@@ -335,30 +336,28 @@ impl<'a> System<'a> {
     /// (inner `J` only; the same three values for each axis): the sums of
     /// [`System::gather`] with power 2 over the entries `1 − p_Jᵀ M_i⁻¹ p_J`,
     /// each computed where it is summed (no buffer of `3 nnz` values).
-    fn diagonal(&self) -> Vec<[f64; 3]> {
+    fn diagonal(&self, ranks: &dyn crate::ranks::Ranks) -> Vec<[f64; 3]> {
         let c = self.columns;
-        (0..self.shapes.len())
-            .into_par_iter()
-            .map(|j| {
-                let mut yj = [0.0; 3];
-                if !self.inner[j] {
-                    return yj;
+        let mut out = filled(self.shapes.len(), [0.0; 3]);
+        crate::ranks::each_row(ranks, &mut out, |j, yj| {
+            *yj = [0.0; 3];
+            if !self.inner[j] {
+                return;
+            }
+            for k in c.offsets[j]..c.offsets[j + 1] {
+                let i = c.at(k).1;
+                let p = offset(self.points[j], self.points[i]);
+                let m = &self.g[i];
+                let pmp: f64 = (0..4)
+                    .map(|x| (0..4).map(|y| p[x] * m[x][y] * p[y]).sum::<f64>())
+                    .sum();
+                let v = self.volume[i].powi(2);
+                for d in yj.iter_mut() {
+                    *d += v * (1.0 - pmp);
                 }
-                for k in c.offsets[j]..c.offsets[j + 1] {
-                    let i = c.at(k).1;
-                    let p = offset(self.points[j], self.points[i]);
-                    let m = &self.g[i];
-                    let pmp: f64 = (0..4)
-                        .map(|x| (0..4).map(|y| p[x] * m[x][y] * p[y]).sum::<f64>())
-                        .sum();
-                    let v = self.volume[i].powi(2);
-                    for d in yj.iter_mut() {
-                        *d += v * (1.0 - pmp);
-                    }
-                }
-                yj
-            })
-            .collect()
+            }
+        });
+        out
     }
 
     /// `y_J = Σ_i V_i^power w_q` over column `J` (inner `J` only).
@@ -397,19 +396,18 @@ struct Fused {
 }
 
 impl Fused {
-    fn new(sys: &System) -> Self {
+    fn new(ranks: &dyn crate::ranks::Ranks, sys: &System) -> Self {
         let c = sys.columns;
-        let diag = (0..sys.shapes.len())
-            .into_par_iter()
-            .map(|j| {
-                if !sys.inner[j] {
-                    return 0.0;
-                }
+        let mut diag = filled(sys.shapes.len(), 0.0);
+        crate::ranks::each_row(ranks, &mut diag, |j, d| {
+            *d = if !sys.inner[j] {
+                0.0
+            } else {
                 (c.offsets[j]..c.offsets[j + 1])
                     .map(|k| sys.volume[c.at(k).1].powi(2))
                     .sum()
-            })
-            .collect();
+            };
+        });
         Fused {
             diag,
             w: filled(sys.shapes.len(), [[0.0; 4]; 4]),
@@ -548,12 +546,12 @@ pub fn conform(
     let n = shapes.len();
     // The sparsity is the same before and after: one transpose serves both.
     let columns = Columns::of(shapes, n);
-    let sys = System::new(shapes, points, volume, inner, &columns);
+    let sys = System::new(ranks, shapes, points, volume, inner, &columns);
     // a_J over every node, for the scale of the stop.
     let mut a = filled(n, [0.0; 3]);
     {
         let c = &sys.columns;
-        a.par_iter_mut().enumerate().for_each(|(j, aj)| {
+        crate::ranks::each_row(ranks, &mut a, |j, aj| {
             for k in c.offsets[j]..c.offsets[j + 1] {
                 let (q, i) = c.at(k);
                 for d in 0..3 {
@@ -576,8 +574,8 @@ pub fn conform(
     let before = inner_max(&a);
     let goal = tolerance * largest;
     // Jacobi preconditioner: A_JJ = Σ_i V_i² (1 − p_Jᵀ M_i⁻¹ p_J).
-    let diag = sys.diagonal();
-    let mut fused = Fused::new(&sys);
+    let diag = sys.diagonal(ranks);
+    let mut fused = Fused::new(ranks, &sys);
     let levels = match preconditioner {
         Preconditioner::Jacobi => None,
         Preconditioner::Levels => {
@@ -793,7 +791,14 @@ mod tests {
         let n = shapes.len();
         let inner: Vec<bool> = lat.surfaces.iter().map(|s| s.interior()).collect();
         let columns = Columns::of(&shapes, n);
-        let sys = System::new(&shapes, pts, &lat.volume, &inner, &columns);
+        let sys = System::new(
+            &crate::ranks::Alone,
+            &shapes,
+            pts,
+            &lat.volume,
+            &inner,
+            &columns,
+        );
         let mut uniform = crate::test_rng::rng(11);
         let mu: Vec<[f64; 3]> = (0..n)
             .map(|_| std::array::from_fn(|_| uniform() - 0.5))
@@ -803,11 +808,11 @@ mod tests {
         let mut plain = vec![[0.0; 3]; n];
         sys.gather(&e, 2, &mut plain);
         let mut fused = vec![[0.0; 3]; n];
-        Fused::new(&sys).apply(Isa::BASELINE, &sys, &mu, &mut fused);
+        Fused::new(&crate::ranks::Alone, &sys).apply(Isa::BASELINE, &sys, &mu, &mut fused);
         // Every compiled copy gives the baseline's bits.
         for isa in Isa::available() {
             let mut copy = vec![[0.0; 3]; n];
-            Fused::new(&sys).apply(isa, &sys, &mu, &mut copy);
+            Fused::new(&crate::ranks::Alone, &sys).apply(isa, &sys, &mu, &mut copy);
             assert_eq!(copy, fused, "the {} copy", isa.name());
         }
         let scale = plain.iter().map(|&v| norm3(v)).fold(0.0, f64::max);

@@ -662,15 +662,16 @@ impl NodalShapes {
     }
 
     /// [`NodalShapes::velocity_gradients`] shared among `ranks`: each
-    /// computes its share of the nodes, then every rank holds them all
-    /// (the same bits).
+    /// computes only the rows of its share aligned to `align`
+    /// ([`crate::ranks::each_own_row`]), the other rows of `out` left as
+    /// they were (their reader, the material pass, reads the same share).
     pub fn velocity_gradients_on(
         &self,
-        ranks: &dyn crate::ranks::Ranks,
+        (ranks, align): (&dyn crate::ranks::Ranks, usize),
         velocity: &[[f64; 3]],
         out: &mut [[[f64; 3]; 3]],
     ) {
-        crate::ranks::each_row(ranks, out, |i, l| *l = self.gradient(i, velocity));
+        crate::ranks::each_own_row(ranks, out, align, |i, l| *l = self.gradient(i, velocity));
     }
 
     /// The collocated gradient (eq. 4) of the nodal vector field `field`

@@ -40,6 +40,54 @@ pub(crate) fn ordered<T: Send>(
     tree(0..n.div_ceil(BLOCK).max(1), n, &zero, &fold, &join)
 }
 
+/// [`ordered`] shared among `ranks`: each rank folds the blocks of its
+/// share ([`crate::ranks::share`] of the blocks, which is
+/// [`crate::ranks::share`] of the nodes aligned to [`BLOCK`]: `fold` need
+/// read only that rank's nodes), the blocks' results travel as `to`'s
+/// plain values and come back by `from`, and every rank joins them over
+/// the same tree. The same bits as [`ordered`] on any number of ranks.
+pub(crate) fn ordered_on<T: Send, W: crate::ranks::Plain + Default>(
+    ranks: &dyn crate::ranks::Ranks,
+    n: usize,
+    (zero, fold, join): (
+        impl Fn() -> T + Sync,
+        impl Fn(T, usize) -> T + Sync,
+        impl Fn(T, T) -> T + Sync,
+    ),
+    (to, from): (impl Fn(&T) -> W + Sync, impl Fn(&W) -> T),
+) -> T {
+    use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
+    if ranks.size() == 1 {
+        return ordered(n, zero, fold, join);
+    }
+    let blocks = n.div_ceil(BLOCK).max(1);
+    let parts = crate::ranks::shares(ranks, blocks, 1);
+    let own = parts[ranks.rank()].clone();
+    let mut wire = vec![W::default(); blocks];
+    let first = own.start;
+    wire[own].par_iter_mut().enumerate().for_each(|(k, w)| {
+        let b = first + k;
+        *w = to(&(b * BLOCK..n.min((b + 1) * BLOCK)).fold(zero(), &fold));
+    });
+    crate::ranks::gather_parts(ranks, &parts, &mut wire);
+    let mut leaves: Vec<Option<T>> = wire.iter().map(|w| Some(from(w))).collect();
+    // The tree of `ordered`, over the blocks' results.
+    fn tree<T>(
+        blocks: std::ops::Range<usize>,
+        leaves: &mut [Option<T>],
+        join: &impl Fn(T, T) -> T,
+    ) -> T {
+        if blocks.len() <= 1 {
+            return leaves[blocks.start].take().expect("each block joined once");
+        }
+        let mid = blocks.start + blocks.len() / 2;
+        let a = tree(blocks.start..mid, leaves, join);
+        let b = tree(mid..blocks.end, leaves, join);
+        join(a, b)
+    }
+    tree(0..blocks, &mut leaves, &join)
+}
+
 /// `Σ f(i)` over `0..n` in the order of [`ordered`].
 pub(crate) fn sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
     ordered(n, || 0.0, |s, i| s + f(i), |a, b| a + b)
@@ -78,6 +126,65 @@ mod tests {
         let serial: f64 = x.iter().sum();
         assert!((plain - serial).abs() < 1e-12 * x.len() as f64);
         assert_eq!(sum(0, |i| x[i]), 0.0);
+    }
+
+    /// Shared among ranks (each a thread with a share of the blocks, its
+    /// blocks' results through their wire form), the sum has the bits of
+    /// the plain one, and the first error in node order still wins.
+    #[test]
+    fn the_sum_shared_among_ranks_has_the_bits_of_the_plain_one() {
+        let mut rng = crate::test_rng::rng(5);
+        for n in [0, 17, BLOCK, 5 * BLOCK + 17, 9 * BLOCK] {
+            let x: Vec<f64> = (0..n).map(|_| rng() - 0.3).collect();
+            let plain = sum(n, |i| x[i]);
+            for size in [1, 2, 3, 4] {
+                let got = crate::ranks::tests::on_threads(size, |ranks| {
+                    ordered_on(
+                        ranks,
+                        n,
+                        (|| 0.0, |s, i| s + x[i], |a, b| a + b),
+                        (|s: &f64| [*s], |w: &[f64; 1]| w[0]),
+                    )
+                });
+                for g in got {
+                    assert_eq!(g.to_bits(), plain.to_bits(), "n {n}, {size} ranks");
+                }
+            }
+        }
+        let n = 5 * BLOCK;
+        let bad = [BLOCK + 3, 3 * BLOCK + 1];
+        let got = crate::ranks::tests::on_threads(3, |ranks| {
+            ordered_on(
+                ranks,
+                n,
+                (
+                    || Ok(0.0),
+                    |s: Result<f64, usize>, i| {
+                        let s = s?;
+                        if bad.contains(&i) {
+                            Err(i)
+                        } else {
+                            Ok(s + 1.0)
+                        }
+                    },
+                    |a, b| a.and_then(|a| b.map(|b| a + b)),
+                ),
+                (
+                    |r: &Result<f64, usize>| match r {
+                        Ok(v) => [0.0, *v],
+                        Err(i) => [1.0, *i as f64],
+                    },
+                    |w: &[f64; 2]| {
+                        if w[0] == 0.0 {
+                            Ok(w[1])
+                        } else {
+                            Err(w[1] as usize)
+                        }
+                    },
+                ),
+            )
+        });
+        assert!(got.iter().all(|g| *g == Err(bad[0])), "{got:?}");
     }
 
     /// The first error in node order wins, as in a serial pass.

@@ -192,6 +192,10 @@ pub(crate) struct RunArgs {
     /// No progress bar and no table on stdout (errors are still reported).
     #[arg(long, short)]
     pub(crate) quiet: bool,
+    /// At the end, print the wall time of each phase of the solver's steps
+    /// to stderr (the 3-D scenes; on MPI's ranks, each rank its own).
+    #[arg(long)]
+    pub(crate) phases: bool,
 }
 
 #[derive(Args)]

@@ -242,12 +242,32 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
         lines.extend(failures.into_iter().map(|f| format!("error: {f}")));
         return Err(Stop::Interrupted(lines));
     }
+    if a.phases {
+        print_phases(team, &sim);
+    }
     let printed = if a.quiet {
         Ok(())
     } else {
         print_summary(&sim, wall)
     };
     outcome(failures, printed)
+}
+
+/// `--phases`: the solver's time by phase on stderr, marked with the rank
+/// on several ranks, or a line saying that the scene keeps none.
+fn print_phases(team: &Handle, sim: &Simulation) {
+    let head = if team.size() > 1 {
+        format!("phases of rank {} of {}", team.rank(), team.size())
+    } else {
+        "phases".to_string()
+    };
+    let _ = match sim.phase_table() {
+        Some(table) => errln!("{head}:\n{}", table.trim_end()),
+        None => errln!(
+            "--phases: scene `{}` keeps no time by phase (the 3-D scenes do)",
+            sim.kind().name()
+        ),
+    };
 }
 
 /// Writes the next snapshot of the run into `--vtk-dir` (if given) and

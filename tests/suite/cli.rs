@@ -833,3 +833,74 @@ fn the_table_and_json_show_the_continuum_and_the_experiment() {
     assert!(v["reference"]["mushroom_radius"].as_f64().unwrap() > 0.0);
     assert!(v.get("reference_continuum").is_none(), "{v}");
 }
+
+/// `--phases` prints the 3-D solver's time by phase: every phase named
+/// once, their seconds adding up to the total (to the table's rounding),
+/// which is no more than the process's time; a scene that keeps no phases
+/// says so, and the run still succeeds.
+#[test]
+fn phases_prints_the_time_of_each_phase_adding_up_to_the_total() {
+    let dir = scratch("phases");
+    let json = dir.join("out.json");
+    let began = std::time::Instant::now();
+    let out = bin()
+        .args([
+            "run",
+            "taylor3d",
+            "-q",
+            "--phases",
+            "--set",
+            "particles_radial=4",
+            "--set",
+            "end_time=2e-6",
+            "--json",
+        ])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let elapsed = began.elapsed().as_secs_f64();
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let seconds = |line: &str| -> f64 {
+        let rest = &line[28..];
+        let at = rest.find(" s").expect("seconds");
+        rest[..at].trim().parse().expect("a number")
+    };
+    let rows: Vec<&str> = err
+        .lines()
+        .skip_while(|l| *l != "phases:")
+        .skip(1)
+        .collect();
+    let total = rows.iter().find(|l| l.starts_with("total")).expect(&err);
+    let phases: Vec<&&str> = rows.iter().filter(|l| !l.starts_with("total")).collect();
+    for name in ["force assembly", "material update", "conforming correction"] {
+        assert_eq!(
+            phases.iter().filter(|l| l.starts_with(name)).count(),
+            1,
+            "{err}"
+        );
+    }
+    assert_eq!(phases.len(), 14, "{err}");
+    let sum: f64 = phases.iter().map(|l| seconds(l)).sum();
+    assert!((sum - seconds(total)).abs() <= 0.0005 * 15.0, "{err}");
+    // The phases include the first build, before the run's own clock
+    // (`wall_time_s`) starts: they fit in the process's time.
+    assert!(
+        seconds(total) <= elapsed + 0.001,
+        "{err} against {elapsed} s"
+    );
+    assert!(json.exists());
+    assert!(total.contains("operator builds"), "{err}");
+
+    let out = bin()
+        .args(SMALL_RUN)
+        .args(["-q", "--phases"])
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("--phases: scene `taylor` keeps no time by phase"),
+        "{err}"
+    );
+}

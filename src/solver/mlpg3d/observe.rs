@@ -416,6 +416,9 @@ impl crate::model::Model for Mlpg3d {
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.min_spacing_ratio())
     }
+    fn phase_table(&self) -> Option<String> {
+        Some(self.profile().table())
+    }
     fn load_state(
         &mut self,
         saved: crate::model::SavedSolver<'_>,

@@ -629,6 +629,9 @@ impl crate::model::Model for Penetration {
     fn min_spacing_ratio(&self) -> Option<f64> {
         Some(self.run.min_spacing_ratio())
     }
+    fn phase_table(&self) -> Option<String> {
+        Some(self.run.profile().table())
+    }
     fn load_state(
         &mut self,
         saved: crate::model::SavedSolver<'_>,

@@ -147,8 +147,13 @@ pub(super) fn step_with(
         &mut scratch.images.vel,
         mirror::vector,
     );
-    g.shapes
-        .velocity_gradients_on(&*pipe.ranks, vel_ext, &mut scratch.grad);
+    // Each rank's rows of the material pass's share only (its sums go by
+    // blocks: `update::MATERIAL_ALIGN`).
+    g.shapes.velocity_gradients_on(
+        (&*pipe.ranks, update::MATERIAL_ALIGN),
+        vel_ext,
+        &mut scratch.grad,
+    );
     pipe.profile.lap(Phase::Gradients, &mut watch);
     update::update_material(
         &*pipe.ranks,
@@ -174,7 +179,7 @@ pub(super) fn step_with(
         },
         &mut scratch.results,
     );
-    let t = update::sum(&scratch.results, state.clock.time)?;
+    let t = update::sum_on(&*pipe.ranks, &scratch.results, state.clock.time)?;
     pipe.profile.lap(Phase::Material, &mut watch);
     state.energy.internal += t.internal;
     state.plastic_work += t.plastic;

@@ -66,10 +66,12 @@ pub(super) fn update_material(
         update_rows(input, fields, results, 0);
         return;
     }
-    // Each rank steps its share of the points, then every rank holds
-    // every point's fields, damage variables and result ([`crate::ranks`]).
+    // Each rank steps its share of the points (in whole blocks of the
+    // sums, [`MATERIAL_ALIGN`]), then every rank holds every point's
+    // fields and damage variables ([`crate::ranks`]); the results stay
+    // with their rank ([`sum_on`]).
     use crate::ranks::gather_parts;
-    let parts = crate::ranks::shares(ranks, results.len(), 1);
+    let parts = crate::ranks::shares(ranks, results.len(), MATERIAL_ALIGN);
     let own = parts[ranks.rank()].clone();
     let MaterialFields {
         dev,
@@ -103,18 +105,12 @@ pub(super) fn update_material(
     if input.damaging {
         crate::material::MaterialState::gather(states, ranks, &parts);
     }
-    // Only this rank's results are encoded; the others' arrive.
-    let mut wire = vec![[0.0; 8]; results.len()];
-    for k in own.clone() {
-        wire[k] = encode(&results[k]);
-    }
-    gather_parts(ranks, &parts, &mut wire);
-    for (k, r) in results.iter_mut().enumerate() {
-        if !own.contains(&k) {
-            *r = decode(&wire[k]);
-        }
-    }
 }
+
+/// The alignment of the material pass's shares among the ranks: whole
+/// blocks of the ordered sums, so that each rank sums its own points'
+/// results ([`sum_on`]).
+pub(super) const MATERIAL_ALIGN: usize = crate::approx::sums::BLOCK;
 
 /// The fields of a non-finite value, as [`encode`] numbers them.
 const NON_FINITE_FIELDS: [&str; 4] = ["velocity", "density", "stress", "temperature"];
@@ -316,14 +312,39 @@ fn update_rows(
         );
 }
 
-/// The sums of the step over the nodes, on the pool in the fixed order of
-/// [`crate::approx::sums`] (the same bits for any number of threads), or the
-/// first node's error at `time`.
-pub(super) fn sum(
+/// [`sum`] shared among `ranks`, each holding the results of its share of
+/// [`update_material`] only: each sums its blocks, and the blocks' sums
+/// (or their first error, [`encode`]) are joined on every rank over the
+/// same tree (the same bits).
+pub(super) fn sum_on(
+    ranks: &dyn crate::ranks::Ranks,
     results: &[std::result::Result<Tally, (usize, Error)>],
     time: f64,
 ) -> Result<Tally> {
-    let add = |t: Tally, s: &Tally| Tally {
+    if ranks.size() == 1 {
+        return sum(results, time);
+    }
+    type Point = std::result::Result<Tally, (usize, Error)>;
+    let add = |t: Point, s: &Point| -> Point {
+        let (t, s) = (t?, s.as_ref().map_err(|(i, e)| (*i, e.clone()))?);
+        Ok(add_tally(t, s))
+    };
+    crate::approx::sums::ordered_on(
+        ranks,
+        results.len(),
+        (
+            || Ok(Tally::default()),
+            |t, i| add(t, &results[i]),
+            |a, b| add(a, &b),
+        ),
+        (encode, decode),
+    )
+    .map_err(|(_, e)| at_time(e, time))
+}
+
+/// The sum of two tallies (the largest speed of the two).
+fn add_tally(t: Tally, s: &Tally) -> Tally {
+    Tally {
         internal: t.internal + s.internal,
         plastic: t.plastic + s.plastic,
         damping: t.damping + s.damping,
@@ -331,7 +352,17 @@ pub(super) fn sum(
         momentum: t.momentum + s.momentum,
         mass: t.mass + s.mass,
         worst_speed: t.worst_speed.max(s.worst_speed),
-    };
+    }
+}
+
+/// The sums of the step over the nodes, on the pool in the fixed order of
+/// [`crate::approx::sums`] (the same bits for any number of threads), or the
+/// first node's error at `time`.
+pub(super) fn sum(
+    results: &[std::result::Result<Tally, (usize, Error)>],
+    time: f64,
+) -> Result<Tally> {
+    let add = add_tally;
     crate::approx::sums::ordered(
         results.len(),
         || Ok(Tally::default()),
