@@ -212,11 +212,7 @@ pub fn all_max_f64(ranks: &dyn Ranks, value: f64) -> f64 {
     if ranks.size() == 1 {
         return value;
     }
-    let mut all = vec![0.0; ranks.size()];
-    all[ranks.rank()] = value;
-    let each: Vec<Range<usize>> = (0..ranks.size()).map(|r| r..r + 1).collect();
-    gather_parts(ranks, &each, &mut all);
-    all.into_iter().fold(0.0, f64::max)
+    all_gather_one(ranks, value).into_iter().fold(0.0, f64::max)
 }
 
 /// `f(i, &mut out[i])` for the rows of this rank's share (on the pool),
@@ -237,6 +233,15 @@ pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &m
         .enumerate()
         .for_each(|(k, v)| f(start + k, v));
     gather_parts(ranks, &parts, out);
+}
+
+/// Every rank's `value`, in rank order (one exchange).
+pub fn all_gather_one<T: Plain + Default>(ranks: &dyn Ranks, value: T) -> Vec<T> {
+    let mut all = vec![T::default(); ranks.size()];
+    all[ranks.rank()] = value;
+    let each: Vec<Range<usize>> = (0..ranks.size()).map(|r| r..r + 1).collect();
+    gather_parts(ranks, &each, &mut all);
+    all
 }
 
 /// `f(i, &mut out[i])` for the rows of this rank's share aligned to

@@ -590,6 +590,7 @@ pub fn conform(
                     col_offsets: &columns.offsets,
                     col_entries: &columns.entries,
                     d: &fused.diag,
+                    ranks,
                 },
                 jacobi,
             )

@@ -96,6 +96,9 @@ pub(crate) struct Fine<'a> {
     pub col_entries: &'a [u64],
     /// `D_J = Σ_i V_i²` over column `J` (zero off the inner nodes).
     pub d: &'a [f64],
+    /// The ranks that share the first level's operator
+    /// ([`crate::ranks`]).
+    pub ranks: &'a dyn crate::ranks::Ranks,
 }
 
 /// `(1, (x − centre) / h)`.
@@ -386,9 +389,15 @@ fn pad(b: &mut Block, rank: usize) {
 fn first_operator(f: &Fine, gr: &Grouping, h: f64) -> Blocks {
     let groups = gr.centre.len();
     let s = f.shapes;
-    let rows: Vec<Vec<(usize, Block)>> = (0..groups)
-        .into_par_iter()
-        .map(|a| {
+    // Each rank builds the block rows of its share of the groups; the rows
+    // then travel to every rank (the same bits).
+    let ranks = f.ranks;
+    let own = crate::ranks::share(groups, ranks.rank(), ranks.size(), 1);
+    let mut rows: Vec<Vec<(usize, Block)>> = vec![Vec::new(); groups];
+    let first = own.start;
+    rows[own].par_iter_mut().enumerate().for_each(|(k, row)| {
+        let a = first + k;
+        *row = {
             let nodes = &gr.members[gr.offsets[a]..gr.offsets[a + 1]];
             let mut touching: Vec<usize> = nodes
                 .iter()
@@ -465,8 +474,14 @@ fn first_operator(f: &Fine, gr: &Grouping, h: f64) -> Blocks {
                     (b, blk)
                 })
                 .collect()
-        })
-        .collect();
+        };
+    });
+    if ranks.size() > 1 {
+        let parts = crate::ranks::shares(ranks, groups, 1);
+        crate::ranks::gather_encoded(ranks, &parts, &mut rows, Vec::clone, |slot, row| {
+            *slot = row
+        });
+    }
     Blocks::of(rows)
 }
 

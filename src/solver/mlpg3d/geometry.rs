@@ -341,7 +341,11 @@ pub(super) fn named_pairs(
     );
     let still = rebuild * rebuild * (1.0 - PRE_TEST_MARGIN);
     let dot = |a: [f64; 3]| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    let pairs = (0..state.pos.len())
+    // Each rank visits its share of the nodes; the smallest and the flags
+    // are the same in any order.
+    let ranks = &*pipe.ranks;
+    let own = crate::ranks::share(state.pos.len(), ranks.rank(), ranks.size(), 1);
+    let pairs = own
         .into_par_iter()
         .map(|i| {
             let lo = sup.named.offsets[i];
@@ -368,6 +372,20 @@ pub(super) fn named_pairs(
             out
         })
         .reduce(|| NamedPairs::NONE, NamedPairs::join);
+    let pairs = if ranks.size() == 1 {
+        pairs
+    } else {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let mine = [pairs.nearest, flag(pairs.recompute), flag(pairs.strained)];
+        crate::ranks::all_gather_one(ranks, mine)
+            .into_iter()
+            .map(|[nearest, recompute, strained]| NamedPairs {
+                nearest,
+                recompute: recompute != 0.0,
+                strained: strained != 0.0,
+            })
+            .fold(NamedPairs::NONE, NamedPairs::join)
+    };
     NamedPairs {
         nearest: pairs.nearest.sqrt(),
         ..pairs

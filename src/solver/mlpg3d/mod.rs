@@ -183,6 +183,16 @@ impl Setup3d {
 
     /// Whether a body's material has a damage model (no pass over the
     /// nodes: the step asks every time).
+    /// Whether a body's material keeps damage variables at its points
+    /// (Rajendran-Grove's or JH-2's): otherwise every point's
+    /// [`crate::material::PointState`] holds none, and the passes that read
+    /// them (the shifting's) need not visit the points.
+    fn damage_vars(&self) -> bool {
+        std::iter::once(&self.material)
+            .chain(self.others.iter().map(|b| &b.material))
+            .any(|m| !matches!(m.damage, crate::material::Damage::None))
+    }
+
     fn damaging(&self) -> bool {
         std::iter::once(&self.material)
             .chain(self.others.iter().map(|b| &b.material))

@@ -74,14 +74,21 @@ pub(super) fn shift(
         plane: &setup.plane,
         held: &setup.held,
         mass: &setup.mass,
-        points: state.material_state.points(),
+        // Without damage variables no point has any to read (the same
+        // values as reading each point's empty ones, without the visit).
+        points: if setup.damage_vars() {
+            state.material_state.points()
+        } else {
+            &[]
+        },
         materials: (&setup.material, &setup.others, &setup.group),
         time: state.clock.time,
     };
     let (buffers, ext) = (&mut scratch.shifting, &mut scratch.images);
     let images = &g.mirror;
     let reference = extended(images, &state.reference, &mut ext.built, mirror::vector);
-    freedoms(&frame, reference, &mut buffers.free);
+    // Only this rank's rows: the shifts read their own node's freedom.
+    freedoms(&frame, ranks, reference, &mut buffers.free);
     let pos = extended(images, &state.pos, &mut ext.pos, mirror::vector);
     let (spacing, step_scale) = (frame.spacing, setup.rod.step_scale());
     shifts_on(
@@ -158,7 +165,8 @@ struct ShiftFrame<'a> {
     plane: &'a [u8],
     held: &'a [bool],
     mass: &'a [f64],
-    /// The material state of each node (empty before the first step).
+    /// The material state of each node (empty before the first step, and
+    /// in a run whose materials keep no damage variables).
     points: &'a [PointState],
     /// The rod's material, the further bodies and each node's body.
     materials: (&'a Material, &'a [Body], &'a [u8]),
@@ -178,11 +186,16 @@ struct ShiftedFields<'a> {
 }
 
 /// How each node may move (`reference`: the reference places, extended
-/// by the images).
-fn freedoms(frame: &ShiftFrame, reference: &[[f64; 3]], free: &mut [Freedom]) {
+/// by the images): the nodes of this rank's share ([`shifts_on`]'s).
+fn freedoms(
+    frame: &ShiftFrame,
+    ranks: &dyn crate::ranks::Ranks,
+    reference: &[[f64; 3]],
+    free: &mut [Freedom],
+) {
     let (surf, contact, anvil, nodal) = (frame.surfaces, frame.contact, frame.anvil, frame.nodal);
     let (shapes, points) = (&frame.geometry.shapes, frame.points);
-    free.par_iter_mut().enumerate().for_each(|(i, f)| {
+    crate::ranks::each_own_row(ranks, free, 1, |i, f| {
         // A pulverized node stays put: its ceramic state (pulverized,
         // its porosity) is not carried, so carrying its neighbours'
         // stress and density to it created energy (the penetration at
