@@ -335,6 +335,86 @@ impl Snapshot {
     }
 }
 
+impl Snapshot {
+    /// The particles `rows` of this snapshot (one rank's piece of a run on
+    /// several, [`crate::ranks::share`]): their positions and every field's
+    /// values.
+    pub fn piece(&self, rows: std::ops::Range<usize>) -> Snapshot {
+        Snapshot {
+            time: self.time,
+            positions: self.positions[rows.clone()].to_vec(),
+            fields: self
+                .fields
+                .iter()
+                .map(|f| {
+                    let k = f.components.len();
+                    Field {
+                        data: f.data[rows.start * k..rows.end * k].to_vec(),
+                        ..f.clone()
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// Writes the parallel file (`.pvtu`) that joins `pieces`, the `.vtu`
+    /// files of this snapshot's pieces ([`Snapshot::piece`],
+    /// [`Snapshot::write_vtu`]) named relative to it: ParaView opens it as
+    /// one data set. It declares the points and this snapshot's fields as
+    /// the pieces hold them (64-bit floats; two components padded to three).
+    pub fn write_pvtu(&self, path: &Path, pieces: &[String]) -> Result<()> {
+        use quick_xml::Writer;
+        use quick_xml::events::{BytesDecl, Event};
+        let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+        let xml = |e: quick_xml::Error| Error::io(path, e);
+        w.write_event(Event::Decl(BytesDecl::new("1.0", None, None)))
+            .map_err(xml)?;
+        let array = |w: &mut Writer<Vec<u8>>, name: Option<&str>, comps: usize| {
+            let comps = comps.to_string();
+            let mut e = w
+                .create_element("PDataArray")
+                .with_attributes([("type", "Float64"), ("NumberOfComponents", comps.as_str())]);
+            if let Some(name) = name {
+                e = e.with_attribute(("Name", name));
+            }
+            e.write_empty().map(drop)
+        };
+        w.create_element("VTKFile")
+            .with_attributes([
+                ("type", "PUnstructuredGrid"),
+                ("version", "1.0"),
+                ("byte_order", "LittleEndian"),
+                ("header_type", "UInt64"),
+            ])
+            .write_inner_content(|w| {
+                w.create_element("PUnstructuredGrid")
+                    .with_attribute(("GhostLevel", "0"))
+                    .write_inner_content(|w| {
+                        w.create_element("PPointData").write_inner_content(|w| {
+                            for f in &self.fields {
+                                let k = f.components.len();
+                                array(w, Some(f.name), if k == 2 { 3 } else { k })?;
+                            }
+                            Ok::<_, quick_xml::Error>(())
+                        })?;
+                        w.create_element("PPoints")
+                            .write_inner_content(|w| array(w, None, 3))?;
+                        for piece in pieces {
+                            w.create_element("Piece")
+                                .with_attribute(("Source", piece.as_str()))
+                                .write_empty()?;
+                        }
+                        Ok::<_, quick_xml::Error>(())
+                    })
+                    .map(drop)
+            })
+            .map_err(xml)?;
+        let mut bytes = w.into_inner();
+        bytes.push(b'\n');
+        crate::files::write_whole_bytes(path, &bytes)
+    }
+}
+
 /// Writes a ParaView collection (`.pvd`) of snapshot files with their
 /// times: `snapshots` holds (time in s, file name relative to the `.pvd`).
 /// The `.vtu` format has no place for the time of a snapshot, so ParaView

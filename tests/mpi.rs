@@ -157,3 +157,117 @@ fn a_scene_on_one_rank_only_refuses_several() {
         "{err}"
     );
 }
+
+/// The points (x, y, z interleaved) and the point arrays (name, values) of
+/// a `.vtu` or `.pvtu` file as vtkio's reader sees it, the pieces of a
+/// parallel file loaded and joined in their order.
+fn read_vtk(path: &std::path::Path) -> (Vec<f64>, Vec<(String, Vec<f64>)>) {
+    use vtkio::model::{Attribute, DataSet, Piece};
+    let mut vtk = vtkio::Vtk::import(path).unwrap();
+    vtk.load_all_pieces().unwrap();
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("{}: not an unstructured grid", path.display());
+    };
+    let (mut points, mut arrays) = (Vec::new(), Vec::<(String, Vec<f64>)>::new());
+    for piece in pieces {
+        let Piece::Inline(piece) = piece else {
+            panic!("{}: a piece not loaded", path.display());
+        };
+        points.extend(piece.points.cast_into::<f64>().unwrap());
+        for (k, a) in piece.data.point.into_iter().enumerate() {
+            let Attribute::DataArray(a) = a else {
+                panic!("not a data array");
+            };
+            let values: Vec<f64> = a.data.cast_into().unwrap();
+            match arrays.get_mut(k) {
+                Some((name, all)) => {
+                    assert_eq!(*name, a.name);
+                    all.extend(values);
+                }
+                None => arrays.push((a.name.clone(), values)),
+            }
+        }
+    }
+    (points, arrays)
+}
+
+/// On two ranks each snapshot is a piece per rank and a `.pvtu` that
+/// joins them: read back by vtkio's reader, the joined pieces hold the
+/// one-rank snapshot's points and fields, in order, bit for bit; the
+/// collection lists the `.pvtu` files.
+#[test]
+fn the_vtk_pieces_join_into_the_snapshot_of_one_rank() {
+    let sets = ["particles_radial=3", "end_time=2e-6"];
+    let mut written = Vec::new();
+    for ranks in [1, 2] {
+        let vtk = dir().join(format!("vtk-{ranks}"));
+        let _ = std::fs::remove_dir_all(&vtk);
+        let n = ranks.to_string();
+        let path = vtk.to_str().unwrap().to_string();
+        let mut args = vec!["-n", &n, PROGRAM, "run", "taylor3d", "-q"];
+        for s in &sets {
+            args.extend(["--set", s]);
+        }
+        args.extend(["--vtk-dir", &path, "--vtk-times", "0,1e-6"]);
+        let out = mpiexec(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        written.push(vtk);
+    }
+    let pvd = std::fs::read_to_string(written[1].join("particles.pvd")).unwrap();
+    for k in 0..3 {
+        let one = read_vtk(&written[0].join(format!("particles_{k:04}.vtu")));
+        let two = written[1].join(format!("particles_{k:04}.pvtu"));
+        assert!(
+            pvd.contains(&format!("file=\"particles_{k:04}.pvtu\"")),
+            "{pvd}"
+        );
+        for r in 0..2 {
+            assert!(
+                written[1]
+                    .join(format!("particles_{k:04}_{r}.vtu"))
+                    .exists()
+            );
+        }
+        let two = read_vtk(&two);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert!(!one.0.is_empty());
+        assert_eq!(bits(&one.0), bits(&two.0), "snapshot {k}: points");
+        assert_eq!(one.1.len(), two.1.len(), "snapshot {k}: arrays");
+        for ((a, x), (b, y)) in one.1.iter().zip(&two.1) {
+            assert_eq!(a, b);
+            assert_eq!(bits(x), bits(y), "snapshot {k}: `{a}`");
+        }
+    }
+}
+
+/// An output that cannot be written on one rank only (its `--vtk-dir`
+/// under a file) stops every rank before the run, with that rank's
+/// error, printed once; no rank waits for it.
+#[test]
+fn an_output_that_fails_on_one_rank_stops_every_rank() {
+    let good = dir().join("vtk-good");
+    let good = good.to_str().unwrap();
+    let run = |vtk| {
+        let set = ["--set", "particles_radial=3", "--vtk-dir", vtk];
+        [PROGRAM, "run", "taylor3d", "-q"].into_iter().chain(set)
+    };
+    let args: Vec<&str> = ["-n", "1"]
+        .into_iter()
+        .chain(run(good))
+        .chain([":", "-n", "1"])
+        .chain(run("/dev/null/vtk"))
+        .collect();
+    let out = mpiexec(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(
+        err.matches("error: --vtk-dir /dev/null/vtk").count(),
+        1,
+        "{err}"
+    );
+    assert!(err.contains("(rank 1)"), "{err}");
+}

@@ -43,8 +43,9 @@ fn run_on(team: &Handle, mut a: RunArgs) -> Result<(), Stop> {
     let (sim, mut host) = team::agree(&**team, began)?;
     if team.rank() > 0 {
         // Rank 0 writes and prints; the others hold the same run.
+        // Every rank writes its piece of each VTK snapshot.
         (host.json, host.csv, host.checkpoint) = (None, None, None);
-        (host.profile, host.vtk_dir) = (None, None);
+        host.profile = None;
         a.quiet = true;
     }
     run_sim(team, sim, host, &a)
@@ -54,35 +55,18 @@ fn run_on(team: &Handle, mut a: RunArgs) -> Result<(), Stop> {
 fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -> Result<(), Stop> {
     let end_time = sim.end_time();
     // Every output is checked before the run, so that a typo does not cost
-    // the results of a long run.
-    if let Some(path) = &host.json {
-        check_output_file("--json", path)?;
-    }
-    if let Some(path) = &host.csv {
-        check_output_file("--csv", path)?;
-    }
-    if let Some(path) = &host.checkpoint {
-        check_output_file("--checkpoint", path)?;
-    }
-    if let Some(path) = &host.profile {
-        check_output_file("--profile", path)?;
-        if sim.rod_profile().is_none() {
-            return Err(Stop::failed(format!(
-                "--profile: scene `{}` has no rod to outline",
-                sim.kind().name()
-            )));
-        }
-    }
-    if let Some(dir) = &host.vtk_dir {
-        check_output_dir("--vtk-dir", dir, "particles.pvd")?;
-    }
-    signals::install().map_err(|e| Stop::failed(format!("installing the signal handlers: {e}")))?;
+    // the results of a long run; on several ranks, a failed check on any
+    // stops all (the others would wait for it at the first step).
+    let checked = check_outputs(team, &sim, &host).and_then(|()| {
+        signals::install().map_err(|e| Stop::failed(format!("installing the signal handlers: {e}")))
+    });
+    team::agree(&**team, checked)?;
     // The first snapshot failure, reported after the run.
     let mut vtk_error = None;
     if host.vtk_dir.is_some() && host.vtk_next == 0 && sim.steps() == 0 {
         let due = host.vtk_times.iter().take_while(|&&t| t <= 0.0).count();
         if due > 0 {
-            if let Err(e) = write_vtk(&sim, &mut host) {
+            if let Err(e) = write_vtk(team, &sim, &mut host) {
                 vtk_error = Some(e);
             }
             host.vtk_next = due;
@@ -124,7 +108,7 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
             while host.vtk_next < host.vtk_times.len()
                 && sim.time() >= host.vtk_times[host.vtk_next]
             {
-                if let Err(e) = write_vtk(&sim, &mut host) {
+                if let Err(e) = write_vtk(team, &sim, &mut host) {
                     vtk_error.get_or_insert(e);
                 }
                 host.vtk_next += 1;
@@ -199,7 +183,7 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
     // The final snapshot is the run's end's: an interrupted run writes it
     // when it is continued.
     if interrupted.is_none()
-        && let Err(e) = write_vtk(&sim, &mut host)
+        && let Err(e) = write_vtk(team, &sim, &mut host)
     {
         vtk_error.get_or_insert(e);
     }
@@ -253,6 +237,43 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
     outcome(failures, printed)
 }
 
+/// The checks of the outputs before a run (rank 0 holds every output but
+/// the VTK pieces, which every rank writes).
+fn check_outputs(team: &Handle, sim: &Simulation, host: &RunHost) -> Result<(), Stop> {
+    if let Some(path) = &host.json {
+        check_output_file("--json", path)?;
+    }
+    if let Some(path) = &host.csv {
+        check_output_file("--csv", path)?;
+    }
+    if let Some(path) = &host.checkpoint {
+        check_output_file("--checkpoint", path)?;
+    }
+    if let Some(path) = &host.profile {
+        check_output_file("--profile", path)?;
+        if sim.rod_profile().is_none() {
+            return Err(Stop::failed(format!(
+                "--profile: scene `{}` has no rod to outline",
+                sim.kind().name()
+            )));
+        }
+    }
+    if let Some(dir) = &host.vtk_dir {
+        let probe = if team.rank() == 0 {
+            "particles.pvd".to_string()
+        } else {
+            piece_name(host.vtk_written.len(), team.rank())
+        };
+        check_output_dir("--vtk-dir", dir, &probe)?;
+    }
+    Ok(())
+}
+
+/// The file of rank `rank`'s piece of snapshot `k` on several ranks.
+fn piece_name(k: usize, rank: usize) -> String {
+    format!("particles_{k:04}_{rank}.vtu")
+}
+
 /// `--phases`: the solver's time by phase on stderr, marked with the rank
 /// on several ranks, or a line saying that the scene keeps none.
 fn print_phases(team: &Handle, sim: &Simulation) {
@@ -272,12 +293,41 @@ fn print_phases(team: &Handle, sim: &Simulation) {
 
 /// Writes the next snapshot of the run into `--vtk-dir` (if given) and
 /// rewrites the collection `particles.pvd`, so that it is whole even when
-/// a run stops early.
-fn write_vtk(sim: &Simulation, host: &mut RunHost) -> Result<(), Error> {
-    if let Some(dir) = &host.vtk_dir {
-        let name = format!("particles_{:04}.vtu", host.vtk_written.len());
-        sim.snapshot().write_vtu(&dir.join(&name))?;
-        host.vtk_written.push((sim.time(), name));
+/// a run stops early. On several ranks each rank writes its share of the
+/// particles as a piece (`particles_NNNN_R.vtu`), and rank 0 the parallel
+/// file that joins them (`particles_NNNN.pvtu`), listed in the collection;
+/// a piece that failed on any rank fails the snapshot on rank 0.
+fn write_vtk(team: &Handle, sim: &Simulation, host: &mut RunHost) -> Result<(), Error> {
+    let Some(dir) = host.vtk_dir.clone() else {
+        return Ok(());
+    };
+    let k = host.vtk_written.len();
+    let snapshot = sim.snapshot();
+    let name = if team.size() == 1 {
+        let name = format!("particles_{k:04}.vtu");
+        snapshot.write_vtu(&dir.join(&name))?;
+        name
+    } else {
+        let (rank, size) = (team.rank(), team.size());
+        let rows = meshless_impact::ranks::share(snapshot.positions.len(), rank, size, 1);
+        let mine = snapshot
+            .piece(rows)
+            .write_vtu(&dir.join(piece_name(k, rank)));
+        if let Some((r, message)) = team::first_error(&**team, mine.err().map(|e| e.to_string())) {
+            return Err(Error::io(
+                dir.join(piece_name(k, r)),
+                format!("rank {r}'s piece: {message}"),
+            ));
+        }
+        let name = format!("particles_{k:04}.pvtu");
+        if rank == 0 {
+            let pieces: Vec<String> = (0..size).map(|r| piece_name(k, r)).collect();
+            snapshot.write_pvtu(&dir.join(&name), &pieces)?;
+        }
+        name
+    };
+    host.vtk_written.push((sim.time(), name));
+    if team.rank() == 0 {
         meshless_impact::write_pvd(&dir.join("particles.pvd"), &host.vtk_written)?;
     }
     Ok(())

@@ -54,6 +54,16 @@ fn first_failure(team: &dyn Ranks, mine: Option<Vec<u8>>) -> Option<(i64, Vec<u8
     Some((failed, bytes))
 }
 
+/// The lowest rank whose `mine` is `Some` (an error of a collective
+/// output), with its message, on every rank; `None` when no rank's is.
+pub(crate) fn first_error(team: &dyn Ranks, mine: Option<String>) -> Option<(usize, String)> {
+    if team.size() == 1 {
+        return mine.map(|m| (0, m));
+    }
+    let (rank, bytes) = first_failure(team, mine.map(String::into_bytes))?;
+    Some((rank as usize, String::from_utf8_lossy(&bytes).into_owned()))
+}
+
 /// The signal that asked any rank to stop (its number; 0 for none): every
 /// rank breaks off at the same step.
 pub(crate) fn agree_signal(team: &dyn Ranks, signal: i32) -> i32 {
