@@ -44,6 +44,15 @@ pub trait Ranks: Debug + Send + Sync {
     /// bytes; `local.len() == counts[self.rank()]`).
     fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]);
 
+    /// [`Ranks::all_gather`] with this rank's bytes already in their place
+    /// in `out` (after the bytes of the ranks before it). By default
+    /// through a copy of them; an implementation may gather in place.
+    fn all_gather_in_place(&self, counts: &[usize], out: &mut [u8]) {
+        let at: usize = counts[..self.rank()].iter().sum();
+        let own = out[at..at + counts[self.rank()]].to_vec();
+        self.all_gather(&own, counts, out);
+    }
+
     /// The smallest of every rank's `value`. (Signed: MPICH's reduction of
     /// `MPI_UINT64_T` through rsmpi took 2^64 − 1 for the minimum of 0 and
     /// 2^64 − 1, measured; `i64::MAX` is the "none" of a minimum here.)
@@ -122,13 +131,6 @@ unsafe impl Plain for usize {}
 // SAFETY: an array of a plain type has its elements' bytes, no padding.
 unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
 
-/// The bytes of `v`.
-fn bytes<T: Plain>(v: &[T]) -> &[u8] {
-    // SAFETY: `T: Plain` has no padding, so every byte is initialised;
-    // the length is the slice's size in bytes.
-    unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
-}
-
 /// The bytes of `v`, writable.
 fn bytes_mut<T: Plain>(v: &mut [T]) -> &mut [u8] {
     // SAFETY: as in `bytes`; any bytes written make valid `T`s (`Plain`).
@@ -162,8 +164,7 @@ pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &m
     debug_assert_eq!(parts.last().map_or(0, |p| p.end), out.len());
     let size = std::mem::size_of::<T>();
     let counts: Vec<usize> = parts.iter().map(|p| p.len() * size).collect();
-    let own = bytes(&out[parts[ranks.rank()].clone()]).to_vec();
-    ranks.all_gather(&own, &counts, bytes_mut(out));
+    ranks.all_gather_in_place(&counts, bytes_mut(out));
 }
 
 /// [`gather_parts`] for values that are not [`Plain`]: each rank's part

@@ -390,6 +390,9 @@ impl<'a> System<'a> {
 struct Fused {
     /// `D_J` (zero off the inner nodes).
     diag: Vec<f64>,
+    /// The rows whose `w_i` this rank's columns read (every row alone):
+    /// each rank computes those itself rather than receive them.
+    rows: std::ops::Range<usize>,
     /// `w_i` (4 × 3 per row, each basis value's three components padded
     /// to four: one vector).
     w: Vec<[[f64; 4]; 4]>,
@@ -408,9 +411,24 @@ impl Fused {
                     .sum()
             };
         });
+        let n = sys.shapes.len();
+        let rows = if ranks.size() == 1 {
+            0..n
+        } else {
+            // The rows of the entries of this rank's inner columns.
+            let own = crate::ranks::share(n, ranks.rank(), ranks.size(), ROWS);
+            let (lo, hi) = own
+                .into_par_iter()
+                .filter(|&j| sys.inner[j])
+                .flat_map_iter(|j| (c.offsets[j]..c.offsets[j + 1]).map(|k| c.at(k).1))
+                .fold(|| (usize::MAX, 0), |(lo, hi), i| (lo.min(i), hi.max(i + 1)))
+                .reduce(|| (usize::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+            lo.min(hi)..hi
+        };
         Fused {
             diag,
-            w: filled(sys.shapes.len(), [[0.0; 4]; 4]),
+            rows,
+            w: filled(n, [[0.0; 4]; 4]),
         }
     }
 
@@ -421,10 +439,11 @@ impl Fused {
         self.apply_on(&crate::ranks::Alone, isa, sys, mu, y);
     }
 
-    /// [`Fused::apply`] shared among `ranks`: each computes the rows of
-    /// its share (whole tasks of [`ROWS`]), the rows are gathered, then
-    /// each computes its share of the columns, and the columns are
-    /// gathered (the same bits on any number of ranks).
+    /// [`Fused::apply`] shared among `ranks`: each computes the rows its
+    /// columns read ([`Fused::rows`]: its own share's and the rows about
+    /// it; no rows travel), then its share of the columns (whole tasks of
+    /// [`ROWS`]), and the columns are gathered (the same bits on any
+    /// number of ranks).
     fn apply_on(
         &mut self,
         ranks: &dyn crate::ranks::Ranks,
@@ -440,14 +459,13 @@ impl Fused {
             crate::ranks::shares(ranks, n, ROWS)
         };
         let own = parts.get(ranks.rank()).cloned().unwrap_or(0..n);
-        let first = own.start;
-        self.w[own.clone()]
+        let rows = self.rows.clone();
+        let start = rows.start;
+        self.w[rows]
             .par_chunks_mut(ROWS)
             .enumerate()
-            .for_each(|(k, w)| row_pass(isa, sys, mu, first + k * ROWS, w));
-        if !parts.is_empty() {
-            crate::ranks::gather_parts(ranks, &parts, &mut self.w);
-        }
+            .for_each(|(k, w)| row_pass(isa, sys, mu, start + k * ROWS, w));
+        let first = own.start;
         let (diag, w) = (&self.diag[..], &self.w[..]);
         y[own]
             .par_chunks_mut(ROWS)

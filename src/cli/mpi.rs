@@ -4,8 +4,10 @@
 
 use meshless_impact::ranks::Ranks;
 use mpi::collective::SystemOperation;
+use mpi::datatype::Equivalence;
 use mpi::datatype::PartitionMut;
 use mpi::environment::Universe;
+use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives, Root};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -27,6 +29,11 @@ pub(crate) struct MpiRanks {
     /// them at the end).
     calls: AtomicU64,
     received: AtomicU64,
+    /// The library is MPICH, whose `MPI_IN_PLACE` is `(void *) -1`
+    /// (`mpi.h`): rsmpi has no in-place gather and its bindings no
+    /// `MPI_IN_PLACE`, so the gathers in place use that value, and only
+    /// where the library says it is MPICH.
+    mpich: bool,
     _universe: Universe,
 }
 
@@ -71,12 +78,15 @@ pub(crate) fn init() -> Result<MpiRanks, String> {
     }
     let world = universe.world();
     let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let mpich = mpi::environment::library_version().is_ok_and(|v| v.starts_with("MPICH"))
+        && std::env::var_os("MI_NO_IN_PLACE").is_none();
     Ok(MpiRanks {
         world,
         rank,
         size,
         calls: AtomicU64::new(0),
         received: AtomicU64::new(0),
+        mpich,
         _universe: universe,
     })
 }
@@ -92,6 +102,48 @@ impl MpiRanks {
 }
 
 impl Ranks for MpiRanks {
+    fn all_gather_in_place(&self, counts: &[usize], out: &mut [u8]) {
+        if !self.mpich || out.len() > i32::MAX as usize {
+            let at: usize = counts[..self.rank].iter().sum();
+            let own = out[at..at + counts[self.rank]].to_vec();
+            return self.all_gather(&own, counts, out);
+        }
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.received
+            .fetch_add((out.len() - counts[self.rank]) as u64, Ordering::Relaxed);
+        let counts32: Vec<i32> = counts.iter().map(|&c| c as i32).collect();
+        let displs: Vec<i32> = counts
+            .iter()
+            .scan(0i32, |s, &c| {
+                let at = *s;
+                *s += c as i32;
+                Some(at)
+            })
+            .collect();
+        let byte = u8::equivalent_datatype().as_raw();
+        // MPICH's MPI_IN_PLACE (`mpi.h`: `(void *) -1`), checked in `init`.
+        let in_place = usize::MAX as *const std::ffi::c_void;
+        // SAFETY: `out` holds the sum of `counts` bytes (the caller's
+        // contract), `counts32` and `displs` have one entry per rank, the
+        // communicator is this world's, and with MPI_IN_PLACE the send
+        // arguments are ignored. MPI is called from one thread at a time
+        // (see the `Send` impl).
+        let rc = unsafe {
+            mpi::ffi::MPI_Allgatherv(
+                in_place,
+                0,
+                byte,
+                out.as_mut_ptr().cast(),
+                counts32.as_ptr(),
+                displs.as_ptr(),
+                byte,
+                self.world.as_raw(),
+            )
+        };
+        // MPI's default handler aborts the job on an error: a return is a
+        // success.
+        debug_assert_eq!(rc, 0);
+    }
     fn rank(&self) -> usize {
         self.rank
     }
