@@ -169,7 +169,7 @@ fn material_pass(
             mass,
             vel,
             grad,
-            damaging: false,
+            damage_vars: false,
         },
         MaterialFields {
             dev: &mut out.dev,

@@ -166,7 +166,7 @@ pub(super) fn step_with(
             mass: &setup.mass,
             vel: &state.vel,
             grad: &scratch.grad,
-            damaging,
+            damage_vars: setup.damage_vars(),
         },
         MaterialFields {
             dev: &mut state.dev,

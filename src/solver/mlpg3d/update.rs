@@ -36,9 +36,9 @@ pub(super) struct MaterialInputs<'a> {
     pub(super) vel: &'a [[f64; 3]],
     /// The velocity gradient `L = ∂v/∂x` at each node.
     pub(super) grad: &'a [[[f64; 3]; 3]],
-    /// Some material damages (its points hold damage variables, which
-    /// ranks that share the pass exchange).
-    pub(super) damaging: bool,
+    /// Some material keeps damage variables at its points (Rajendran-Grove's
+    /// or JH-2's), which ranks that share the pass exchange.
+    pub(super) damage_vars: bool,
 }
 
 /// The node fields the material pass updates.
@@ -102,7 +102,7 @@ pub(super) fn update_material(
     gather_parts(ranks, &parts, temp);
     gather_parts(ranks, &parts, rho);
     gather_parts(ranks, &parts, visc);
-    if input.damaging {
+    if input.damage_vars {
         crate::material::MaterialState::gather(states, ranks, &parts);
     }
 }
@@ -203,7 +203,7 @@ fn update_rows(
         mass,
         vel,
         grad,
-        damaging: _,
+        damage_vars: _,
     } = *input;
     fields
         .dev
