@@ -364,11 +364,6 @@ impl Snapshot {
     /// the pieces hold them (64-bit floats; two components padded to three).
     pub fn write_pvtu(&self, path: &Path, pieces: &[String]) -> Result<()> {
         use quick_xml::Writer;
-        use quick_xml::events::{BytesDecl, Event};
-        let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-        let xml = |e: quick_xml::Error| Error::io(path, e);
-        w.write_event(Event::Decl(BytesDecl::new("1.0", None, None)))
-            .map_err(xml)?;
         let array = |w: &mut Writer<Vec<u8>>, name: Option<&str>, comps: usize| {
             let comps = comps.to_string();
             let mut e = w
@@ -379,40 +374,55 @@ impl Snapshot {
             }
             e.write_empty().map(drop)
         };
-        w.create_element("VTKFile")
-            .with_attributes([
-                ("type", "PUnstructuredGrid"),
-                ("version", "1.0"),
-                ("byte_order", "LittleEndian"),
-                ("header_type", "UInt64"),
-            ])
-            .write_inner_content(|w| {
-                w.create_element("PUnstructuredGrid")
-                    .with_attribute(("GhostLevel", "0"))
-                    .write_inner_content(|w| {
-                        w.create_element("PPointData").write_inner_content(|w| {
-                            for f in &self.fields {
-                                let k = f.components.len();
-                                array(w, Some(f.name), if k == 2 { 3 } else { k })?;
+        write_xml(path, |w| {
+            w.create_element("VTKFile")
+                .with_attributes([
+                    ("type", "PUnstructuredGrid"),
+                    ("version", "1.0"),
+                    ("byte_order", "LittleEndian"),
+                    ("header_type", "UInt64"),
+                ])
+                .write_inner_content(|w| {
+                    w.create_element("PUnstructuredGrid")
+                        .with_attribute(("GhostLevel", "0"))
+                        .write_inner_content(|w| {
+                            w.create_element("PPointData").write_inner_content(|w| {
+                                for f in &self.fields {
+                                    let k = f.components.len();
+                                    array(w, Some(f.name), if k == 2 { 3 } else { k })?;
+                                }
+                                Ok::<_, quick_xml::Error>(())
+                            })?;
+                            w.create_element("PPoints")
+                                .write_inner_content(|w| array(w, None, 3))?;
+                            for piece in pieces {
+                                w.create_element("Piece")
+                                    .with_attribute(("Source", piece.as_str()))
+                                    .write_empty()?;
                             }
                             Ok::<_, quick_xml::Error>(())
-                        })?;
-                        w.create_element("PPoints")
-                            .write_inner_content(|w| array(w, None, 3))?;
-                        for piece in pieces {
-                            w.create_element("Piece")
-                                .with_attribute(("Source", piece.as_str()))
-                                .write_empty()?;
-                        }
-                        Ok::<_, quick_xml::Error>(())
-                    })
-                    .map(drop)
-            })
-            .map_err(xml)?;
-        let mut bytes = w.into_inner();
-        bytes.push(b'\n');
-        crate::files::write_whole_bytes(path, &bytes)
+                        })
+                        .map(drop)
+                })
+                .map(drop)
+        })
     }
+}
+
+/// Writes the XML file `path`: the declaration, then what `body` writes
+/// (indented by two), then a final newline, whole.
+fn write_xml(
+    path: &Path,
+    body: impl FnOnce(&mut quick_xml::Writer<Vec<u8>>) -> std::result::Result<(), quick_xml::Error>,
+) -> Result<()> {
+    use quick_xml::events::{BytesDecl, Event};
+    let mut w = quick_xml::Writer::new_with_indent(Vec::new(), b' ', 2);
+    w.write_event(Event::Decl(BytesDecl::new("1.0", None, None)))
+        .and_then(|()| body(&mut w))
+        .map_err(|e| Error::io(path, e))?;
+    let mut bytes = w.into_inner();
+    bytes.push(b'\n');
+    crate::files::write_whole_bytes(path, &bytes)
 }
 
 /// Writes a ParaView collection (`.pvd`) of snapshot files with their
@@ -420,38 +430,31 @@ impl Snapshot {
 /// The `.vtu` format has no place for the time of a snapshot, so ParaView
 /// takes it from here (open the `.pvd` to step through the run in time).
 pub fn write_pvd(path: &Path, snapshots: &[(f64, String)]) -> Result<()> {
-    use quick_xml::Writer;
-    use quick_xml::events::{BytesDecl, Event};
-    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-    let xml = |e: quick_xml::Error| Error::io(path, e);
-    w.write_event(Event::Decl(BytesDecl::new("1.0", None, None)))
-        .map_err(xml)?;
-    w.create_element("VTKFile")
-        .with_attributes([
-            ("type", "Collection"),
-            ("version", "0.1"),
-            ("byte_order", "LittleEndian"),
-        ])
-        .write_inner_content(|w| {
-            w.create_element("Collection")
-                .write_inner_content(|w| {
-                    for (time, file) in snapshots {
-                        w.create_element("DataSet")
-                            .with_attributes([
-                                ("timestep", format!("{time:e}").as_str()),
-                                ("part", "0"),
-                                ("file", file.as_str()),
-                            ])
-                            .write_empty()?;
-                    }
-                    Ok::<_, quick_xml::Error>(())
-                })
-                .map(drop)
-        })
-        .map_err(xml)?;
-    let mut bytes = w.into_inner();
-    bytes.push(b'\n');
-    crate::files::write_whole_bytes(path, &bytes)
+    write_xml(path, |w| {
+        w.create_element("VTKFile")
+            .with_attributes([
+                ("type", "Collection"),
+                ("version", "0.1"),
+                ("byte_order", "LittleEndian"),
+            ])
+            .write_inner_content(|w| {
+                w.create_element("Collection")
+                    .write_inner_content(|w| {
+                        for (time, file) in snapshots {
+                            w.create_element("DataSet")
+                                .with_attributes([
+                                    ("timestep", format!("{time:e}").as_str()),
+                                    ("part", "0"),
+                                    ("file", file.as_str()),
+                                ])
+                                .write_empty()?;
+                        }
+                        Ok::<_, quick_xml::Error>(())
+                    })
+                    .map(drop)
+            })
+            .map(drop)
+    })
 }
 
 observables! {

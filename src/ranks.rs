@@ -48,9 +48,7 @@ pub trait Ranks: Debug + Send + Sync {
     /// in `out` (after the bytes of the ranks before it). By default
     /// through a copy of them; an implementation may gather in place.
     fn all_gather_in_place(&self, counts: &[usize], out: &mut [u8]) {
-        let at: usize = counts[..self.rank()].iter().sum();
-        let own = out[at..at + counts[self.rank()]].to_vec();
-        self.all_gather(&own, counts, out);
+        gather_through_copy(self, counts, out);
     }
 
     /// The smallest of every rank's `value`. (Signed: MPICH's reduction of
@@ -63,6 +61,14 @@ pub trait Ranks: Debug + Send + Sync {
 
     /// `bytes` of rank `root` on every rank (resized to its length).
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>);
+}
+
+/// [`Ranks::all_gather_in_place`] through a copy of this rank's bytes
+/// (the trait's default, and a fallback of an implementation's own).
+pub fn gather_through_copy<R: Ranks + ?Sized>(ranks: &R, counts: &[usize], out: &mut [u8]) {
+    let at: usize = counts[..ranks.rank()].iter().sum();
+    let own = out[at..at + counts[ranks.rank()]].to_vec();
+    ranks.all_gather(&own, counts, out);
 }
 
 /// One process alone: every exchange is the identity.

@@ -104,9 +104,7 @@ impl MpiRanks {
 impl Ranks for MpiRanks {
     fn all_gather_in_place(&self, counts: &[usize], out: &mut [u8]) {
         if !self.mpich || out.len() > i32::MAX as usize {
-            let at: usize = counts[..self.rank].iter().sum();
-            let own = out[at..at + counts[self.rank]].to_vec();
-            return self.all_gather(&own, counts, out);
+            return meshless_impact::ranks::gather_through_copy(self, counts, out);
         }
         self.calls.fetch_add(1, Ordering::Relaxed);
         self.received
