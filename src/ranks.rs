@@ -167,7 +167,14 @@ pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &m
     if ranks.size() == 1 {
         return;
     }
-    debug_assert_eq!(parts.last().map_or(0, |p| p.end), out.len());
+    // Counts that do not cover `out` would have MPI write past it.
+    assert!(
+        parts.first().is_some_and(|p| p.start == 0)
+            && parts.windows(2).all(|w| w[0].end == w[1].start)
+            && parts.last().is_some_and(|p| p.end == out.len()),
+        "the parts of a gather cover its buffer in order: {parts:?} over {}",
+        out.len()
+    );
     let size = std::mem::size_of::<T>();
     let counts: Vec<usize> = parts.iter().map(|p| p.len() * size).collect();
     ranks.all_gather_in_place(&counts, bytes_mut(out));

@@ -661,17 +661,20 @@ impl NodalShapes {
             .for_each(|(i, l)| *l = self.gradient(i, velocity));
     }
 
-    /// [`NodalShapes::velocity_gradients`] shared among `ranks`: each
-    /// computes only the rows of its share aligned to `align`
-    /// ([`crate::ranks::each_own_row`]), the other rows of `out` left as
-    /// they were (their reader, the material pass, reads the same share).
+    /// [`NodalShapes::velocity_gradients`] of the rows `own` only (a rank's
+    /// part of the material pass), the other rows of `out` left as they
+    /// were (their reader, the material pass, reads the same part).
     pub fn velocity_gradients_on(
         &self,
-        (ranks, align): (&dyn crate::ranks::Ranks, usize),
+        own: std::ops::Range<usize>,
         velocity: &[[f64; 3]],
         out: &mut [[[f64; 3]; 3]],
     ) {
-        crate::ranks::each_own_row(ranks, out, align, |i, l| *l = self.gradient(i, velocity));
+        let start = own.start;
+        out[own]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, l)| *l = self.gradient(start + k, velocity));
     }
 
     /// The collocated gradient (eq. 4) of the nodal vector field `field`

@@ -34,6 +34,7 @@ use crate::approx::buffers::refill;
 use crate::approx::mls::NodalShapes;
 use crate::approx::weak::VOIGT;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// The transpose of the rows of `shapes` over `columns ≥ shapes.len()`
@@ -42,8 +43,8 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 /// `i` that names `J`, in ascending `i`.
 pub(crate) fn transpose(shapes: &NodalShapes, columns: usize) -> (Vec<usize>, Vec<u64>) {
     let mut offsets = Vec::new();
-    column_offsets(shapes, columns, &mut offsets);
-    let entries = column_entries(shapes, &offsets);
+    column_offsets(shapes, 0..columns, &mut offsets);
+    let entries = column_entries(shapes, &offsets, 0..columns);
     (offsets, entries)
 }
 
@@ -53,47 +54,53 @@ pub(crate) fn entry_parts(e: u64) -> (usize, usize) {
     ((e >> 32) as usize, (e & 0xffff_ffff) as usize)
 }
 
-/// Where each of the `columns` columns of `shapes` starts among the entries
-/// of the transpose: `columns + 1` offsets, written into `offsets`. The
-/// counts run on the pool (an atomic counter per column; a count is the
-/// same in any order).
-fn column_offsets(shapes: &NodalShapes, columns: usize, offsets: &mut Vec<usize>) {
-    let counts: Vec<AtomicUsize> = (0..columns)
+/// Where each of the columns `held` of `shapes` starts among the entries
+/// of the transpose of those columns: `held.len() + 1` offsets from 0,
+/// written into `offsets`. The counts run on the pool (an atomic counter
+/// per column; a count is the same in any order).
+fn column_offsets(shapes: &NodalShapes, held: Range<usize>, offsets: &mut Vec<usize>) {
+    let counts: Vec<AtomicUsize> = held
+        .clone()
         .into_par_iter()
         .map(|_| AtomicUsize::new(0))
         .collect();
     shapes.nodes.par_chunks(1 << 14).for_each(|chunk| {
         for &j in chunk {
-            counts[j].fetch_add(1, Ordering::Relaxed);
+            if held.contains(&j) {
+                counts[j - held.start].fetch_add(1, Ordering::Relaxed);
+            }
         }
     });
-    refill(offsets, columns + 1, 0);
+    refill(offsets, held.len() + 1, 0);
     for (j, c) in counts.into_iter().enumerate() {
         offsets[j + 1] = offsets[j] + c.into_inner();
     }
 }
 
-/// The entries of the transpose of `shapes` whose columns start at
-/// `offsets`, each `q << 32 | i`, in ascending `i` within each column.
-/// The scatter runs on the pool, each entry placed by its column's atomic
-/// cursor, and then each column is sorted: a column's entries are
-/// distinct, and ascending `q` is ascending `i` (the rows are stored in
-/// order), so the result is that of a serial counting sort for any number
-/// of threads.
-fn column_entries(shapes: &NodalShapes, offsets: &[usize]) -> Vec<u64> {
+/// The entries of the transpose of the columns `held` of `shapes`, whose
+/// columns start at `offsets` ([`column_offsets`]), each `q << 32 | i`, in
+/// ascending `i` within each column. The scatter runs on the pool, each
+/// entry placed by its column's atomic cursor, and then each column is
+/// sorted: a column's entries are distinct, and ascending `q` is ascending
+/// `i` (the rows are stored in order), so the result is that of a serial
+/// counting sort for any number of threads.
+fn column_entries(shapes: &NodalShapes, offsets: &[usize], held: Range<usize>) -> Vec<u64> {
     let columns = offsets.len() - 1;
     let cursor: Vec<AtomicUsize> = offsets[..columns]
         .par_iter()
         .map(|&o| AtomicUsize::new(o))
         .collect();
-    let slots: Vec<AtomicU64> = (0..shapes.nodes.len())
+    let slots: Vec<AtomicU64> = (0..offsets[columns])
         .into_par_iter()
         .map(|_| AtomicU64::new(0))
         .collect();
     (0..shapes.len()).into_par_iter().for_each(|i| {
         for q in shapes.row(i) {
-            let k = cursor[shapes.nodes[q]].fetch_add(1, Ordering::Relaxed);
-            slots[k].store((q as u64) << 32 | i as u64, Ordering::Relaxed);
+            let j = shapes.nodes[q];
+            if held.contains(&j) {
+                let k = cursor[j - held.start].fetch_add(1, Ordering::Relaxed);
+                slots[k].store((q as u64) << 32 | i as u64, Ordering::Relaxed);
+            }
         }
     });
     // In place (the same size and alignment): no second buffer.
@@ -142,11 +149,15 @@ pub(crate) fn for_segments<T: Send>(
 }
 
 /// The transpose of the nodal shape functions and their gradients: for
-/// each node `J`, the nodes `i` (ascending) with `φ_J(x_i)` and
-/// `∇φ_J(x_i)`.
+/// each node `J` of [`NodalOperator::held`], the nodes `i` (ascending) with
+/// `φ_J(x_i)` and `∇φ_J(x_i)`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct NodalOperator {
-    /// Row `J` is `offsets[J]..offsets[J + 1]`.
+    /// The columns held: every one, or on one of several ranks the rank's
+    /// share of them ([`crate::ranks::share`]), the columns its passes
+    /// compute.
+    pub held: Range<usize>,
+    /// Row `J` is `offsets[J - held.start]..offsets[J - held.start + 1]`.
     pub offsets: Vec<usize>,
     /// The nodes `i` whose shapes name `J`, ascending in each row.
     pub nodes: Vec<usize>,
@@ -171,9 +182,23 @@ impl NodalOperator {
     /// [`transpose`], written straight into the operator: no list of
     /// entries beside it (BENCHMARKS.md, memory).
     pub fn rebuild(&mut self, shapes: &NodalShapes, columns: usize) {
-        column_offsets(shapes, columns, &mut self.offsets);
-        let entries = column_entries(shapes, &self.offsets);
-        let total = shapes.nodes.len();
+        self.rebuild_on(&crate::ranks::Alone, shapes, columns);
+    }
+
+    /// [`NodalOperator::rebuild`] of this rank's share of the columns only
+    /// (the share [`crate::ranks::each_row`] gives it over `columns` rows):
+    /// the columns that [`NodalOperator::apply_on`] and
+    /// [`NodalOperator::defect_transpose_on`] compute on this rank.
+    pub fn rebuild_on(
+        &mut self,
+        ranks: &dyn crate::ranks::Ranks,
+        shapes: &NodalShapes,
+        columns: usize,
+    ) {
+        self.held = crate::ranks::share(columns, ranks.rank(), ranks.size(), 1);
+        column_offsets(shapes, self.held.clone(), &mut self.offsets);
+        let entries = column_entries(shapes, &self.offsets, self.held.clone());
+        let total = entries.len();
         refill(&mut self.nodes, total, 0);
         refill(&mut self.grad, total, [0.0; 3]);
         refill(&mut self.phi, total, 0.0);
@@ -201,9 +226,10 @@ impl NodalOperator {
         y: &[[f64; 3]],
         out: &mut [[f64; 3]],
     ) {
+        self.check_held(ranks, out.len());
         crate::ranks::each_row(ranks, out, |j, o| {
             let mut m = [0.0; 3];
-            for q in self.offsets[j]..self.offsets[j + 1] {
+            for q in self.column(j) {
                 let (yi, p) = (y[self.nodes[q]], self.phi[q]);
                 for c in 0..3 {
                     m[c] += p * yi[c];
@@ -230,9 +256,10 @@ impl NodalOperator {
         volume: &[f64],
         out: &mut [[f64; 3]],
     ) {
+        self.check_held(ranks, out.len());
         crate::ranks::each_row(ranks, out, |j, f| {
             *f = [0.0; 3];
-            for q in self.offsets[j]..self.offsets[j + 1] {
+            for q in self.column(j) {
                 let i = self.nodes[q];
                 let (s, g, v) = (&stress[i], self.grad[q], volume[i]);
                 for c in 0..3 {
@@ -241,6 +268,23 @@ impl NodalOperator {
                 }
             }
         });
+    }
+
+    /// The entries of column `j` (one of [`NodalOperator::held`]).
+    #[inline(always)]
+    pub fn column(&self, j: usize) -> Range<usize> {
+        let c = j - self.held.start;
+        self.offsets[c]..self.offsets[c + 1]
+    }
+
+    /// The columns a pass over `columns` rows computes on this rank are
+    /// the ones held: a fault otherwise, not input.
+    fn check_held(&self, ranks: &dyn crate::ranks::Ranks, columns: usize) {
+        assert_eq!(
+            self.held,
+            crate::ranks::share(columns, ranks.rank(), ranks.size(), 1),
+            "the nodal operator holds the columns its pass computes"
+        );
     }
 
     /// Bytes held by the operator.
@@ -343,7 +387,7 @@ mod tests {
         let op = NodalOperator::build(&shapes, shapes.len());
         assert_eq!(op.nodes.len(), shapes.nodes.len());
         for j in 0..n {
-            let row = op.offsets[j]..op.offsets[j + 1];
+            let row = op.column(j);
             assert!(op.nodes[row.clone()].windows(2).all(|w| w[0] < w[1]));
             for q in row {
                 let i = op.nodes[q];
@@ -407,6 +451,40 @@ mod tests {
                     (i, shapes.grad[q], shapes.phi[q])
                 );
             }
+        }
+    }
+
+    /// Built on 2 and 3 ranks (threads standing in for MPI), each rank
+    /// holds its share of the columns, as the whole operator has them, and
+    /// the forces and the smoothing's transpose come out with the bits of
+    /// one rank.
+    #[test]
+    fn each_rank_holds_its_columns_and_the_passes_keep_their_bits() {
+        let (shapes, stress, vel, vol) = setup();
+        let n = vel.len();
+        let whole = NodalOperator::build(&shapes, n);
+        let mut want_f = vec![[0.0; 3]; n];
+        whole.apply(&stress, &vol, &mut want_f);
+        let mut want_d = vec![[0.0; 3]; n];
+        whole.defect_transpose(&vel, &mut want_d);
+        for size in [2, 3] {
+            crate::ranks::tests::on_threads(size, |ranks| {
+                let mut op = NodalOperator::default();
+                op.rebuild_on(ranks, &shapes, n);
+                assert_eq!(op.held, crate::ranks::share(n, ranks.rank(), size, 1));
+                for j in op.held.clone() {
+                    let (mine, all) = (op.column(j), whole.column(j));
+                    assert_eq!(op.nodes[mine.clone()], whole.nodes[all.clone()]);
+                    assert_eq!(op.grad[mine.clone()], whole.grad[all.clone()]);
+                    assert_eq!(op.phi[mine], whole.phi[all]);
+                }
+                let mut f = vec![[0.0; 3]; n];
+                op.apply_on(ranks, &stress, &vol, &mut f);
+                assert_eq!(f, want_f, "{size} ranks");
+                let mut d = vec![[0.0; 3]; n];
+                op.defect_transpose_on(ranks, &vel, &mut d);
+                assert_eq!(d, want_d, "{size} ranks");
+            });
         }
     }
 

@@ -40,15 +40,16 @@ pub(crate) fn ordered<T: Send>(
     tree(0..n.div_ceil(BLOCK).max(1), n, &zero, &fold, &join)
 }
 
-/// [`ordered`] shared among `ranks`: each rank folds the blocks of its
-/// share ([`crate::ranks::share`] of the blocks, which is
-/// [`crate::ranks::share`] of the nodes aligned to [`BLOCK`]: `fold` need
-/// read only that rank's nodes), the blocks' results travel as `to`'s
-/// plain values and come back by `from`, and every rank joins them over
-/// the same tree. The same bits as [`ordered`] on any number of ranks.
+/// [`ordered`] shared among `ranks`: rank `r` folds its blocks `parts[r]`
+/// (contiguous, in rank order, covering the blocks of [`BLOCK`] nodes:
+/// `fold` need read only that rank's nodes), the blocks' results travel
+/// as `to`'s plain values and come back by `from`, and every rank joins
+/// them over the same tree. The same bits as [`ordered`] on any number of
+/// ranks and for any parts.
 pub(crate) fn ordered_on<T: Send, W: crate::ranks::Plain + Default>(
     ranks: &dyn crate::ranks::Ranks,
     n: usize,
+    parts: &[std::ops::Range<usize>],
     (zero, fold, join): (
         impl Fn() -> T + Sync,
         impl Fn(T, usize) -> T + Sync,
@@ -61,7 +62,7 @@ pub(crate) fn ordered_on<T: Send, W: crate::ranks::Plain + Default>(
         return ordered(n, zero, fold, join);
     }
     let blocks = n.div_ceil(BLOCK).max(1);
-    let parts = crate::ranks::shares(ranks, blocks, 1);
+    debug_assert_eq!(parts.last().map(|p| p.end), Some(blocks));
     let own = parts[ranks.rank()].clone();
     let mut wire = vec![W::default(); blocks];
     let first = own.start;
@@ -69,7 +70,7 @@ pub(crate) fn ordered_on<T: Send, W: crate::ranks::Plain + Default>(
         let b = first + k;
         *w = to(&(b * BLOCK..n.min((b + 1) * BLOCK)).fold(zero(), &fold));
     });
-    crate::ranks::gather_parts(ranks, &parts, &mut wire);
+    crate::ranks::gather_parts(ranks, parts, &mut wire);
     let mut leaves: Vec<Option<T>> = wire.iter().map(|w| Some(from(w))).collect();
     // The tree of `ordered`, over the blocks' results.
     fn tree<T>(
@@ -137,17 +138,33 @@ mod tests {
         for n in [0, 17, BLOCK, 5 * BLOCK + 17, 9 * BLOCK] {
             let x: Vec<f64> = (0..n).map(|_| rng() - 0.3).collect();
             let plain = sum(n, |i| x[i]);
+            let blocks = n.div_ceil(BLOCK).max(1);
             for size in [1, 2, 3, 4] {
-                let got = crate::ranks::tests::on_threads(size, |ranks| {
-                    ordered_on(
-                        ranks,
-                        n,
-                        (|| 0.0, |s, i| s + x[i], |a, b| a + b),
-                        (|s: &f64| [*s], |w: &[f64; 1]| w[0]),
-                    )
-                });
-                for g in got {
-                    assert_eq!(g.to_bits(), plain.to_bits(), "n {n}, {size} ranks");
+                // Equal parts, and parts growing with the rank (the first
+                // empty when there are few blocks).
+                let skewed: Vec<std::ops::Range<usize>> = (0..size)
+                    .map(|r| {
+                        blocks * r * r / (size * size)..blocks * (r + 1) * (r + 1) / (size * size)
+                    })
+                    .collect();
+                for parts in [None, Some(&skewed)] {
+                    let got = crate::ranks::tests::on_threads(size, |ranks| {
+                        let equal = crate::ranks::shares(ranks, blocks, 1);
+                        ordered_on(
+                            ranks,
+                            n,
+                            parts.unwrap_or(&equal),
+                            (|| 0.0, |s, i| s + x[i], |a, b| a + b),
+                            (|s: &f64| [*s], |w: &[f64; 1]| w[0]),
+                        )
+                    });
+                    for g in got {
+                        assert_eq!(
+                            g.to_bits(),
+                            plain.to_bits(),
+                            "n {n}, {size} ranks, {parts:?}"
+                        );
+                    }
                 }
             }
         }
@@ -157,6 +174,7 @@ mod tests {
             ordered_on(
                 ranks,
                 n,
+                &crate::ranks::shares(ranks, n.div_ceil(BLOCK), 1),
                 (
                     || Ok(0.0),
                     |s: Result<f64, usize>, i| {

@@ -29,6 +29,13 @@ pub(crate) struct MpiRanks {
     /// them at the end).
     calls: AtomicU64,
     received: AtomicU64,
+    /// Nanoseconds spent in the collectives, and (with `MI_MPI_STATS=2`,
+    /// which puts a barrier before each one) of those, waiting at the
+    /// barrier for the slowest rank: the imbalance, apart from the transfer.
+    spent: AtomicU64,
+    waited: AtomicU64,
+    /// `MI_MPI_STATS=2`: a barrier before each collective.
+    split_wait: bool,
     /// The library is MPICH, whose `MPI_IN_PLACE` is `(void *) -1`
     /// (`mpi.h`): rsmpi has no in-place gather and its bindings no
     /// `MPI_IN_PLACE`, so the gathers in place use that value, and only
@@ -41,11 +48,20 @@ impl Drop for MpiRanks {
     fn drop(&mut self) {
         if std::env::var_os("MI_MPI_STATS").is_some() {
             eprintln!(
-                "mpi: rank {} of {}: {} collective calls, {} bytes received",
+                "mpi: rank {} of {}: {} collective calls, {} bytes received, {:.3} s in them{}",
                 self.rank,
                 self.size,
                 self.calls.load(Ordering::Relaxed),
-                self.received.load(Ordering::Relaxed)
+                self.received.load(Ordering::Relaxed),
+                self.spent.load(Ordering::Relaxed) as f64 * 1e-9,
+                if self.split_wait {
+                    format!(
+                        " ({:.3} s waiting at a barrier before them)",
+                        self.waited.load(Ordering::Relaxed) as f64 * 1e-9
+                    )
+                } else {
+                    String::new()
+                }
             );
         }
     }
@@ -86,6 +102,9 @@ pub(crate) fn init() -> Result<MpiRanks, String> {
         size,
         calls: AtomicU64::new(0),
         received: AtomicU64::new(0),
+        spent: AtomicU64::new(0),
+        waited: AtomicU64::new(0),
+        split_wait: std::env::var("MI_MPI_STATS").is_ok_and(|v| v == "2"),
         mpich,
         _universe: universe,
     })
@@ -94,10 +113,38 @@ pub(crate) fn init() -> Result<MpiRanks, String> {
 impl MpiRanks {
     /// `value` reduced by `op` over every rank.
     fn reduce(&self, value: i64, op: SystemOperation) -> i64 {
+        let _t = self.timed();
         self.calls.fetch_add(1, Ordering::Relaxed);
         let mut out = 0i64;
         self.world.all_reduce_into(&value, &mut out, op);
         out
+    }
+
+    /// Starts timing a collective (the time is added when the guard
+    /// drops); with `MI_MPI_STATS=2`, first waits at a barrier and counts
+    /// that wait apart.
+    fn timed(&self) -> Timed<'_> {
+        let start = std::time::Instant::now();
+        if self.split_wait {
+            self.world.barrier();
+            self.waited
+                .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        }
+        Timed { ranks: self, start }
+    }
+}
+
+/// The guard of [`MpiRanks::timed`].
+struct Timed<'a> {
+    ranks: &'a MpiRanks,
+    start: std::time::Instant,
+}
+
+impl Drop for Timed<'_> {
+    fn drop(&mut self) {
+        self.ranks
+            .spent
+            .fetch_add(self.start.elapsed().as_nanos() as u64, Ordering::Relaxed);
     }
 }
 
@@ -106,6 +153,7 @@ impl Ranks for MpiRanks {
         if !self.mpich || out.len() > i32::MAX as usize {
             return meshless_impact::ranks::gather_through_copy(self, counts, out);
         }
+        let _t = self.timed();
         self.calls.fetch_add(1, Ordering::Relaxed);
         self.received
             .fetch_add((out.len() - counts[self.rank]) as u64, Ordering::Relaxed);
@@ -150,6 +198,7 @@ impl Ranks for MpiRanks {
     }
     fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]) {
         debug_assert_eq!(local.len(), counts[self.rank]);
+        let _t = self.timed();
         self.calls.fetch_add(1, Ordering::Relaxed);
         self.received
             .fetch_add((out.len() - local.len()) as u64, Ordering::Relaxed);
@@ -210,6 +259,7 @@ impl Ranks for MpiRanks {
         self.reduce(value, SystemOperation::max())
     }
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>) {
+        let _t = self.timed();
         let root = self.world.process_at_rank(root as i32);
         let mut len = bytes.len() as u64;
         root.broadcast_into(&mut len);

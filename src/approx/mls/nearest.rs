@@ -26,6 +26,7 @@ use rayon::iter::IndexedParallelIterator;
 use rayon::iter::IntoParallelIterator;
 use rayon::iter::ParallelIterator;
 use rayon::slice::ParallelSlice;
+use rayon::slice::ParallelSliceMut;
 
 /// The named pairs of every row, in row order.
 pub(super) struct Named {
@@ -161,14 +162,14 @@ impl<'a> Radius<'a> {
 }
 
 /// Visits the answers of block `b`'s rows in order (`visit(found, entry,
-/// start of its pairs)`): from the first pass, or a row's last from
-/// `later` (`over`: by row, (row, found, entry, start)). `start` runs
+/// start of its pairs)`): from the first pass (`block`), or a row's last
+/// from `later` (`over`: by row, (row, found, entry, start)). `start` runs
 /// through the block's pairs (a row found again still holds its first
 /// entry there).
 fn walk(
     b: usize,
     rows: usize,
-    blocks: &[Found],
+    block: &Found,
     later: &[Found],
     over: &[(usize, u32, u32, usize)],
     mut visit: impl FnMut(&Found, usize, usize),
@@ -179,13 +180,13 @@ fn walk(
     for i in first..last {
         let e = i - first;
         let s = start;
-        start += blocks[b].len[e];
+        start += block.len[e];
         match over.get(next) {
             Some(&(row, f, e, s)) if row == i => {
                 next += 1;
                 visit(&later[f as usize], e as usize, s);
             }
-            _ => visit(&blocks[b], e, s),
+            _ => visit(block, e, s),
         }
     }
 }
@@ -193,16 +194,32 @@ fn walk(
 /// The named pairs of the first `rows` of `points` (each of its body),
 /// starting from the radius `search`. Fails when the radius overflows
 /// (a place that is not a number).
+///
+/// Shared among `ranks`: each finds the rows of its share (whole blocks),
+/// the radius doubles in step on every rank until no rank has a short row
+/// left, each rank's unsure rows are found again at that common final
+/// radius, and then every rank holds every row: the rows of one rank, to
+/// the bit.
 pub(super) fn named_rows(
     points: &[[f64; 3]],
     group: &[u8],
     rows: usize,
     k: usize,
     mut search: f64,
+    ranks: &dyn crate::ranks::Ranks,
 ) -> Result<Named> {
+    let shares = crate::ranks::shares(ranks, rows, ROWS_PER_BLOCK);
+    let own = shares[ranks.rank()].clone();
+    let own_blocks = if own.is_empty() {
+        0..0
+    } else {
+        own.start / ROWS_PER_BLOCK..own.end.div_ceil(ROWS_PER_BLOCK)
+    };
+    // This rank's blocks of the first pass, from `own_blocks.start`.
     let blocks: Vec<Found> = {
         let at = Radius::new(points, group, k, search);
-        (0..rows.div_ceil(ROWS_PER_BLOCK))
+        own_blocks
+            .clone()
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new()),
@@ -221,15 +238,19 @@ pub(super) fn named_rows(
         .iter()
         .flat_map(|f| f.unsure.iter().map(|&i| (i, 0)))
         .collect();
+    // Whether any rank has a short row left.
+    let short_anywhere = |todo: &[usize]| ranks.all_max(i64::from(!todo.is_empty())) > 0;
     // The rows found at larger radii, pass by pass.
     let mut later: Vec<Found> = Vec::new();
     let mut level = 0;
-    while !todo.is_empty() {
+    let mut more = short_anywhere(&todo);
+    while more {
         search *= 2.0;
         level += 1;
         // Every body holds more than k nodes (checked by the caller), so
         // a radius past the box finds them, unless a place is not a
-        // number or overflows: then stop rather than double for ever.
+        // number or overflows: then stop rather than double for ever
+        // (on every rank at once: the radius is the same on all).
         if !search.is_finite() {
             let particle = points
                 .iter()
@@ -241,27 +262,30 @@ pub(super) fn named_rows(
                 time: f64::NAN,
             });
         }
-        let at = Radius::new(points, group, k, search);
-        let found = at.again(&todo);
+        // The grid at this radius, built only where a row needs it.
+        let at = (!todo.is_empty()).then(|| Radius::new(points, group, k, search));
+        let found = at.as_ref().map_or_else(Vec::new, |at| at.again(&todo));
         todo = found.iter().flat_map(|f| f.short.iter().copied()).collect();
         unsure.extend(
             found
                 .iter()
                 .flat_map(|f| f.unsure.iter().map(|&i| (i, level))),
         );
+        later.extend(found);
+        more = short_anywhere(&todo);
         // The rows a larger radius could change, found again at the
         // final one.
-        if todo.is_empty() {
+        if !more {
             let mut redo: Vec<usize> = unsure
                 .iter()
                 .filter(|&&(_, l)| l < level)
                 .map(|&(i, _)| i)
                 .collect();
             redo.sort_unstable();
-            later.extend(found);
-            later.extend(at.again(&redo));
-        } else {
-            later.extend(found);
+            if !redo.is_empty() {
+                let at = at.unwrap_or_else(|| Radius::new(points, group, k, search));
+                later.extend(at.again(&redo));
+            }
         }
     }
     // The rows found later, by row, the last answer of each: (row,
@@ -282,60 +306,79 @@ pub(super) fn named_rows(
         .map(|(_, o)| *o)
         .collect();
     // Each row's answer: from the first pass, or its last from later.
-    // The entries of each block, then the blocks filled on the pool.
-    let counts: Vec<usize> = (0..blocks.len())
-        .into_par_iter()
-        .map(|b| {
-            let mut count = 0;
-            walk(b, rows, &blocks, &later, &over, |found, e, _| {
-                count += found.len[e]
-            });
-            count
-        })
-        .collect();
-    let entries = counts.iter().sum();
+    // This rank's rows' lengths and k-th distances, then every rank's.
     let mut named = Named {
         kth: vec![0.0; rows],
         named: NeighbourList {
             offsets: vec![0; rows + 1],
-            indices: vec![0; entries],
+            indices: Vec::new(),
         },
-        distance: vec![0.0; entries],
+        distance: Vec::new(),
         #[cfg(test)]
         search,
     };
+    // The answers of this rank's `c`-th block.
+    let walk_own = |c: usize, block: &Found, visit: &mut dyn FnMut(&Found, usize, usize)| {
+        walk(own_blocks.start + c, rows, block, &later, &over, visit)
+    };
+    named.kth[own.clone()]
+        .par_chunks_mut(ROWS_PER_BLOCK)
+        .zip(named.named.offsets[1 + own.start..1 + own.end].par_chunks_mut(ROWS_PER_BLOCK))
+        .zip(&blocks)
+        .enumerate()
+        .for_each(|(c, ((kth, lens), block))| {
+            let mut r = 0;
+            walk_own(c, block, &mut |found, e, _| {
+                kth[r] = found.kth[e];
+                lens[r] = found.len[e];
+                r += 1;
+            });
+        });
+    crate::ranks::gather_parts(ranks, &shares, &mut named.kth);
+    let offsets = &mut named.named.offsets;
+    crate::ranks::gather_parts(ranks, &shares, &mut offsets[1..]);
+    for i in 0..rows {
+        offsets[i + 1] += offsets[i];
+    }
+    let entries = offsets[rows];
+    named.named.indices = vec![0; entries];
+    named.distance = vec![0.0; entries];
+    // This rank's rows' pairs, a block at a time, then every rank's.
+    let offsets = &named.named.offsets;
     let mut parts = Vec::with_capacity(blocks.len());
-    let (mut indices, mut distance) = (&mut named.named.indices[..], &mut named.distance[..]);
-    let mut base = 0;
-    for ((kth, offsets), &count) in named
-        .kth
-        .chunks_mut(ROWS_PER_BLOCK)
-        .zip(named.named.offsets[1..].chunks_mut(ROWS_PER_BLOCK))
-        .zip(&counts)
-    {
+    let (mut indices, mut distance) = (
+        &mut named.named.indices[offsets[own.start]..offsets[own.end]],
+        &mut named.distance[offsets[own.start]..offsets[own.end]],
+    );
+    for b in own_blocks.clone() {
+        let (first, last) = (b * ROWS_PER_BLOCK, rows.min((b + 1) * ROWS_PER_BLOCK));
+        let count = offsets[last] - offsets[first];
         let (i, rest_i) = indices.split_at_mut(count);
         let (d, rest_d) = distance.split_at_mut(count);
-        parts.push((kth, offsets, i, d, base));
+        parts.push((i, d));
         (indices, distance) = (rest_i, rest_d);
-        base += count;
     }
     parts
         .into_par_iter()
+        .zip(&blocks)
         .enumerate()
-        .for_each(|(b, (kth, offsets, indices, distance, base))| {
-            let (mut r, mut at) = (0, 0);
-            walk(b, rows, &blocks, &later, &over, |found, e, s| {
+        .for_each(|(c, ((indices, distance), block))| {
+            let mut at = 0;
+            walk_own(c, block, &mut |found, e, s| {
                 let len = found.len[e];
-                kth[r] = found.kth[e];
                 for (q, &(d, j)) in found.pairs[s..s + len].iter().enumerate() {
                     indices[at + q] = j;
                     distance[at + q] = d;
                 }
                 at += len;
-                offsets[r] = base + at;
-                r += 1;
             });
         });
+    let entry_parts: Vec<std::ops::Range<usize>> = shares
+        .iter()
+        .map(|r| offsets[r.start]..offsets[r.end])
+        .collect();
+    crate::ranks::gather_parts(ranks, &entry_parts, &mut named.named.indices);
+    crate::ranks::gather_parts(ranks, &entry_parts, &mut named.distance);
     Ok(named)
 }
 
@@ -362,9 +405,18 @@ mod tests {
         let k = 10;
         for group in [&group[..], &[][..]] {
             let start = 0.15;
-            let got = named_rows(&points, group, points.len(), k, start).unwrap();
+            let got =
+                named_rows(&points, group, points.len(), k, start, &crate::ranks::Alone).unwrap();
             assert!(got.search >= 8.0 * start, "the far nodes double the radius");
-            let want = named_rows(&points, group, points.len(), k, got.search).unwrap();
+            let want = named_rows(
+                &points,
+                group,
+                points.len(),
+                k,
+                got.search,
+                &crate::ranks::Alone,
+            )
+            .unwrap();
             assert_eq!(want.search, got.search);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&got.kth), bits(&want.kth));
@@ -374,6 +426,33 @@ mod tests {
                 "some rows are flat and name more"
             );
             assert_eq!(bits(&got.distance), bits(&want.distance));
+        }
+    }
+
+    /// Shared among 2, 3 and 5 ranks (threads standing in for MPI), the
+    /// rows are those of one rank, to the bit: the same point set, whose
+    /// far nodes double the radius on one rank's share only.
+    #[test]
+    fn the_rows_on_any_number_of_ranks_are_those_of_one() {
+        let mut next = crate::test_rng::rng(5);
+        let mut points: Vec<[f64; 3]> = (0..1500).map(|_| [next(), next(), next()]).collect();
+        points.extend((0..300).map(|_| [1.2 + 0.3 * next(), 0.3 * next(), 0.0]));
+        points.extend((0..12).map(|q| [5.0 + q as f64 * 0.4, 3.0, -2.0]));
+        let group: Vec<u8> = (0..points.len()).map(|j| u8::from(j % 5 == 0)).collect();
+        let k = 10;
+        let want =
+            named_rows(&points, &group, points.len(), k, 0.15, &crate::ranks::Alone).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for size in [2, 3, 5] {
+            let got = crate::ranks::tests::on_threads(size, |ranks| {
+                named_rows(&points, &group, points.len(), k, 0.15, ranks).unwrap()
+            });
+            for g in got {
+                assert_eq!(g.search, want.search, "{size} ranks");
+                assert_eq!(bits(&g.kth), bits(&want.kth), "{size} ranks");
+                assert_eq!(g.named, want.named, "{size} ranks");
+                assert_eq!(bits(&g.distance), bits(&want.distance), "{size} ranks");
+            }
         }
     }
 }

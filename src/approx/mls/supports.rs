@@ -101,6 +101,19 @@ impl Supports {
         rows: usize,
         params: SupportParams,
     ) -> Result<Self> {
+        Self::compute_rows_on(points, group, rows, params, &crate::ranks::Alone)
+    }
+
+    /// [`Supports::compute_rows`] shared among `ranks`: each finds the
+    /// named nodes of its share of the rows, and every rank then holds
+    /// them all (the same bits on any number of ranks).
+    pub fn compute_rows_on(
+        points: &[[f64; 3]],
+        group: &[u8],
+        rows: usize,
+        params: SupportParams,
+        ranks: &dyn crate::ranks::Ranks,
+    ) -> Result<Self> {
         let k = params.neighbours;
         // A place that is not a number is never within a radius: the search
         // below would double it for ever.
@@ -159,7 +172,7 @@ impl Supports {
         // (BENCHMARKS.md, memory). A row with k others or fewer within
         // the search radius is found again at twice the radius
         // (`nearest.rs`).
-        let found = super::nearest::named_rows(points, group, rows, k, search)?;
+        let found = super::nearest::named_rows(points, group, rows, k, search, ranks)?;
         let (named, named_distance) = (found.named, found.distance);
         // Each node's radius reaches every node that names it: maxima of
         // distances (not negative: their bits order as they do), taken on

@@ -144,7 +144,7 @@ pub(super) fn build_geometry(
     g.op = TractionOperator::default();
     let n = state.pos.len();
     if supports || g.supports.is_none() {
-        let (sup, mirror) = supports_with_images(setup, state).map_err(stamp)?;
+        let (sup, mirror) = supports_with_images(setup, state, &*pipe.ranks).map_err(stamp)?;
         g.supports = Some(sup);
         g.mirror = mirror;
         pipe.profile.supports += 1;
@@ -210,7 +210,7 @@ pub(super) fn build_geometry(
         }
     }
     if setup.rod.scheme.forces.nodal() || setup.rod.scheme.order == SmoothingOrder::Two {
-        g.nodal.rebuild(&g.shapes, pts.len());
+        g.nodal.rebuild_on(&*pipe.ranks, &g.shapes, pts.len());
     } else {
         g.nodal = NodalOperator::default();
     }
@@ -231,11 +231,15 @@ pub(super) fn build_geometry(
 /// wide as the largest `r_J + d_k` (from six spacings, widened until
 /// it is), and the images farther than their `r_J + d_k` are then
 /// dropped: the rows are the same.
-pub(super) fn supports_with_images(setup: &Setup3d, state: &State3d) -> Result<(Supports, Mirror)> {
+pub(super) fn supports_with_images(
+    setup: &Setup3d,
+    state: &State3d,
+    ranks: &dyn crate::ranks::Ranks,
+) -> Result<(Supports, Mirror)> {
     let n = state.pos.len();
     let at = &state.supports_at;
     if setup.plane.is_empty() {
-        let sup = Supports::compute_grouped(at, &setup.group, SupportParams::default())?;
+        let sup = Supports::compute_rows_on(at, &setup.group, n, SupportParams::default(), ranks)?;
         return Ok((sup, Mirror::default()));
     }
     let mut layer = 6.0 * setup.reach;
@@ -246,7 +250,7 @@ pub(super) fn supports_with_images(setup: &Setup3d, state: &State3d) -> Result<(
         if !setup.group.is_empty() {
             m.extend(&setup.group, &mut group, mirror::same);
         }
-        let mut sup = Supports::compute_rows(&pts, &group, n, SupportParams::default())?;
+        let mut sup = Supports::compute_rows_on(&pts, &group, n, SupportParams::default(), ranks)?;
         // A node's radius covers what its images' do (their namers are
         // the images of its own), and its images have its radius.
         for (k, &j) in m.source.iter().enumerate() {

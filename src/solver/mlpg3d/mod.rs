@@ -74,6 +74,7 @@
 //! - `observe.rs`: what a run reports; `restore.rs`: the checks of a
 //!   restored run; `util.rs`: small shared helpers.
 
+mod balance;
 pub mod contact;
 pub mod failure;
 mod geometry;
@@ -317,6 +318,8 @@ struct Pipeline3d {
     /// The ranks that share the passes over the nodes ([`crate::ranks`];
     /// one alone by default).
     ranks: crate::ranks::Handle,
+    /// The material pass's shares among the ranks, by measured cost.
+    balance: balance::Balance,
 }
 
 /// The run's state is all it saves.

@@ -138,6 +138,14 @@ impl Mlpg3d {
     /// the same bits on any number of ranks.
     pub fn set_ranks(&mut self, ranks: crate::ranks::Handle) {
         self.pipe.ranks = ranks;
+        // The nodal operator built before holds every column (one rank);
+        // each rank now holds its share of them.
+        if let Some(g) = self.pipe.geometry.as_mut()
+            && !g.nodal.offsets.is_empty()
+        {
+            let columns = g.nodal.held.end;
+            g.nodal.rebuild_on(&*self.pipe.ranks, &g.shapes, columns);
+        }
     }
 
     /// The heap bytes the run holds, by part (capacities, not lengths):

@@ -159,7 +159,7 @@ fn material_pass(
     };
     let mut states = vec![PointState::default(); n];
     update_material(
-        &crate::ranks::Alone,
+        (&crate::ranks::Alone, &mut Default::default()),
         &MaterialInputs {
             dt: DT,
             damping_time,

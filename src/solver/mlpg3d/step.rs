@@ -147,16 +147,16 @@ pub(super) fn step_with(
         &mut scratch.images.vel,
         mirror::vector,
     );
-    // Each rank's rows of the material pass's share only (its sums go by
-    // blocks: `update::MATERIAL_ALIGN`).
-    g.shapes.velocity_gradients_on(
-        (&*pipe.ranks, update::MATERIAL_ALIGN),
-        vel_ext,
-        &mut scratch.grad,
-    );
+    // Each rank's rows of the material pass's part only (whole blocks of
+    // its sums, balanced by cost: `balance.rs`).
+    let ranks = &*pipe.ranks;
+    let n = state.pos.len();
+    let own = pipe.balance.parts(ranks, n)[ranks.rank()].clone();
+    g.shapes
+        .velocity_gradients_on(own, vel_ext, &mut scratch.grad);
     pipe.profile.lap(Phase::Gradients, &mut watch);
     update::update_material(
-        &*pipe.ranks,
+        (ranks, &mut pipe.balance),
         &MaterialInputs {
             dt,
             damping_time: setup.damping_time,
@@ -179,7 +179,13 @@ pub(super) fn step_with(
         },
         &mut scratch.results,
     );
-    let t = update::sum_on(&*pipe.ranks, &scratch.results, state.clock.time)?;
+    let t = update::sum_on(
+        (ranks, pipe.balance.parts(ranks, n)),
+        &scratch.results,
+        state.clock.time,
+    );
+    pipe.balance.end_step(ranks);
+    let t = t?;
     pipe.profile.lap(Phase::Material, &mut watch);
     state.energy.internal += t.internal;
     state.plastic_work += t.plastic;

@@ -4,6 +4,7 @@
 //! 3-D ([`Full`]) form, with each node's share of the step's energies and
 //! its checks; then the sums over the nodes in node order.
 
+use super::balance::Balance;
 use super::scratch::Tally;
 use super::util::at_time;
 use super::util::material_of;
@@ -57,7 +58,7 @@ pub(super) struct MaterialFields<'a> {
 /// first error met at it: the compression limit, a non-finite field) to
 /// `results`.
 pub(super) fn update_material(
-    ranks: &dyn crate::ranks::Ranks,
+    (ranks, balance): (&dyn crate::ranks::Ranks, &mut Balance),
     input: &MaterialInputs,
     fields: MaterialFields,
     results: &mut [std::result::Result<Tally, (usize, Error)>],
@@ -66,12 +67,13 @@ pub(super) fn update_material(
         update_rows(input, fields, results, 0);
         return;
     }
-    // Each rank steps its share of the points (in whole blocks of the
-    // sums, [`MATERIAL_ALIGN`]), then every rank holds every point's
-    // fields and damage variables ([`crate::ranks`]); the results stay
-    // with their rank ([`sum_on`]).
+    // Each rank steps its share of the points (whole blocks of the sums,
+    // balanced by their cost: [`Balance`]), a block at a time, timing
+    // each; then every rank holds every point's fields and damage
+    // variables ([`crate::ranks`]); the results stay with their rank
+    // ([`sum_on`]).
     use crate::ranks::gather_parts;
-    let parts = crate::ranks::shares(ranks, results.len(), MATERIAL_ALIGN);
+    let parts = balance.parts(ranks, results.len()).to_vec();
     let own = parts[ranks.rank()].clone();
     let MaterialFields {
         dev,
@@ -82,20 +84,25 @@ pub(super) fn update_material(
         visc,
         states,
     } = fields;
-    update_rows(
-        input,
-        MaterialFields {
-            dev: &mut dev[own.clone()],
-            pressure: &mut pressure[own.clone()],
-            eps_p: &mut eps_p[own.clone()],
-            temp: &mut temp[own.clone()],
-            rho: &mut rho[own.clone()],
-            visc: &mut visc[own.clone()],
-            states: &mut states[own.clone()],
-        },
-        &mut results[own.clone()],
-        own.start,
-    );
+    for start in own.clone().step_by(MATERIAL_ALIGN) {
+        let block = start..own.end.min(start + MATERIAL_ALIGN);
+        let watch = std::time::Instant::now();
+        update_rows(
+            input,
+            MaterialFields {
+                dev: &mut dev[block.clone()],
+                pressure: &mut pressure[block.clone()],
+                eps_p: &mut eps_p[block.clone()],
+                temp: &mut temp[block.clone()],
+                rho: &mut rho[block.clone()],
+                visc: &mut visc[block.clone()],
+                states: &mut states[block.clone()],
+            },
+            &mut results[block.clone()],
+            start,
+        );
+        balance.book(start / MATERIAL_ALIGN, watch.elapsed().as_secs_f64());
+    }
     gather_parts(ranks, &parts, dev);
     gather_parts(ranks, &parts, pressure);
     gather_parts(ranks, &parts, eps_p);
@@ -312,12 +319,13 @@ fn update_rows(
         );
 }
 
-/// [`sum`] shared among `ranks`, each holding the results of its share of
-/// [`update_material`] only: each sums its blocks, and the blocks' sums
-/// (or their first error, [`encode`]) are joined on every rank over the
-/// same tree (the same bits).
+/// [`sum`] shared among `ranks`, each holding the results of its part
+/// `parts[rank]` of [`update_material`] only (whole blocks of the sums):
+/// each sums its blocks, and the blocks' sums (or their first error,
+/// [`encode`]) are joined on every rank over the same tree (the same bits
+/// for any parts).
 pub(super) fn sum_on(
-    ranks: &dyn crate::ranks::Ranks,
+    (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
     results: &[std::result::Result<Tally, (usize, Error)>],
     time: f64,
 ) -> Result<Tally> {
@@ -332,6 +340,7 @@ pub(super) fn sum_on(
     crate::approx::sums::ordered_on(
         ranks,
         results.len(),
+        &super::balance::blocks_of(parts),
         (
             || Ok(Tally::default()),
             |t, i| add(t, &results[i]),

@@ -1,0 +1,149 @@
+//! The material pass's shares among the ranks, balanced by its measured
+//! cost: a point of a damaged ceramic or in plastic flow costs several
+//! times an elastic one, so equal shares of the points leave one rank
+//! waiting for another (`penetration` 8 across, quarter, to 8 µs: the
+//! material update took 2.08 s on one rank and 1.49 s on the other).
+//!
+//! Each rank times the blocks of its share ([`crate::approx::sums::BLOCK`]
+//! points, the blocks of the ordered sums), and every [`EVERY`] steps the
+//! blocks' times are gathered and the blocks split again so that each rank
+//! gets an equal part of their total. Every rank computes the split from
+//! the same gathered times, so the ranks agree on it. The shares change
+//! only who computes which points: the sums go by blocks over a fixed tree
+//! ([`crate::approx::sums::ordered_on`]), so the bits do not depend
+//! on the split.
+
+use crate::approx::sums::BLOCK;
+use crate::ranks::Ranks;
+use std::ops::Range;
+
+/// Steps between two splits.
+const EVERY: usize = 10;
+
+/// The current split of the material pass's points among the ranks, and
+/// the time of this rank's blocks since it was made.
+#[derive(Debug, Default, Clone)]
+pub(super) struct Balance {
+    /// The points of each rank (whole blocks, contiguous, in rank order).
+    parts: Vec<Range<usize>>,
+    /// Seconds spent on each block since the last split (this rank's
+    /// blocks only; the others are zero).
+    cost: Vec<f64>,
+    /// Steps since the last split.
+    steps: usize,
+}
+
+impl Balance {
+    /// The points of each rank for a pass over `n` points (equal shares of
+    /// the blocks at first, or when `n` or the ranks changed).
+    pub(super) fn parts(&mut self, ranks: &dyn Ranks, n: usize) -> &[Range<usize>] {
+        if self.parts.len() != ranks.size() || self.parts.last().map(|p| p.end) != Some(n) {
+            self.parts = crate::ranks::shares(ranks, n, BLOCK);
+            self.cost = vec![0.0; n.div_ceil(BLOCK)];
+            self.steps = 0;
+        }
+        &self.parts
+    }
+
+    /// Books `seconds` spent on block `b`.
+    pub(super) fn book(&mut self, b: usize, seconds: f64) {
+        self.cost[b] += seconds;
+    }
+
+    /// Ends a step: every [`EVERY`] steps the blocks' times are gathered
+    /// and the blocks split again ([`split`]). A collective call: every
+    /// rank calls it at every step.
+    pub(super) fn end_step(&mut self, ranks: &dyn Ranks) {
+        if ranks.size() == 1 || self.cost.is_empty() {
+            return;
+        }
+        self.steps += 1;
+        if self.steps < EVERY {
+            return;
+        }
+        let n = self.parts.last().map_or(0, |p| p.end);
+        crate::ranks::gather_parts(ranks, &blocks_of(&self.parts), &mut self.cost);
+        self.parts = split(&self.cost, ranks.size())
+            .into_iter()
+            .map(|b| (b.start * BLOCK).min(n)..(b.end * BLOCK).min(n))
+            .collect();
+        self.cost.iter_mut().for_each(|c| *c = 0.0);
+        self.steps = 0;
+    }
+}
+
+/// The blocks of each part of the points (parts that start on a block's
+/// start or at the end): contiguous, covering every block. An empty part
+/// at the end holds no block.
+pub(super) fn blocks_of(parts: &[Range<usize>]) -> Vec<Range<usize>> {
+    parts
+        .iter()
+        .map(|p| p.start.div_ceil(BLOCK)..p.end.div_ceil(BLOCK))
+        .collect()
+}
+
+/// Contiguous ranges of the blocks of `cost`, one per part, in order,
+/// covering them all: part `r` starts at the first block before which at
+/// least `r / parts` of the total cost lies. Blocks of no measured cost
+/// (none measured) count as equal.
+pub(super) fn split(cost: &[f64], parts: usize) -> Vec<Range<usize>> {
+    let total: f64 = cost.iter().sum();
+    let weight = |b: usize| if total > 0.0 { cost[b] } else { 1.0 };
+    let total = if total > 0.0 {
+        total
+    } else {
+        cost.len() as f64
+    };
+    let mut starts = Vec::with_capacity(parts + 1);
+    let (mut b, mut before) = (0, 0.0);
+    for r in 0..parts {
+        let goal = total * r as f64 / parts as f64;
+        // The boundary nearest the goal, never behind the last one.
+        while b < cost.len() && before + 0.5 * weight(b) < goal {
+            before += weight(b);
+            b += 1;
+        }
+        starts.push(b);
+    }
+    starts.push(cost.len());
+    starts.windows(2).map(|w| w[0]..w[1]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The parts cover the blocks in order, and each holds about its share
+    /// of the cost: one costly block at the start goes alone to the first
+    /// rank; no cost measured gives equal parts.
+    #[test]
+    fn the_split_gives_each_part_its_share_of_the_cost() {
+        let cost = [1.0, 1.0, 1.0, 1.0, 4.0, 4.0, 4.0, 4.0];
+        assert_eq!(split(&cost, 2), vec![0..5, 5..8]);
+        assert_eq!(split(&[8.0, 1.0, 1.0, 1.0, 1.0], 2), vec![0..1, 1..5]);
+        assert_eq!(split(&[0.0; 6], 3), vec![0..2, 2..4, 4..6]);
+        for parts in 1..6 {
+            let got = split(&cost, parts);
+            assert_eq!(got.len(), parts);
+            assert_eq!(got[0].start, 0);
+            assert_eq!(got[parts - 1].end, cost.len());
+            assert!(got.windows(2).all(|w| w[0].end == w[1].start));
+        }
+        // More parts than blocks: some are empty.
+        let got = split(&[1.0, 1.0], 4);
+        assert_eq!(got.iter().map(|r| r.len()).sum::<usize>(), 2);
+    }
+
+    /// The blocks of the parts of the points cover the blocks once, an
+    /// empty part at the end (where the last block is short) holding none:
+    /// 4 ranks on 1960 points once gave that part a block, and the gather
+    /// overran its buffer.
+    #[test]
+    fn the_blocks_of_the_parts_cover_the_blocks_once() {
+        let n = BLOCK + 936;
+        let parts = [0..BLOCK, BLOCK..n, n..n, n..n];
+        assert_eq!(blocks_of(&parts), vec![0..1, 1..2, 2..2, 2..2]);
+        let parts = [0..0, 0..BLOCK, BLOCK..BLOCK, BLOCK..n];
+        assert_eq!(blocks_of(&parts), vec![0..0, 0..1, 1..1, 1..2]);
+    }
+}
