@@ -175,6 +175,60 @@ fn a_scene_on_one_rank_only_refuses_several() {
     );
 }
 
+/// `--phases` on 2 ranks: rank 0 prints both ranks' tables, whole and in
+/// rank order (each rank printing its own interleaved them on the
+/// terminal: `phases of rank 0 of 2phases of rank 1 of 2:`), each adding
+/// up to its total as the one-rank table does.
+#[test]
+fn the_phases_of_every_rank_are_printed_whole_in_rank_order() {
+    let out = mpiexec(&[
+        "-n",
+        "2",
+        PROGRAM,
+        "run",
+        "taylor3d",
+        "-q",
+        "--phases",
+        "--set",
+        "particles_radial=3",
+        "--set",
+        "end_time=1e-6",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    let heads: Vec<usize> = (0..lines.len())
+        .filter(|&k| lines[k].starts_with("phases of rank"))
+        .collect();
+    assert_eq!(heads.len(), 2, "{err}");
+    for (rank, &at) in heads.iter().enumerate() {
+        assert_eq!(lines[at], format!("phases of rank {rank} of 2:"), "{err}");
+        // The table's rows up to its total: seconds that add up to it.
+        let rows: Vec<&str> = lines[at + 1..]
+            .iter()
+            .take_while(|l| !l.starts_with("phases of rank"))
+            .copied()
+            .collect();
+        // The number before the first word `s`.
+        let seconds = |l: &str| -> f64 {
+            let words: Vec<&str> = l.split_whitespace().collect();
+            let at = words.iter().position(|w| *w == "s").expect(l);
+            words[at - 1].parse().expect(l)
+        };
+        let total = rows.iter().find(|l| l.starts_with("total")).expect(&err);
+        let sum: f64 = rows
+            .iter()
+            .take_while(|l| !l.starts_with("total"))
+            .map(|l| seconds(l))
+            .sum();
+        // Each row is rounded to 1 ms.
+        assert!(
+            (sum - seconds(total)).abs() <= 0.001 * rows.len() as f64,
+            "rank {rank}: rows add up to {sum} s against {total}"
+        );
+    }
+}
+
 /// The points (x, y, z interleaved) and the point arrays (name, values) of
 /// a `.vtu` or `.pvtu` file as vtkio's reader sees it, the pieces of a
 /// parallel file loaded and joined in their order.

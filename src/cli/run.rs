@@ -274,21 +274,38 @@ fn piece_name(k: usize, rank: usize) -> String {
     format!("particles_{k:04}_{rank}.vtu")
 }
 
-/// `--phases`: the solver's time by phase on stderr, marked with the rank
-/// on several ranks, or a line saying that the scene keeps none.
+/// `--phases`: the solver's time by phase on stderr (on several ranks,
+/// every rank's, printed by rank 0 in rank order), or a line saying that
+/// the scene keeps none.
 fn print_phases(team: &Handle, sim: &Simulation) {
-    let head = if team.size() > 1 {
-        format!("phases of rank {} of {}", team.rank(), team.size())
-    } else {
-        "phases".to_string()
+    let table = match sim.phase_table() {
+        Some(table) => table.trim_end().to_string(),
+        None => {
+            let _ = errln!(
+                "--phases: scene `{}` keeps no time by phase (the 3-D scenes do)",
+                sim.kind().name()
+            );
+            return;
+        }
     };
-    let _ = match sim.phase_table() {
-        Some(table) => errln!("{head}:\n{}", table.trim_end()),
-        None => errln!(
-            "--phases: scene `{}` keeps no time by phase (the 3-D scenes do)",
-            sim.kind().name()
-        ),
-    };
+    if team.size() == 1 {
+        let _ = errln!("phases:\n{table}");
+        return;
+    }
+    // Every rank's table, printed by rank 0 in rank order (the ranks'
+    // own prints interleaved on the terminal).
+    let lengths = meshless_impact::ranks::all_gather_one(&**team, table.len() as u64);
+    let counts: Vec<usize> = lengths.iter().map(|&l| l as usize).collect();
+    let mut all = vec![0u8; counts.iter().sum()];
+    team.all_gather(table.as_bytes(), &counts, &mut all);
+    if team.rank() == 0 {
+        let mut at = 0;
+        for (rank, &count) in counts.iter().enumerate() {
+            let text = String::from_utf8_lossy(&all[at..at + count]);
+            at += count;
+            let _ = errln!("phases of rank {rank} of {}:\n{text}", team.size());
+        }
+    }
 }
 
 /// Writes the next snapshot of the run into `--vtk-dir` (if given) and
