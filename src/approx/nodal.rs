@@ -153,6 +153,9 @@ pub(crate) fn for_segments<T: Send>(
 /// `φ_J(x_i)` and `∇φ_J(x_i)`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct NodalOperator {
+    /// The columns of the whole operator (the nodes and their mirror
+    /// images).
+    pub columns: usize,
     /// The columns held: every one, or on one of several ranks the rank's
     /// share of them ([`crate::ranks::share`]), the columns its passes
     /// compute.
@@ -195,6 +198,7 @@ impl NodalOperator {
         shapes: &NodalShapes,
         columns: usize,
     ) {
+        self.columns = columns;
         self.held = crate::ranks::share(columns, ranks.rank(), ranks.size(), 1);
         column_offsets(shapes, self.held.clone(), &mut self.offsets);
         let entries = column_entries(shapes, &self.offsets, self.held.clone());
@@ -472,6 +476,7 @@ mod tests {
                 let mut op = NodalOperator::default();
                 op.rebuild_on(ranks, &shapes, n);
                 assert_eq!(op.held, crate::ranks::share(n, ranks.rank(), size, 1));
+                assert_eq!(op.columns, n);
                 for j in op.held.clone() {
                     let (mine, all) = (op.column(j), whole.column(j));
                     assert_eq!(op.nodes[mine.clone()], whole.nodes[all.clone()]);

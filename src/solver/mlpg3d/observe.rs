@@ -138,12 +138,12 @@ impl Mlpg3d {
     /// the same bits on any number of ranks.
     pub fn set_ranks(&mut self, ranks: crate::ranks::Handle) {
         self.pipe.ranks = ranks;
-        // The nodal operator built before holds every column (one rank);
-        // each rank now holds its share of them.
+        // The nodal operator built before holds the columns of the ranks
+        // it was built for; each rank now holds its share of them.
         if let Some(g) = self.pipe.geometry.as_mut()
             && !g.nodal.offsets.is_empty()
         {
-            let columns = g.nodal.held.end;
+            let columns = g.nodal.columns;
             g.nodal.rebuild_on(&*self.pipe.ranks, &g.shapes, columns);
         }
     }
