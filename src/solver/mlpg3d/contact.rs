@@ -124,6 +124,14 @@ fn pairs_in_order(
 /// of which at least one is `loose` (pulverized: powder that meets its
 /// neighbours by contact, not through the continuum), ascending, appended
 /// to `out`.
+///
+/// Searched from the loose nodes only (a few per cent of a plate): a loose
+/// node `a` takes each neighbour `b` above it as `(a, b)`, and each one
+/// below it that is not loose as `(b, a)` (a loose `b` finds the pair
+/// itself); the pairs are then sorted. The same list as the search from
+/// every node ([`tests::loose_pairs_from_every_node`], the plain twin,
+/// pinned to it by a test), whose cost was a neighbour search at every
+/// node of the body at every step.
 pub fn loose_pairs(
     pos: &[[f64; 3]],
     group: &[u8],
@@ -131,19 +139,40 @@ pub fn loose_pairs(
     reach: f64,
     out: &mut Vec<(usize, usize)>,
 ) {
-    if !loose.iter().any(|&l| l) {
+    let seeds: Vec<usize> = (0..loose.len())
+        .into_par_iter()
+        .with_min_len(BLOCK)
+        .filter(|&i| loose[i])
+        .collect();
+    if seeds.is_empty() {
         return;
     }
     let Some(cells) = Cells::new(pos, reach) else {
         return;
     };
-    pairs_in_order(pos.len(), &cells, pos, out, |i, j| {
-        (j > i
-            && (loose[i] || loose[j])
-            && group.get(i) == group.get(j)
-            && distance(&pos[i], &pos[j]) < reach)
-            .then_some((i, j))
-    });
+    let mut found: Vec<(usize, usize)> = seeds
+        .par_chunks(BLOCK / 16)
+        .map(|chunk| {
+            let (mut found, mut row) = (Vec::new(), Vec::new());
+            for &a in chunk {
+                cells.sorted_into(&pos[a], &mut row);
+                found.extend(row.iter().filter_map(|&b| {
+                    let near = b != a
+                        && group.get(a) == group.get(b)
+                        && distance(&pos[a], &pos[b]) < reach;
+                    match (near, b > a) {
+                        (true, true) => Some((a, b)),
+                        (true, false) if !loose[b] => Some((b, a)),
+                        _ => None,
+                    }
+                }));
+            }
+            found
+        })
+        .flatten_iter()
+        .collect();
+    found.par_sort_unstable();
+    out.extend_from_slice(&found);
 }
 
 /// Resolves the approaching pairs in order: removes each one's relative
@@ -366,6 +395,50 @@ mod tests {
         }
         assert!(want.len() > 100, "{}", want.len());
         assert_eq!(got, want);
+    }
+
+    /// The plain twin of [`loose_pairs`]: the search from every node, each
+    /// keeping its neighbours above it when one of the two is loose.
+    pub(super) fn loose_pairs_from_every_node(
+        pos: &[[f64; 3]],
+        group: &[u8],
+        loose: &[bool],
+        reach: f64,
+        out: &mut Vec<(usize, usize)>,
+    ) {
+        if !loose.iter().any(|&l| l) {
+            return;
+        }
+        let Some(cells) = Cells::new(pos, reach) else {
+            return;
+        };
+        pairs_in_order(pos.len(), &cells, pos, out, |i, j| {
+            (j > i
+                && (loose[i] || loose[j])
+                && group.get(i) == group.get(j)
+                && distance(&pos[i], &pos[j]) < reach)
+                .then_some((i, j))
+        });
+    }
+
+    /// The search from the loose nodes gives the list of the search from
+    /// every node, in its order: random nodes of two bodies, a few to
+    /// nearly all of them loose, after other pairs already in the list.
+    #[test]
+    fn the_loose_pairs_from_the_loose_nodes_are_the_plain_ones() {
+        let mut next = crate::test_rng::rng(17);
+        let pos: Vec<[f64; 3]> = (0..3000).map(|_| [next(), next(), 0.3 * next()]).collect();
+        let group: Vec<u8> = (0..pos.len()).map(|i| u8::from(i % 7 == 0)).collect();
+        for share in [0.02, 0.3, 0.97] {
+            let loose: Vec<bool> = (0..pos.len()).map(|_| next() < share).collect();
+            for group in [&group[..], &[][..]] {
+                let (mut want, mut got) = (vec![(0, 1)], vec![(0, 1)]);
+                loose_pairs_from_every_node(&pos, group, &loose, 0.04, &mut want);
+                loose_pairs(&pos, group, &loose, 0.04, &mut got);
+                assert!(want.len() > 10, "pairs are found ({share})");
+                assert_eq!(got, want, "loose share {share}");
+            }
+        }
     }
 
     /// Pulverized nodes: pairs within one body closer than the reach with a
