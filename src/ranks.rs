@@ -198,13 +198,7 @@ pub fn gather_encoded<T, W>(
     let me = ranks.rank();
     let wire: Vec<W> = out[parts[me].clone()].iter().map(to).collect();
     let own = postcard::to_allocvec(&wire).expect("values encode into a vector");
-    let mut lengths = vec![0u64; ranks.size()];
-    lengths[me] = own.len() as u64;
-    let each: Vec<Range<usize>> = (0..ranks.size()).map(|r| r..r + 1).collect();
-    gather_parts(ranks, &each, &mut lengths);
-    let counts: Vec<usize> = lengths.iter().map(|&l| l as usize).collect();
-    let mut all = vec![0u8; counts.iter().sum()];
-    ranks.all_gather(&own, &counts, &mut all);
+    let (all, counts) = all_gather_bytes(ranks, &own);
     let mut at = 0;
     for (r, part) in parts.iter().enumerate() {
         let bytes = &all[at..at + counts[r]];
@@ -218,6 +212,18 @@ pub fn gather_encoded<T, W>(
             from(slot, v);
         }
     }
+}
+
+/// Every rank's `mine`, of any length, joined in rank order, with each
+/// rank's length (two exchanges).
+pub fn all_gather_bytes(ranks: &dyn Ranks, mine: &[u8]) -> (Vec<u8>, Vec<usize>) {
+    let counts: Vec<usize> = all_gather_one(ranks, mine.len() as u64)
+        .into_iter()
+        .map(|l| l as usize)
+        .collect();
+    let mut all = vec![0u8; counts.iter().sum()];
+    ranks.all_gather(mine, &counts, &mut all);
+    (all, counts)
 }
 
 /// The largest of every rank's `value` by [`f64::max`] in rank order (a

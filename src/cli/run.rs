@@ -294,10 +294,7 @@ fn print_phases(team: &Handle, sim: &Simulation) {
     }
     // Every rank's table, printed by rank 0 in rank order (the ranks'
     // own prints interleaved on the terminal).
-    let lengths = meshless_impact::ranks::all_gather_one(&**team, table.len() as u64);
-    let counts: Vec<usize> = lengths.iter().map(|&l| l as usize).collect();
-    let mut all = vec![0u8; counts.iter().sum()];
-    team.all_gather(table.as_bytes(), &counts, &mut all);
+    let (all, counts) = meshless_impact::ranks::all_gather_bytes(&**team, table.as_bytes());
     if team.rank() == 0 {
         let mut at = 0;
         for (rank, &count) in counts.iter().enumerate() {

@@ -386,6 +386,20 @@ pub(super) fn named_rows(
 mod tests {
     use super::*;
 
+    /// A cube of `cube` random nodes, `plane` nodes crowded in z = 0 beside
+    /// it (flat rows), and 12 nodes far off (they double the radius several
+    /// times), in that order.
+    fn cube_plane_and_far(
+        next: &mut impl FnMut() -> f64,
+        cube: usize,
+        plane: usize,
+    ) -> Vec<[f64; 3]> {
+        let mut points: Vec<[f64; 3]> = (0..cube).map(|_| [next(), next(), next()]).collect();
+        points.extend((0..plane).map(|_| [1.2 + 0.3 * next(), 0.3 * next(), 0.0]));
+        points.extend((0..12).map(|q| [5.0 + q as f64 * 0.4, 3.0, -2.0]));
+        points
+    }
+
     /// Against the search of every row at the final radius (the rows as
     /// they were found before): a cube of nodes, a plane of nodes crowded
     /// in z = 0 beside it (flat rows), and a few nodes far off (they
@@ -393,9 +407,7 @@ mod tests {
     #[test]
     fn the_rows_are_those_of_the_final_radius_to_the_bit() {
         let mut next = crate::test_rng::rng(11);
-        let mut points: Vec<[f64; 3]> = (0..2000).map(|_| [next(), next(), next()]).collect();
-        points.extend((0..400).map(|_| [1.2 + 0.3 * next(), 0.3 * next(), 0.0]));
-        points.extend((0..12).map(|q| [5.0 + q as f64 * 0.4, 3.0, -2.0]));
+        let mut points = cube_plane_and_far(&mut next, 2000, 400);
         // Interleaved, so that the rows found again lie among others in
         // their blocks.
         for q in (1..points.len()).rev() {
@@ -435,9 +447,7 @@ mod tests {
     #[test]
     fn the_rows_on_any_number_of_ranks_are_those_of_one() {
         let mut next = crate::test_rng::rng(5);
-        let mut points: Vec<[f64; 3]> = (0..1500).map(|_| [next(), next(), next()]).collect();
-        points.extend((0..300).map(|_| [1.2 + 0.3 * next(), 0.3 * next(), 0.0]));
-        points.extend((0..12).map(|q| [5.0 + q as f64 * 0.4, 3.0, -2.0]));
+        let points = cube_plane_and_far(&mut next, 1500, 300);
         let group: Vec<u8> = (0..points.len()).map(|j| u8::from(j % 5 == 0)).collect();
         let k = 10;
         let want =
