@@ -158,8 +158,9 @@ impl RajendranGrove {
     /// eq. 22, 1/s, and pulverization at the crack density 0.75 of section
     /// 4.3), as printed: the initial crack size 0.58 µm. A `const fn`, so
     /// that parameter tables take their defaults from it
-    /// ([`super::ceramic_block::PLATE_CERAMIC`], whose level `ad85_seed`,
-    /// the default, is this; `ad85_spall` has a0 = 100 µm).
+    /// ([`super::ceramic_block::PLATE_CERAMIC`], whose level `ad85_seed`
+    /// is this; `ad85_spall` has a0 = 100 µm, and the default
+    /// `ad85_planes_freund` adds tensile crack planes).
     pub const fn ad85() -> Self {
         RajendranGrove {
             density: 3420.0,

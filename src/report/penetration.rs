@@ -45,11 +45,17 @@ pub(super) fn damage(plan: &Plan, doc: &mut Doc) -> Result<()> {
         .and_then(|s| s.get("projectile_diameter").ok())
         .map_or(f64::NAN, |d| 0.5 * d);
     let spacing = radius / (across - 1.0);
+    let ceramic = run
+        .scene
+        .as_ref()
+        .and_then(|s| s.level("plate_ceramic").ok().flatten())
+        .map_or("?", |l| l.name);
     doc.para(&format!(
         "## 7. Ballistic penetration: the damage zones\n\n\
          The seed's case (004, section 5.2): a tungsten rod 10 mm long and 10 mm across at \
          1500 m/s through an AD85 plate 5 mm thick and 80 mm across, by the 3-D MLPG solver \
-         with the scene's choices (README, \"Ballistic penetration\"), at {across} nodes across \
+         with the scene's choices (README, \"Ballistic penetration\") and its default ceramic \
+         (`plate_ceramic = {ceramic}`; `ad85_seed` is the seed's Table 1 as printed), at {across} nodes across \
          the projectile's radius ({} nodes): {} at {:.2} µs after {} steps in {:.1} s. \
          Projectile velocity at the end {:.1} m/s (the seed's residual velocity: \
          {SEED_RESIDUAL} m/s, {:+.1} %), energy error {}. The residual velocity under \

@@ -194,8 +194,16 @@ pub fn builtin_names() -> Vec<String> {
 /// with the value such a scene ran with: `conform_preconditioner` was
 /// added with Jacobi's (0) as its default on 2026-11-30 and became the
 /// levels (1) the same day; a state or checkpoint saved before names no
-/// preconditioner and ran with Jacobi's.
-const SAVED_WITHOUT: &[(&str, f64)] = &[("conform_preconditioner", 0.0)];
+/// preconditioner and ran with Jacobi's. The ceramic's default moved from
+/// `ad85_seed` (0) to `ad85_planes_freund` on 2026-11-30 (issue 68): a
+/// scene saved before `plate_ceramic` (2026-11-28) or
+/// `plate_tensile_flaw_size` (2026-11-29) existed ran with the seed's set
+/// and no tensile flaws.
+const SAVED_WITHOUT: &[(&str, f64)] = &[
+    ("conform_preconditioner", 0.0),
+    ("plate_ceramic", 0.0),
+    ("plate_tensile_flaw_size", 0.0),
+];
 
 /// A [`Scene`] as saved: its kind's parameters by name, under the kind's
 /// name with a capital (`{"Taylor": {"impact_speed": 181.0, ...}}`).

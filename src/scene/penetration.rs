@@ -231,7 +231,7 @@ const AFTER: &[ParamSpec] = &[
 const PLATE_MODEL: &[Level] = &[
     Level {
         name: "rajendran_grove",
-        description: "the Rajendran-Grove ceramic of the plate_ parameters (the seed's model)",
+        description: "the Rajendran-Grove ceramic of the plate_ parameters (the seed's model; plate_ceramic names its set)",
         sets: &[],
     },
     Level {

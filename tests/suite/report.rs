@@ -229,10 +229,12 @@ fn quick_report_regenerates_and_meets_its_claims() {
         assert!(num(r, "energy_error") < 0.05, "{r:?}");
     }
 
-    // The seed's penetration case at 4 across: pictures at 4, 8, 12 and
-    // 20 µs; the pulverized zone only grows (pulverization is final); the
-    // projectile slows and leaves within 20 % of the seed's 1240 m/s
-    // (measured 1059.5 m/s; tests/suite/penetration.rs).
+    // The seed's penetration case at 4 across with the default ceramic
+    // (`ad85_planes_freund`, tensile crack planes): pictures at 4, 8, 12
+    // and 20 µs; the damaged fraction and the comminuted zone (nodes split
+    // on all three planes: a split is final) only grow, the zone is there
+    // from 4 µs; the projectile slows and leaves within 20 % of the seed's
+    // 1240 m/s (measured 1147.6 m/s, comminuted radius 15.0 then 21.7 mm).
     let zones = read_csv(&dir.join("penetration_zones.csv"));
     let times: Vec<f64> = zones.iter().map(|r| num(r, "time_us")).collect();
     assert_eq!(times.len(), 4, "{times:?}");
@@ -240,14 +242,13 @@ fn quick_report_regenerates_and_meets_its_claims() {
         assert!((t - want).abs() < 0.1, "{times:?}");
         assert!(index.contains(&format!("penetration_damage_{want:.0}us.svg")));
     }
-    let pulverized: Vec<f64> = zones
-        .iter()
-        .map(|r| num(r, "pulverized_fraction"))
-        .collect();
-    assert!(
-        pulverized[0] > 0.0 && pulverized.windows(2).all(|w| w[1] >= w[0]),
-        "{pulverized:?}"
-    );
+    for column in ["damaged_fraction", "comminuted_radius_mm"] {
+        let c: Vec<f64> = zones.iter().map(|r| num(r, column)).collect();
+        assert!(
+            c[0] > 0.0 && c.windows(2).all(|w| w[1] >= w[0]),
+            "{column}: {c:?}"
+        );
+    }
     let v: Vec<f64> = zones
         .iter()
         .map(|r| num(r, "projectile_velocity_mps"))
@@ -256,10 +257,11 @@ fn quick_report_regenerates_and_meets_its_claims() {
     assert!((v[3] / 1240.0 - 1.0).abs() < 0.2, "{v:?}");
 
     // The ballistic-limit sweep at 3 across (quarter model), each shot to
-    // its outcome: 500 m/s stops, 1000 m/s perforates slowly (at 29.06 µs,
-    // 378.4 m/s: tests/suite/penetration.rs::a_slow_perforation_is_not_called_stopped
-    // holds the same shot), 1500 m/s perforates; the report brackets the
-    // ballistic limit between the two.
+    // its outcome, with the default ceramic: the plate cracks in tension
+    // and every shot perforates (500 m/s at 45.9 µs with 362.2 m/s), the
+    // faster shot leaving faster, so the shots do not bracket the limit.
+    // (With the seed's set, `ad85_seed`, 500 m/s stopped:
+    // tests/suite/penetration.rs.)
     let shots = read_csv(&dir.join("ballistic_limit.csv"));
     let outcomes: Vec<(f64, &str)> = shots
         .iter()
@@ -268,18 +270,24 @@ fn quick_report_regenerates_and_meets_its_claims() {
     assert_eq!(
         outcomes,
         [
-            (500.0, "stopped"),
+            (500.0, "perforated"),
             (1000.0, "perforated"),
             (1500.0, "perforated")
         ]
     );
-    assert_eq!(num(&shots[0], "residual_velocity_mps"), 0.0);
-    let (slow, fast) = (
-        num(&shots[1], "residual_velocity_mps"),
-        num(&shots[2], "residual_velocity_mps"),
+    let residual: Vec<f64> = shots
+        .iter()
+        .map(|r| num(r, "residual_velocity_mps"))
+        .collect();
+    assert!(
+        residual.windows(2).all(|w| 0.0 < w[0] && w[0] < w[1])
+            && residual
+                .iter()
+                .zip([500.0, 1000.0, 1500.0])
+                .all(|(r, v)| *r < v),
+        "{residual:?}"
     );
-    assert!(0.0 < slow && slow < fast && fast < 1500.0, "{slow} {fast}");
-    assert!(index.contains("**the ballistic limit lies between 500 and 1000 m/s**"));
+    assert!(index.contains("the shots do not bracket the ballistic limit"));
     assert!(index.contains("ballistic_limit.svg"));
 
     // The stability matrix: each case ends as expected, and no output of any

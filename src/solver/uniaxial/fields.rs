@@ -75,8 +75,15 @@ impl PlateImpact {
         let r = self.state.reading;
         let precursor = r.precursor.unwrap_or(0.0);
         let pullback = r.peak - r.pullback_minimum;
+        // The release that carries the pullback back to the free surface
+        // runs at c_L where the whole pulse came in the elastic precursor
+        // (a target struck below its HEL: ρ0 c_L du is the stress of an
+        // elastic wave in uniaxial strain), and at the bulk speed c_B
+        // behind a plastic wave (Novikov's reading for metals).
+        let elastic = r.precursor.is_some_and(|u| u >= r.peak);
+        let c_release = if elastic { c_l } else { c_b };
         let spall_strength = if self.state.spall.is_some() {
-            0.5 * rho0 * c_b * pullback
+            0.5 * rho0 * c_release * pullback
         } else {
             0.0
         };
