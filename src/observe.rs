@@ -488,7 +488,7 @@ observables! {
     precursor_stress: "Pa", "rho0 c_L u / 2 of the precursor with the target's reference density and longitudinal sound speed: the Hugoniot elastic limit when the impact passes it";
     peak_velocity: "m/s", "the peak of the first pulse: the highest free-surface velocity before it first fell by 5 % of impact_speed";
     pullback_velocity: "m/s", "the peak less the lowest velocity after it, until the velocity rose again by 5 % of impact_speed (the spall signal or the next pulse): the pullback";
-    spall_strength: "Pa", "rho0 c du / 2 of the pullback du, with c the target's longitudinal sound speed c_L where the whole pulse came in the elastic precursor (a target struck below its HEL) and its bulk sound speed c_B behind a plastic wave, once a target cell has failed in tension (0 before, and in a target that has not)";
+    spall_strength: "Pa", "rho0 c du / 2 of the pullback du, with c the target's longitudinal sound speed c_L where the whole pulse came in the elastic precursor (the peak within 1.5 % of impact_speed of it: a target struck below its HEL) and its bulk sound speed c_B behind a plastic wave, once a target cell has failed in tension (0 before, and in a target that has not)";
     spall_depth: "m", "depth below the target's impact face (reference configuration) of the first target cell that failed in tension: a ceramic pulverized in expansion, or a JH-2 cell pulled below the tensile limit of its damage (0 while none has)";
     max_damage: "1", "largest crack density gamma = N0* a^3 in the target (for a JH-2 target its largest damage D; 0 for a metal target)";
     kinetic_energy: "J/m2", "kinetic energy of both plates per unit area";
