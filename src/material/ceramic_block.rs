@@ -130,8 +130,9 @@ pub const CERAMICS: &[Level] = &[
     Level {
         name: "ad85_planes_freund",
         description: "the default: ad85_planes whose tensile cracks grow by Freund's equation of motion \
-                      (n2+ = 1: a crack runs at c_R (1 - G_c / G)), so that a plane's crack runs to \
-                      its split within a few hundred ns once it passes its onset (issue 68)",
+                      (n2+ = 1: a crack runs at c_R (1 - G_c / G)), so that a plane's crack, once past \
+                      its onset, runs toward the Rayleigh speed as its release rate G grows (the \
+                      seed's n2+ = 0.07 holds it far slower; issue 68)",
         sets: &[
             ("plate_crack_size", AD85.initial_crack_size),
             ("plate_tensile_flaw_size", PLANES_FLAW_SIZE),
