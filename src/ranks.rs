@@ -160,6 +160,17 @@ pub fn shares(ranks: &dyn Ranks, n: usize, align: usize) -> Vec<Range<usize>> {
         .collect()
 }
 
+/// Stops unless `parts` are contiguous, in rank order, and cover `0..len`
+/// (a fault of the program: the counts of a gather must cover its buffer).
+fn assert_covers(parts: &[Range<usize>], len: usize) {
+    assert!(
+        parts.first().is_some_and(|p| p.start == 0)
+            && parts.windows(2).all(|w| w[0].end == w[1].start)
+            && parts.last().is_some_and(|p| p.end == len),
+        "the parts of a gather cover its buffer in order: {parts:?} over {len}"
+    );
+}
+
 /// After each rank has written its own part `parts[rank]` of `out`, every
 /// rank's parts gathered into `out` on every rank. `parts` are contiguous,
 /// in rank order, and cover `out`.
@@ -168,13 +179,7 @@ pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &m
         return;
     }
     // Counts that do not cover `out` would have MPI write past it.
-    assert!(
-        parts.first().is_some_and(|p| p.start == 0)
-            && parts.windows(2).all(|w| w[0].end == w[1].start)
-            && parts.last().is_some_and(|p| p.end == out.len()),
-        "the parts of a gather cover its buffer in order: {parts:?} over {}",
-        out.len()
-    );
+    assert_covers(parts, out.len());
     let size = std::mem::size_of::<T>();
     let counts: Vec<usize> = parts.iter().map(|p| p.len() * size).collect();
     ranks.all_gather_in_place(&counts, bytes_mut(out));
@@ -212,6 +217,76 @@ pub fn gather_encoded<T, W>(
             from(slot, v);
         }
     }
+}
+
+/// The widest record [`gather_records`] takes: far more than a point's
+/// damage variables encode into (at most a few dozen numbers).
+pub const RECORD_MAX: usize = 4096;
+
+/// [`gather_encoded`] in records of one width, gathered in place: each
+/// value's postcard encoding (of its value mapped by `to`) is padded to the
+/// widest of any rank's, the records of every part are gathered into
+/// `wire` (kept by the caller from one call to the next, so that a call
+/// allocates nothing once it has grown), and the other ranks' records are
+/// written back by `from`. The values are encoded and decoded on the pool.
+/// The same values on every rank as [`gather_encoded`] (the same
+/// encoding): only the way they travel differs.
+///
+/// # Panics
+///
+/// If a value encodes into more than [`RECORD_MAX`] bytes (a fault of the
+/// program, not of its input: the types that travel are of fixed size).
+pub fn gather_records<T, W>(
+    ranks: &dyn Ranks,
+    parts: &[Range<usize>],
+    out: &mut [T],
+    wire: &mut Vec<u8>,
+    to: impl Fn(&T) -> W + Sync,
+    from: impl Fn(&mut T, W) + Sync,
+) where
+    T: Send + Sync,
+    W: serde::Serialize + serde::de::DeserializeOwned,
+{
+    use rayon::prelude::*;
+    if ranks.size() == 1 {
+        return;
+    }
+    // Counts that do not cover `out` would have MPI write past `wire`.
+    assert_covers(parts, out.len());
+    let own = parts[ranks.rank()].clone();
+    // The width: the longest encoding of any rank's values.
+    let longest = out[own.clone()]
+        .par_iter()
+        .map(|v| {
+            let len = postcard::experimental::serialized_size(&to(v)).expect("a value encodes");
+            assert!(len <= RECORD_MAX, "a record fits RECORD_MAX bytes: {len}");
+            len
+        })
+        .max()
+        .unwrap_or(0);
+    let width = usize::try_from(ranks.all_max(longest as i64)).unwrap_or(0);
+    if width == 0 {
+        return;
+    }
+    wire.resize(out.len() * width, 0);
+    wire[own.start * width..own.end * width]
+        .par_chunks_mut(width)
+        .zip(&out[own.clone()])
+        .for_each(|(slot, v)| {
+            postcard::to_slice(&to(v), slot).expect("a record fits its width");
+        });
+    let counts: Vec<usize> = parts.iter().map(|p| p.len() * width).collect();
+    ranks.all_gather_in_place(&counts, &mut wire[..]);
+    let wire: &[u8] = wire;
+    out.par_iter_mut()
+        .enumerate()
+        .filter(|(i, _)| !own.contains(i))
+        .for_each(|(i, slot)| {
+            // The same program encoded them: a failure is a fault, not input.
+            let w = postcard::from_bytes(&wire[i * width..(i + 1) * width])
+                .expect("a rank's record decodes");
+            from(slot, w);
+        });
 }
 
 /// Every rank's `mine`, of any length, joined in rank order, with each
@@ -396,6 +471,69 @@ pub(crate) mod tests {
         }
         // Equal shares where the rows divide.
         assert_eq!(share(12, 1, 3, 1), 4..8);
+    }
+
+    /// Records of one width give every rank the values that the encoded
+    /// gather gives (values whose encodings differ in length, NaN's bits
+    /// and all, on parts of unequal length, some empty), and a second call
+    /// reuses the wire without growing it.
+    #[test]
+    fn records_gather_the_values_of_the_encoded_gather() {
+        type V = Option<(f64, [f64; 3])>;
+        let value = |i: usize| -> V {
+            (!i.is_multiple_of(3)).then(|| {
+                let x = if i == 7 {
+                    f64::from_bits(0x7ff8_dead_beef_0001)
+                } else {
+                    i as f64
+                };
+                (x, [0.5 * i as f64, -(i as f64), 1e300])
+            })
+        };
+        let n = 1001;
+        for size in [2, 3, 4] {
+            let got = on_threads(size, |ranks| {
+                // Unequal parts; with four ranks the last one's is empty.
+                let cuts: &[usize] = match size {
+                    2 => &[0, 333, n],
+                    3 => &[0, 83, 333, n],
+                    _ => &[0, 37, 148, n, n],
+                };
+                let parts: Vec<Range<usize>> = cuts.windows(2).map(|w| w[0]..w[1]).collect();
+                let own = parts[ranks.rank()].clone();
+                let start = |own: &Range<usize>| -> Vec<V> {
+                    (0..n)
+                        .map(|i| {
+                            if own.contains(&i) {
+                                value(i)
+                            } else {
+                                Some((-1.0, [0.0; 3]))
+                            }
+                        })
+                        .collect()
+                };
+                let (mut a, mut b) = (start(&own), start(&own));
+                gather_encoded(ranks, &parts, &mut a, |v| *v, |s, w| *s = w);
+                let mut wire = Vec::new();
+                gather_records(ranks, &parts, &mut b, &mut wire, |v| *v, |s, w| *s = w);
+                let grown = wire.capacity();
+                let mut c = start(&own);
+                gather_records(ranks, &parts, &mut c, &mut wire, |v| *v, |s, w| *s = w);
+                (a, b, c, grown == wire.capacity())
+            });
+            for (a, b, c, kept) in got {
+                let bits = |v: &[V]| -> Vec<Option<(u64, [u64; 3])>> {
+                    v.iter()
+                        .map(|x| x.map(|(f, g)| (f.to_bits(), g.map(f64::to_bits))))
+                        .collect()
+                };
+                let want: Vec<V> = (0..n).map(value).collect();
+                assert_eq!(bits(&a), bits(&want), "{size} ranks: the encoded gather");
+                assert_eq!(bits(&b), bits(&want), "{size} ranks: the records");
+                assert_eq!(bits(&c), bits(&want), "{size} ranks: the records again");
+                assert!(kept, "{size} ranks: the wire is reused");
+            }
+        }
     }
 
     /// Alone, a pass over the rows is the plain pass.

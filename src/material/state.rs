@@ -146,12 +146,15 @@ impl MaterialState {
 
     /// After each rank of `ranks` has stepped the points of its part
     /// `parts[rank]`, every rank's damage variables on every rank
-    /// ([`crate::ranks`]). The caches stay each rank's own: they give the
-    /// same bits whether kept or rebuilt.
+    /// ([`crate::ranks`]), in records of one width through `wire` (the
+    /// caller's, kept from step to step: [`crate::ranks::gather_records`]).
+    /// The caches stay each rank's own: they give the same bits whether
+    /// kept or rebuilt.
     pub fn gather(
         points: &mut [PointState],
         ranks: &dyn crate::ranks::Ranks,
         parts: &[std::ops::Range<usize>],
+        wire: &mut Vec<u8>,
     ) {
         /// The damage variables as they travel.
         #[derive(serde::Serialize, serde::Deserialize)]
@@ -160,10 +163,11 @@ impl MaterialState {
             Ceramic(CeramicVars),
             Jh2(Jh2Point),
         }
-        crate::ranks::gather_encoded(
+        crate::ranks::gather_records(
             ranks,
             parts,
             points,
+            wire,
             |p| match p.vars {
                 Vars::None => Wire::None,
                 Vars::Ceramic(c) => Wire::Ceramic(c),

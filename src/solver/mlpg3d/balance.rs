@@ -31,6 +31,10 @@ pub(super) struct Balance {
     cost: Vec<f64>,
     /// Steps since the last split.
     steps: usize,
+    /// The damage variables' records as they travel between the ranks
+    /// after the pass ([`crate::material::MaterialState::gather`]), kept
+    /// from step to step so that a step allocates none.
+    pub(super) wire: Vec<u8>,
 }
 
 impl Balance {

@@ -29,6 +29,7 @@
 //! and runs to 6.56 µs with these contacts).
 
 use crate::neighbours::Cells;
+use crate::ranks::Ranks;
 use rayon::prelude::*;
 
 /// Nodes per task of the searches on the pool.
@@ -37,8 +38,16 @@ const BLOCK: usize = 1024;
 /// The pairs `(i, j)`, `i < j`, of nodes of different bodies (`group`)
 /// closer than `reach`, in ascending order, written into `out`. Only the
 /// nodes in the overlap of two bodies' bounding boxes (grown by `reach`)
-/// are searched.
-pub fn pairs(pos: &[[f64; 3]], group: &[u8], reach: f64, out: &mut Vec<(usize, usize)>) {
+/// are searched. On several `ranks` each searches its share of the blocks
+/// of those nodes and the pairs are gathered in rank order: the same list
+/// on every rank, in the same order, as one rank finds.
+pub fn pairs(
+    pos: &[[f64; 3]],
+    group: &[u8],
+    reach: f64,
+    ranks: &dyn Ranks,
+    out: &mut Vec<(usize, usize)>,
+) {
     out.clear();
     let bodies = group.iter().copied().max().map_or(0, |g| g as usize + 1);
     if bodies < 2 {
@@ -86,25 +95,56 @@ pub fn pairs(pos: &[[f64; 3]], group: &[u8], reach: f64, out: &mut Vec<(usize, u
     let Some(cells) = Cells::new(&sub, reach) else {
         return;
     };
-    pairs_in_order(index.len(), &cells, &sub, out, |a, b| {
+    let keep = |a: usize, b: usize| {
         let (i, j) = (index[a], index[b]);
         (j > i && group[j] != group[i] && distance(&pos[i], &pos[j]) < reach).then_some((i, j))
-    });
+    };
+    let blocks = index.len().div_ceil(BLOCK);
+    if ranks.size() == 1 {
+        pairs_in_order(0..blocks, index.len(), &cells, &sub, out, keep);
+        return;
+    }
+    let mine = crate::ranks::share(blocks, ranks.rank(), ranks.size(), 1);
+    let mut found = Vec::new();
+    pairs_in_order(mine, index.len(), &cells, &sub, &mut found, keep);
+    gather_in_rank_order(ranks, &found, out);
+}
+
+/// Every rank's `found`, appended to `out` in rank order.
+fn gather_in_rank_order(
+    ranks: &dyn Ranks,
+    found: &[(usize, usize)],
+    out: &mut Vec<(usize, usize)>,
+) {
+    let counts = crate::ranks::all_gather_one(ranks, found.len() as u64);
+    let mut parts = Vec::with_capacity(counts.len());
+    let mut at = 0;
+    for &c in &counts {
+        parts.push(at..at + c as usize);
+        at += c as usize;
+    }
+    let mut all = vec![[0usize; 2]; at];
+    for (slot, &(i, j)) in all[parts[ranks.rank()].clone()].iter_mut().zip(found) {
+        *slot = [i, j];
+    }
+    crate::ranks::gather_parts(ranks, &parts, &mut all);
+    out.extend(all.iter().map(|&[i, j]| (i, j)));
 }
 
 /// Appends to `out`, in ascending order of `a` and then of the neighbour
-/// `b`, the pairs `keep(a, b)` gives for each point `a` of `0..n` and each
-/// `b` within the radius of `cells` of it. The points run on the pool in
-/// blocks of 1024, each block's pairs in order, then the blocks in order:
-/// the result of a serial pass for any number of threads.
+/// `b`, the pairs `keep(a, b)` gives for each point `a` of the `blocks`
+/// of 1024 of `0..n` and each `b` within the radius of `cells` of it. The
+/// blocks run on the pool, each block's pairs in order, then the blocks in
+/// order: the result of a serial pass for any number of threads.
 fn pairs_in_order(
+    blocks: std::ops::Range<usize>,
     n: usize,
     cells: &Cells<3>,
     points: &[[f64; 3]],
     out: &mut Vec<(usize, usize)>,
     keep: impl Fn(usize, usize) -> Option<(usize, usize)> + Sync,
 ) {
-    let blocks: Vec<Vec<(usize, usize)>> = (0..n.div_ceil(BLOCK))
+    let blocks: Vec<Vec<(usize, usize)>> = blocks
         .into_par_iter()
         .map(|k| {
             let (mut found, mut row) = (Vec::new(), Vec::new());
@@ -367,7 +407,18 @@ mod tests {
         }
         let reach = 0.07;
         let mut got = Vec::new();
-        pairs(&pos, &group, reach, &mut got);
+        pairs(&pos, &group, reach, &crate::ranks::Alone, &mut got);
+        // On 2, 3 and 4 ranks as threads: the same list on every rank.
+        for size in 2..=4 {
+            let each = crate::ranks::tests::on_threads(size, |ranks| {
+                let mut out = vec![(7, 7)];
+                pairs(&pos, &group, reach, ranks, &mut out);
+                out
+            });
+            for out in each {
+                assert_eq!(out, got, "{size} ranks");
+            }
+        }
         let mut want = Vec::new();
         for i in 0..pos.len() {
             for j in i + 1..pos.len() {
@@ -412,13 +463,20 @@ mod tests {
         let Some(cells) = Cells::new(pos, reach) else {
             return;
         };
-        pairs_in_order(pos.len(), &cells, pos, out, |i, j| {
-            (j > i
-                && (loose[i] || loose[j])
-                && group.get(i) == group.get(j)
-                && distance(&pos[i], &pos[j]) < reach)
-                .then_some((i, j))
-        });
+        pairs_in_order(
+            0..pos.len().div_ceil(BLOCK),
+            pos.len(),
+            &cells,
+            pos,
+            out,
+            |i, j| {
+                (j > i
+                    && (loose[i] || loose[j])
+                    && group.get(i) == group.get(j)
+                    && distance(&pos[i], &pos[j]) < reach)
+                    .then_some((i, j))
+            },
+        );
     }
 
     /// The search from the loose nodes gives the list of the search from

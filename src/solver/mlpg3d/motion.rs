@@ -216,7 +216,7 @@ pub(super) fn collide(
         extended(images, group, &mut ext.group, mirror::same)
     };
     if !group.is_empty() {
-        contact::pairs(pos, group_ext, frame.reach, &mut buffers.pairs);
+        contact::pairs(pos, group_ext, frame.reach, frame.ranks, &mut buffers.pairs);
     }
     if let Some(points) = points {
         buffers.loose.clear();

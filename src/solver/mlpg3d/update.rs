@@ -110,7 +110,7 @@ pub(super) fn update_material(
     gather_parts(ranks, &parts, rho);
     gather_parts(ranks, &parts, visc);
     if input.damage_vars {
-        crate::material::MaterialState::gather(states, ranks, &parts);
+        crate::material::MaterialState::gather(states, ranks, &parts, &mut balance.wire);
     }
 }
 
