@@ -330,6 +330,24 @@ pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &m
     gather_parts(ranks, &parts, out);
 }
 
+/// Every rank's `mine`, of any length, joined in rank order (two
+/// exchanges: the lengths, then the values in place).
+pub fn all_gather_varying<T: Plain + Default>(ranks: &dyn Ranks, mine: &[T]) -> Vec<T> {
+    if ranks.size() == 1 {
+        return mine.to_vec();
+    }
+    let mut parts = Vec::with_capacity(ranks.size());
+    let mut at = 0;
+    for c in all_gather_one(ranks, mine.len() as u64) {
+        parts.push(at..at + c as usize);
+        at += c as usize;
+    }
+    let mut all = vec![T::default(); at];
+    all[parts[ranks.rank()].clone()].copy_from_slice(mine);
+    gather_parts(ranks, &parts, &mut all);
+    all
+}
+
 /// Every rank's `value`, in rank order (one exchange).
 pub fn all_gather_one<T: Plain + Default>(ranks: &dyn Ranks, value: T) -> Vec<T> {
     let mut all = vec![T::default(); ranks.size()];

@@ -107,28 +107,12 @@ pub fn pairs(
     let mine = crate::ranks::share(blocks, ranks.rank(), ranks.size(), 1);
     let mut found = Vec::new();
     pairs_in_order(mine, index.len(), &cells, &sub, &mut found, keep);
-    gather_in_rank_order(ranks, &found, out);
-}
-
-/// Every rank's `found`, appended to `out` in rank order.
-fn gather_in_rank_order(
-    ranks: &dyn Ranks,
-    found: &[(usize, usize)],
-    out: &mut Vec<(usize, usize)>,
-) {
-    let counts = crate::ranks::all_gather_one(ranks, found.len() as u64);
-    let mut parts = Vec::with_capacity(counts.len());
-    let mut at = 0;
-    for &c in &counts {
-        parts.push(at..at + c as usize);
-        at += c as usize;
-    }
-    let mut all = vec![[0usize; 2]; at];
-    for (slot, &(i, j)) in all[parts[ranks.rank()].clone()].iter_mut().zip(found) {
-        *slot = [i, j];
-    }
-    crate::ranks::gather_parts(ranks, &parts, &mut all);
-    out.extend(all.iter().map(|&[i, j]| (i, j)));
+    let mine: Vec<[usize; 2]> = found.iter().map(|&(i, j)| [i, j]).collect();
+    out.extend(
+        crate::ranks::all_gather_varying(ranks, &mine)
+            .into_iter()
+            .map(|[i, j]| (i, j)),
+    );
 }
 
 /// Appends to `out`, in ascending order of `a` and then of the neighbour
