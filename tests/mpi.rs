@@ -128,6 +128,28 @@ fn the_jh2_plate_gives_the_same_bits_on_two_ranks() {
     same_bits(&one, &two, "JH-2: 1 against 2 ranks");
 }
 
+/// Cracks that shield their neighbours (`plate_shield_radius`; the zones
+/// are built from every node's state, which each rank holds) give the same
+/// bits on 1 and 2 ranks, and shield: the damage differs from the run
+/// without them.
+#[test]
+fn shielding_cracks_give_the_same_bits_on_two_ranks() {
+    let plain: &[&str] = &["particles_radial=4", "symmetry=1", "end_time=5e-6"];
+    let sets: &[&str] = &[
+        "particles_radial=4",
+        "symmetry=1",
+        "end_time=5e-6",
+        "plate_shield_radius=0.005",
+    ];
+    let one = run("penetration", sets, 1, "shield");
+    let unshielded = run("penetration", plain, 1, "unshielded");
+    let damaged = |v: &serde_json::Value| v["damaged_fraction"].as_f64().unwrap();
+    assert!(damaged(&one) > 0.05, "{one}");
+    assert_ne!(damaged(&one), damaged(&unshielded));
+    let two = run("penetration", sets, 2, "shield");
+    same_bits(&one, &two, "shielding: 1 against 2 ranks");
+}
+
 /// A run that fails on one rank only (rank 1's memory budget is out of
 /// range) stops both ranks with that rank's named error and exit status 1,
 /// printed once (by rank 0), and writes no outputs.

@@ -176,7 +176,7 @@ const ALUMINA_SPECIFIC_HEAT: f64 = 880.0;
 /// the order of seed 004's Table 1, then the thermal constants and the
 /// initial temperature. Defaults: AD85 ([`RajendranGrove::ad85`]), 880
 /// J/(kg K), Taylor-Quinney 1, 293 K.
-pub const PLATE_CERAMIC: [ParamSpec; 27] = [
+pub const PLATE_CERAMIC: [ParamSpec; 28] = [
     levels_spec(
         "plate_ceramic",
         DEFAULT_CERAMIC,
@@ -352,6 +352,15 @@ pub const PLATE_CERAMIC: [ParamSpec; 27] = [
          a_t / s^2, s = (ln(1/U) / ln 2)^(1/m) from its index (0 = one flaw size everywhere)",
     ),
     row(
+        "plate_shield_radius",
+        "m",
+        AD85.shield_radius,
+        Range::closed(0.0, 0.1),
+        "largest radius of a tensile crack's shielding zone: a crack that has grown for a time t \
+         keeps near-parallel flaws off its plane within min(n1+ C_R t, this) from starting \
+         (Denoual-Hild obscuration; 3-D solver only; 0 = none)",
+    ),
+    row(
         "plate_specific_heat",
         "J/(kg.K)",
         ALUMINA_SPECIFIC_HEAT,
@@ -425,6 +434,7 @@ fn build(v: impl Fn(&str) -> Result<f64>) -> Result<Material> {
         critical_damage: v("plate_critical_damage")?,
         tensile_flaw_size: v("plate_tensile_flaw_size")?,
         tensile_flaw_scatter: v("plate_tensile_flaw_scatter")?,
+        shield_radius: v("plate_shield_radius")?,
     };
     Ok(Material::ceramic(
         rg,
@@ -504,7 +514,7 @@ mod tests {
     /// level sets the same three knobs.
     #[test]
     fn defaults_are_the_seed_ad85_with_the_default_levels_knobs() {
-        let table1: [(&str, f64); 27] = [
+        let table1: [(&str, f64); 28] = [
             ("plate_ceramic", 3.0),
             ("plate_density", 3.42e3),
             ("plate_shear_modulus", 88.0e9),
@@ -529,6 +539,7 @@ mod tests {
             ("plate_critical_damage", 0.75),
             ("plate_tensile_flaw_size", 188e-6),
             ("plate_tensile_flaw_scatter", 0.0),
+            ("plate_shield_radius", 0.0),
             ("plate_specific_heat", 880.0),
             ("plate_taylor_quinney", 1.0),
             ("plate_initial_temperature", 293.0),
@@ -727,7 +738,7 @@ mod tests {
         const CHOICE: MaterialChoice = MaterialChoice::BILINEAR_LINEAR;
         const N: usize = BEFORE.len() + block_len(CHOICE) + PLATE_CERAMIC.len();
         const TABLE: [ParamSpec; N] = compose::<N>(&BEFORE, CHOICE, &PLATE_CERAMIC);
-        assert_eq!(N, 1 + 8 + 27);
+        assert_eq!(N, 1 + 8 + 28);
         assert_eq!(TABLE[0].name, "impact_speed");
         assert_eq!(TABLE[1].name, "density");
         assert_eq!(&TABLE[9..], &PLATE_CERAMIC[..]);

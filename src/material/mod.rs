@@ -43,6 +43,7 @@ use mie_gruneisen::{CompressionLimit, MieGruneisen, check};
 use rajendran_grove::{CeramicPoint, RajendranGrove};
 pub use state::{MaterialState, PointState};
 use state::{Memo, Vars};
+pub use tensile_cracks::Shield;
 use tensor::{Full, SymTensor, radial_return};
 
 /// Equation of state: the pressure from the density and the specific
@@ -158,6 +159,10 @@ pub struct Loading<T: SymTensor> {
     pub spin: T::Spin,
     /// Density at the end of the step (kg/m3).
     pub density: f64,
+    /// The cracks of other points that shield this one (only a ceramic's
+    /// tensile planes read it; [`Shield::NONE`] but in the 3-D solver with
+    /// crack shielding on).
+    pub shield: Shield,
 }
 
 /// The mechanical state of a particle that a material updates.
@@ -470,6 +475,7 @@ impl Material {
             rate: load.rate.to_full(),
             spin: T::spin_to_full(&load.spin),
             density: load.density,
+            shield: load.shield,
         };
         let vars = state
             .ceramic()
@@ -587,12 +593,14 @@ mod tests {
             rate: [2e4, -5e4, 2e4, 1e4],
             spin: 3e3,
             density: 7900.0,
+            shield: Shield::NONE,
         };
         let full = Loading::<Full> {
             dt: axi.dt,
             rate: [2e4, -5e4, 2e4, 1e4, 0.0, 0.0],
             spin: [3e3, 0.0, 0.0],
             density: axi.density,
+            shield: Shield::NONE,
         };
         let (old, old6) = (unloaded([0.0; 4], 0.0), unloaded([0.0; 6], 0.0));
         let (mut s4, mut s6) = (PointState::default(), PointState::default());
@@ -634,6 +642,7 @@ mod tests {
             rate: [0.0, 0.0, 0.0, 5e4, 0.0, 0.0],
             spin: [0.0; 3],
             density: 7850.0,
+            shield: Shield::NONE,
         };
         let old = unloaded([0.0; 6], 0.1);
         let new = m.update(&load, &old, &mut PointState::default()).unwrap();
@@ -668,6 +677,7 @@ mod tests {
             rate: [0.0; 4],
             spin: 0.0,
             density: 7850.0 * 4.0,
+            shield: Shield::NONE,
         };
         let old = unloaded([0.0; 4], 0.0);
         let err = m.update(&load, &old, &mut PointState::default());
@@ -719,6 +729,7 @@ mod tests {
                     rate,
                     spin,
                     density: rho,
+                    shield: Shield::NONE,
                 };
                 let work = c.update(&load, m.energy(twin_temp), &mut twin);
                 twin_temp += tq * work / (rho * heat);
@@ -736,6 +747,7 @@ mod tests {
                     rate: Axisymmetric::from_full(&rate),
                     spin: spin[0],
                     density: rho,
+                    shield: Shield::NONE,
                 };
                 axi = m.update(&load4, &axi, &mut s4).unwrap();
                 assert_eq!(axi.deviator.to_full(), twin.deviator);
@@ -778,6 +790,7 @@ mod tests {
                     rate,
                     spin,
                     density: twin.density,
+                    shield: Shield::NONE,
                 };
                 full = m.update(&load, &full, &mut state).unwrap();
                 assert_eq!(full.deviator, twin.deviator);
@@ -808,6 +821,7 @@ mod tests {
             rate: [0.0, -1e5, 0.0, 0.0, 0.0, 0.0],
             spin: [0.0; 3],
             density: rg.density * (1.0 + 1e-4),
+            shield: Shield::NONE,
         };
         Material::ceramic(rg, heat, tq, t0)
             .update(&squeeze, &unloaded([0.0; 6], 0.0), &mut ceramic)
@@ -903,6 +917,7 @@ mod tests {
                     rate,
                     spin,
                     density: rho,
+                    shield: Shield::NONE,
                 };
                 let mut step = state.points_mut()[0];
                 point = m.update(&load, &point, &mut step).unwrap();
@@ -960,6 +975,7 @@ mod tests {
             rate: [0.0, 0.0, 0.0, 5e4, 0.0, 0.0],
             spin: [0.0; 3],
             density: 7850.0,
+            shield: Shield::NONE,
         };
         for s in steel_state.points_mut() {
             m.update(&load, &unloaded([0.0; 6], 0.0), s).unwrap();

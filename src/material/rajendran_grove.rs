@@ -131,6 +131,14 @@ pub struct RajendranGrove {
     /// size everywhere. Not written when 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub tensile_flaw_scatter: f64,
+    /// The largest radius of a tensile crack's shielding zone (m); 0, the
+    /// default, for no shielding. A crack that has grown for a time `t`
+    /// shields the flaws of near-parallel planes (normals within 45°) off
+    /// its own plane within `min(n1+ C_R t, shield_radius)` of it: they
+    /// cannot start to grow (Denoual & Hild's obscuration; the 3-D solver
+    /// only, `src/solver/mlpg3d/shielding.rs`). Not written when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub shield_radius: f64,
 }
 
 impl RajendranGrove {
@@ -182,6 +190,7 @@ impl RajendranGrove {
             critical_damage: 0.75,
             tensile_flaw_size: 0.0,
             tensile_flaw_scatter: 0.0,
+            shield_radius: 0.0,
         }
     }
 
@@ -221,6 +230,7 @@ impl RajendranGrove {
             self.tensile_flaw_scatter,
             Range::closed(0.0, 100.0),
         )?;
+        check("shield_radius", self.shield_radius, Range::closed(0.0, 0.1))?;
         check(
             "pulverized_cohesion",
             self.pulverized_cohesion,
@@ -326,6 +336,7 @@ impl RajendranGrove {
             flaw_size: self.tensile_flaw_size,
             critical_density: self.critical_damage,
             friction: self.friction,
+            shields: self.shield_radius > 0.0,
         })
     }
 
@@ -346,6 +357,12 @@ impl RajendranGrove {
         let u = ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
         let s = ((1.0 / u).ln() / std::f64::consts::LN_2).powf(1.0 / m);
         self.tensile_flaw_size / (s * s)
+    }
+
+    /// The speed at which a tensile crack's shielding zone grows (m/s): the
+    /// opening cracks' terminal speed of eq. (24), `n1+ C_R`.
+    pub fn shield_speed(&self) -> f64 {
+        self.opening[0] * self.rayleigh_speed()
     }
 
     /// The crack-density factors of the matrix's Poisson ratio.
@@ -568,9 +585,16 @@ impl RajendranGrove {
                 load.dt,
                 self.critical_release_rate(),
                 |g| self.growth_speed(g, true),
+                &load.shield,
             );
             if let Some(cracks) = &mut point.tensile {
-                let (opening, carried) = planes.open(cracks, &sigma, k_bar, g_eff);
+                // A shielded plane that has not started carries at most the
+                // stress at which its flaw would have.
+                let cap = planes.opening_stress(planes.flaw_size, self.critical_release_rate());
+                let caps = cracks.shielding.map_or([None; 3], |kept| {
+                    kept.shielded.map(|held| held.then_some(cap))
+                });
+                let (opening, carried) = planes.open_capped(cracks, &sigma, k_bar, g_eff, caps);
                 cracks.opening = opening;
                 let (pc, dev) = split_stress(&carried);
                 point.elastic_strain = dev.scaled(0.5 / g_eff);
@@ -901,6 +925,7 @@ fn solve_increasing(g: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::Shield;
 
     const AD85_NU: f64 = (450.0 - 176.0) / (2.0 * 538.0);
 
@@ -929,6 +954,7 @@ mod tests {
                 rate: d,
                 spin: [0.0; 3],
                 density: self.m.density * (-self.log_volume).exp(),
+                shield: Shield::NONE,
             };
             self.m.update(&load, 0.0, &mut self.point);
             load.density
@@ -1427,6 +1453,7 @@ mod tests {
 #[cfg(test)]
 mod tensile_plane_tests {
     use super::*;
+    use crate::material::Shield;
 
     /// Work per unit volume done on a point over a strain path given as
     /// rates per step, by the trapezoid of its stresses (as the solvers
@@ -1443,6 +1470,7 @@ mod tensile_plane_tests {
                 rate: *d,
                 spin: [0.0; 3],
                 density: m.density * (-log_volume).exp(),
+                shield: Shield::NONE,
             };
             m.update(&load, 0.0, &mut point);
             let new = stress_of(point.pressure, &point.deviator);
@@ -1544,6 +1572,7 @@ mod tensile_plane_tests {
 #[cfg(test)]
 mod tensile_onset_tests {
     use super::*;
+    use crate::material::Shield;
 
     /// A point pulled in uniaxial strain opens its first tensile plane,
     /// normal to the pull, where the axial stress reaches the penny crack's
@@ -1570,6 +1599,7 @@ mod tensile_onset_tests {
                     rate: [rate, 0.0, 0.0, 0.0, 0.0, 0.0],
                     spin: [0.0; 3],
                     density: m.density * (-log_volume).exp(),
+                    shield: Shield::NONE,
                 };
                 m.update(&load, 0.0, &mut point);
                 if let Some(c) = point.tensile {

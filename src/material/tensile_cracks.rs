@@ -43,6 +43,14 @@
 //! - The point's isotropic cracks then grow only under compression (matrix
 //!   compression `eta >= 0`), as sliding cracks; in tension the planes
 //!   carry the cracking.
+//! - **Shielding** (off unless the constant `shield_radius` is set; the
+//!   3-D solver only, `src/solver/mlpg3d/shielding.rs`): a plane that
+//!   would start to grow inside the shielding zone of another point's
+//!   crack of near the same orientation ([`Shield`]) does not, ever; it
+//!   is *shielded*, and carries at most the normal stress at which its
+//!   flaw would have started (the crack beside it takes the stretch:
+//!   [`CrackPlanes::open_capped`]). Measured in
+//!   `docs/notes/2026-12-01-crack-shielding.md`.
 
 use super::tensor::{Full, matrix};
 use std::f64::consts::PI;
@@ -58,6 +66,79 @@ pub struct TensileCracks {
     /// The opening of each plane's cracks, as a normal strain (1): the
     /// share of the point's stretch across the plane that its cracks take.
     pub opening: [f64; 3],
+    /// What crack shielding keeps of the planes, where the constants
+    /// shield (`None` where they do not, so that the records of the point
+    /// stay as short as before shielding; `None` in states saved before
+    /// it was).
+    #[serde(default)]
+    pub shielding: Option<PlaneShielding>,
+}
+
+/// What crack shielding keeps of a point's three planes.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct PlaneShielding {
+    /// How long each plane's crack has grown (s): 0 until it first grows
+    /// past the point's flaw, then the time since. The crack's shielding
+    /// zone grows with it.
+    pub age: [f64; 3],
+    /// Whether each plane is shielded: a plane that another crack's zone
+    /// held when it would have started (`Shield`) never starts, and
+    /// carries at most the stress at which its flaw would have
+    /// (`CrackPlanes::open_capped`).
+    pub shielded: [bool; 3],
+}
+
+/// The crack normals that shield a point (crack shielding, issue 68): a
+/// plane of the point whose normal lies within 45° of one of them cannot
+/// start to grow ([`CrackPlanes::step`]); a crack that has started goes on.
+/// The 3-D solver gives each point the normals of the cracks of other
+/// points whose shielding zones hold it (`src/solver/mlpg3d/shielding.rs`);
+/// [`Shield::NONE`] everywhere else.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Shield {
+    normals: [[f64; 3]; 3],
+    len: usize,
+}
+
+impl Shield {
+    /// No shielding.
+    pub const NONE: Shield = Shield {
+        normals: [[0.0; 3]; 3],
+        len: 0,
+    };
+
+    /// The cosine of the largest angle between a plane's normal and a
+    /// shielding crack's normal at which the crack shields the plane: 45°.
+    pub const ALIGNED: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+    /// Adds the normal `n` (a unit vector); false where three are held
+    /// already (the normal is not added).
+    pub fn add(&mut self, n: [f64; 3]) -> bool {
+        if self.len == 3 {
+            return false;
+        }
+        self.normals[self.len] = n;
+        self.len += 1;
+        true
+    }
+
+    /// How many normals it holds.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Whether a plane of unit normal `n` is shielded: within 45° of a
+    /// shielding normal.
+    pub fn blocks(&self, n: &[f64; 3]) -> bool {
+        self.normals[..self.len]
+            .iter()
+            .any(|s| dot(s, n).abs() >= Self::ALIGNED)
+    }
 }
 
 /// What the tensile cracks need from the material's constants.
@@ -75,6 +156,9 @@ pub struct CrackPlanes {
     pub critical_density: f64,
     /// Friction coefficient of a closed crack (1).
     pub friction: f64,
+    /// Whether the planes keep what shielding needs
+    /// ([`TensileCracks::shielding`]).
+    pub shields: bool,
 }
 
 /// The [`Full`] tensor of a symmetric 3x3 matrix.
@@ -82,7 +166,8 @@ fn full(m: &[[f64; 3]; 3]) -> Full {
     [m[0][0], m[1][1], m[2][2], m[0][1], m[1][2], m[2][0]]
 }
 
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+/// The dot product of two 3-vectors.
+pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
@@ -215,8 +300,13 @@ impl CrackPlanes {
     /// One step of the tensile cracks of a point under the effective stress
     /// `sigma` (tension positive, XX YY ZZ XY YZ ZX), with spin `spin` (`W_XY, W_YZ,
     /// W_ZX`) over `dt`: the planes turn with the spin, are fixed at the
-    /// first growth, and grow by `speed(release_rate, open = true)`.
+    /// first growth, and grow by `speed(release_rate, open = true)`. A
+    /// plane that `shield` blocks does not start to grow, and is shielded
+    /// from then on (the planes are fixed all the same, so that
+    /// [`CrackPlanes::open_capped`] can relieve it); one that has grown
+    /// goes on.
     /// Returns the new cracks (`None` while no flaw has grown).
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &self,
         cracks: Option<TensileCracks>,
@@ -225,6 +315,7 @@ impl CrackPlanes {
         dt: f64,
         gc: f64,
         speed: impl Fn(f64) -> f64,
+        shield: &Shield,
     ) -> Option<TensileCracks> {
         let s = matrix(sigma);
         let mut cracks = match cracks {
@@ -246,6 +337,7 @@ impl CrackPlanes {
             None => {
                 let (values, vectors) = principal(&s);
                 // False on NaN: no plane forms from a stress that is not a number.
+                // (A shielded plane is fixed too, and does not grow below.)
                 if !(values[0] > 0.0 && self.release_rate(self.flaw_size, values[0], 0.0) > gc) {
                     return None;
                 }
@@ -253,18 +345,37 @@ impl CrackPlanes {
                     normals: vectors,
                     size: [self.flaw_size; 3],
                     opening: [0.0; 3],
+                    shielding: None,
                 }
             }
         };
         let (normal, shear) = Self::tractions(&cracks.normals, &s);
         let split = self.split_size();
+        if self.shields && cracks.shielding.is_none() {
+            cracks.shielding = Some(PlaneShielding::default());
+        }
         for k in 0..3 {
             let a = cracks.size[k];
             if a >= split {
+                if let Some(kept) = &mut cracks.shielding {
+                    kept.age[k] += dt;
+                }
+                continue;
+            }
+            let held = cracks.shielding.is_some_and(|kept| kept.shielded[k]);
+            if a <= self.flaw_size && (held || shield.blocks(&cracks.normals[k])) {
+                if let Some(kept) = &mut cracks.shielding {
+                    kept.shielded[k] = true;
+                }
                 continue;
             }
             let g = self.release_rate(a, normal[k], shear[k]);
             cracks.size[k] = (a + speed(g) * dt).min(split);
+            if let Some(kept) = &mut cracks.shielding
+                && cracks.size[k] > self.flaw_size
+            {
+                kept.age[k] += dt;
+            }
         }
         Some(cracks)
     }
@@ -287,6 +398,23 @@ impl CrackPlanes {
     /// stress of the point's elastic strain from then on (the slip is not
     /// elastic).
     pub fn open(&self, cracks: &TensileCracks, sigma: &Full, k: f64, g: f64) -> ([f64; 3], Full) {
+        self.open_capped(cracks, sigma, k, g, [None; 3])
+    }
+
+    /// [`CrackPlanes::open`] with the normal stress of some planes capped:
+    /// a plane with `caps[i] = Some(c)` opens with its flaws' compliance
+    /// up to the normal stress `c`, and past it stretches at `c` (its
+    /// opening whatever holds its stress at `c`). A shielded plane is so
+    /// relieved: the crack whose zone holds it takes the stretch across it
+    /// beyond the stress at which its own flaw would have started.
+    pub fn open_capped(
+        &self,
+        cracks: &TensileCracks,
+        sigma: &Full,
+        k: f64,
+        g: f64,
+        caps: [Option<f64>; 3],
+    ) -> ([f64; 3], Full) {
         let mut s = rotate_in(&matrix(sigma), &cracks.normals);
         let split = self.split_size();
         let bn = self.normal_compliance();
@@ -308,18 +436,34 @@ impl CrackPlanes {
             normal0[i] - (0..3).map(|j| m(i, j) * (e[j] - old[j])).sum::<f64>()
         };
         let mut active: [bool; 3] = [true; 3];
+        // Open planes held at their cap: the normal stress is the cap.
+        let mut held: [bool; 3] = [false; 3];
         let mut e = [0.0; 3];
-        for _ in 0..4 {
-            // The open set's system (M + diag(stiffness)) e = rhs.
+        let rounds = if caps.iter().any(Option::is_some) {
+            8
+        } else {
+            4
+        };
+        for _ in 0..rounds {
+            // The open set's system (M + diag(stiffness)) e = rhs; a held
+            // plane's row M e = rhs - cap.
             let idx: Vec<usize> = (0..3).filter(|&i| active[i]).collect();
             let mut a = [[0.0; 3]; 3];
             let mut rhs = [0.0; 3];
             for (r, &i) in idx.iter().enumerate() {
                 for (c, &j) in idx.iter().enumerate() {
-                    a[r][c] = m(i, j) + if i == j { stiffness[i] } else { 0.0 };
+                    a[r][c] = m(i, j)
+                        + if i == j && !held[i] {
+                            stiffness[i]
+                        } else {
+                            0.0
+                        };
                 }
                 // The shut planes' e = 0 leaves only their old openings.
                 rhs[r] = normal0[i] + (0..3).map(|j| m(i, j) * old[j]).sum::<f64>();
+                if held[i] {
+                    rhs[r] -= caps[i].unwrap_or(0.0);
+                }
             }
             let x = solve_small(&a, &rhs, idx.len());
             e = [0.0; 3];
@@ -330,7 +474,17 @@ impl CrackPlanes {
             for i in 0..3 {
                 if active[i] && e[i] < 0.0 {
                     active[i] = false;
+                    held[i] = false;
                     changed = true;
+                } else if let (true, Some(cap)) = (active[i], caps[i]) {
+                    // Past the cap with the flaws' compliance: held; held
+                    // with less opening than the compliance gives at the
+                    // cap: back to the compliance.
+                    let over = e[i] * stiffness[i] > cap;
+                    if over != held[i] {
+                        held[i] = over;
+                        changed = true;
+                    }
                 }
             }
             if !changed {
@@ -415,6 +569,16 @@ mod tests {
     const K: f64 = 150e9;
     const G: f64 = 80e9;
 
+    /// Planes along the axes, at the flaws of `p`, intact.
+    fn in_axes(p: &CrackPlanes) -> TensileCracks {
+        TensileCracks {
+            normals: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            size: [p.flaw_size; 3],
+            opening: [0.0; 3],
+            shielding: None,
+        }
+    }
+
     fn planes() -> CrackPlanes {
         CrackPlanes {
             nu: 0.25,
@@ -423,6 +587,7 @@ mod tests {
             flaw_size: 50e-6,
             critical_density: 0.75,
             friction: 0.72,
+            shields: true,
         }
     }
 
@@ -473,18 +638,103 @@ mod tests {
         let onset = p.opening_stress(p.flaw_size, gc);
         let pull = |s: f64| [0.0, s, 0.0, 0.0, 0.0, 0.0];
         assert_eq!(
-            p.step(None, &pull(0.99 * onset), &[0.0; 3], 1e-9, gc, |_| 1000.0),
+            p.step(
+                None,
+                &pull(0.99 * onset),
+                &[0.0; 3],
+                1e-9,
+                gc,
+                |_| 1000.0,
+                &Shield::NONE
+            ),
             None
         );
         let grow = |g: f64| if g > gc { 1000.0 } else { 0.0 };
         let c = p
-            .step(None, &pull(1.01 * onset), &[0.0; 3], 1e-9, gc, grow)
+            .step(
+                None,
+                &pull(1.01 * onset),
+                &[0.0; 3],
+                1e-9,
+                gc,
+                grow,
+                &Shield::NONE,
+            )
             .unwrap();
         assert!((c.normals[0][1].abs() - 1.0).abs() < 1e-12, "{c:?}");
         assert!((c.size[0] - (p.flaw_size + 1e-6)).abs() < 1e-15);
         // The other two planes carry no tension: they do not grow.
         assert_eq!(c.size[1], p.flaw_size);
         assert_eq!(c.size[2], p.flaw_size);
+    }
+
+    /// A shield within 45° of the plane under tension keeps it from
+    /// starting (the planes are fixed), one beyond 45° does not; a shielded plane that
+    /// has not grown stays at its flaw while one that has grown goes on,
+    /// and the grown planes count their age.
+    #[test]
+    fn a_shield_keeps_aligned_planes_from_starting() {
+        let p = planes();
+        let gc = 44.7;
+        let onset = p.opening_stress(p.flaw_size, gc);
+        let pull = [0.0, 1.01 * onset, 0.0, 0.0, 0.0, 0.0];
+        let grow = |g: f64| if g > gc { 1000.0 } else { 0.0 };
+        let mut near = Shield::NONE;
+        assert!(near.add([0.0, 0.8, 0.6]));
+        let mut far = Shield::NONE;
+        assert!(far.add([0.6, 0.0, 0.8]));
+        let held = p
+            .step(None, &pull, &[0.0; 3], 1e-9, gc, grow, &near)
+            .unwrap();
+        assert_eq!(held.size, [p.flaw_size; 3], "fixed, not grown");
+        assert_eq!(held.shielding.unwrap().age, [0.0; 3]);
+        let c = p
+            .step(None, &pull, &[0.0; 3], 1e-9, gc, grow, &far)
+            .unwrap();
+        assert!(c.size[0] > p.flaw_size);
+        assert_eq!(c.shielding.unwrap().age, [1e-9, 0.0, 0.0]);
+        // Formed, with tension now across the second plane as well.
+        let both = [onset * 1.01, onset * 1.01, 0.0, 0.0, 0.0, 0.0];
+        let mut across = Shield::NONE;
+        across.add([1.0, 0.0, 0.0]);
+        across.add([0.0, 1.0, 0.0]);
+        let frame = TensileCracks {
+            normals: [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            ..c
+        };
+        let d = p
+            .step(Some(frame), &both, &[0.0; 3], 1e-9, gc, grow, &across)
+            .unwrap();
+        assert!(d.size[0] > c.size[0], "a grown plane goes on");
+        assert_eq!(d.size[1], p.flaw_size, "a shielded plane does not start");
+        assert_eq!(d.shielding.unwrap().age, [2e-9, 0.0, 0.0]);
+        let e = p
+            .step(Some(frame), &both, &[0.0; 3], 1e-9, gc, grow, &Shield::NONE)
+            .unwrap();
+        assert!(e.size[1] > p.flaw_size);
+    }
+
+    /// A capped plane carries the stress of its flaws' compliance up to its
+    /// cap and the cap past it; the uncapped planes are as without caps.
+    #[test]
+    fn a_capped_plane_carries_at_most_its_cap() {
+        let p = planes();
+        let c = in_axes(&p);
+        let cap = 1e8;
+        let low = [0.5e8, 0.0, 0.0, 0.0, 0.0, 0.0];
+        assert_eq!(
+            p.open_capped(&c, &low, K, G, [Some(cap), None, None]),
+            p.open(&c, &low, K, G)
+        );
+        let high = [3e8, 1e8, -5e7, 0.0, 0.0, 0.0];
+        let (e, carried) = p.open_capped(&c, &high, K, G, [Some(cap), None, None]);
+        assert!((carried[0] - cap).abs() < 1e-6 * cap, "{carried:?}");
+        let (e0, free) = p.open(&c, &high, K, G);
+        assert!(free[0] > cap && e[0] > e0[0], "{free:?} {e:?} {e0:?}");
+        // The plane along y keeps its flaws' compliance.
+        let gamma = p.flaw_density * p.flaw_size.powi(3);
+        let bn = 16.0 * (1.0 - p.nu * p.nu) / (3.0 * p.youngs_modulus);
+        assert!((e[1] / (bn * gamma * carried[1]) - 1.0).abs() < 1e-9);
     }
 
     /// A split plane carries no tension across it and keeps the stresses
@@ -494,9 +744,8 @@ mod tests {
     fn a_split_plane_carries_compression_only() {
         let p = planes();
         let c = TensileCracks {
-            normals: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             size: [p.split_size(), p.flaw_size, p.flaw_size],
-            opening: [0.0; 3],
+            ..in_axes(&p)
         };
         let sigma = [2e8, 1e8, -5e7, 3e7, 0.0, 0.0];
         let carried = p.open(&c, &sigma, K, G).1;
@@ -547,15 +796,19 @@ mod tests {
     #[test]
     fn planes_turn_with_the_material() {
         let p = planes();
-        let c = TensileCracks {
-            normals: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-            size: [p.flaw_size; 3],
-            opening: [0.0; 3],
-        };
+        let c = in_axes(&p);
         // W_XY = -1/s over 1e-3 s in 1000 steps: about 1e-3 rad about z.
         let mut c = Some(c);
         for _ in 0..1000 {
-            c = p.step(c, &[0.0; 6], &[-1.0, 0.0, 0.0], 1e-6, 44.7, |_| 0.0);
+            c = p.step(
+                c,
+                &[0.0; 6],
+                &[-1.0, 0.0, 0.0],
+                1e-6,
+                44.7,
+                |_| 0.0,
+                &Shield::NONE,
+            );
         }
         let n = c.unwrap().normals;
         let angle = n[0][1].atan2(n[0][0]);

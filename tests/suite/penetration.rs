@@ -323,6 +323,20 @@ fn same_bits_on_one_thread_and_two() {
         );
         (s.field("position"), s.field("damage"), s.observables())
     });
+    // Cracks that shield their neighbours: the zones of the step's start,
+    // each node's step tried again with the planes its zones hold.
+    common::same_on_one_thread_and_two(|| {
+        let s = coarse_with(
+            5e-6,
+            &[
+                ("symmetry", 1.0),
+                ("plate_tensile_flaw_size", 188e-6),
+                ("plate_shield_radius", 5e-3),
+                ("plate_tensile_flaw_scatter", 10.0),
+            ],
+        );
+        (s.field("position"), s.field("damage"), s.observables())
+    });
 }
 
 /// The seed's case at 3 nodes across, as a quarter model, at `speed`,

@@ -9,7 +9,7 @@ use super::workspace::{BatchTally, Compressed, KineticChange, Tally, Through};
 use super::{MIN_LEN, kinetic1, wave_and_flow_speed};
 use crate::isa::Isa;
 use crate::lanes::W;
-use crate::material::{Loading, Material, Point, PointState};
+use crate::material::{Loading, Material, Point, PointState, Shield};
 use crate::solver::axisymmetric::boundary::Stress;
 use crate::solver::axisymmetric::pairs::{
     PairInputs, PairOutputs, PairPass, Rows, ScratchPool, laplacian, pair_batch, shepard_means,
@@ -333,6 +333,7 @@ pub(super) fn update(p: Pass, inp: &UpdateInputs, out: UpdateChunks) {
                     rate: [d_rr, d_zz, d_tt, d_rz],
                     spin: omega,
                     density: rho_new,
+                    shield: Shield::NONE,
                 };
                 let before = Point {
                     deviator: dev[k],

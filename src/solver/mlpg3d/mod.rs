@@ -88,6 +88,7 @@ mod restore;
 pub mod scheme;
 mod scratch;
 mod setup;
+mod shielding;
 pub mod shift;
 mod shifting;
 mod spheres;

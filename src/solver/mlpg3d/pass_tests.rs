@@ -170,6 +170,7 @@ fn material_pass(
             vel,
             grad,
             damage_vars: false,
+            shielding: None,
         },
         MaterialFields {
             dev: &mut out.dev,

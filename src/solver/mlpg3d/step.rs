@@ -14,6 +14,7 @@ use super::profile::Stopwatch;
 use super::scratch::ForceBuffers;
 use super::scratch::Scratch;
 use super::scratch::Tally;
+use super::shielding::Shielding;
 use super::shifting;
 use super::update::{self, MaterialFields, MaterialInputs};
 use super::util::extended;
@@ -155,6 +156,15 @@ pub(super) fn step_with(
     g.shapes
         .velocity_gradients_on(own, vel_ext, &mut scratch.grad);
     pipe.profile.lap(Phase::Gradients, &mut watch);
+    // The tensile cracks' shielding zones of the step's start, where a
+    // ceramic's cracks shield (`shielding.rs`).
+    let zones = Shielding::of(
+        (&setup.material, &setup.others, &setup.group),
+        state.material_state.points(),
+        &state.pos,
+        setup.reach,
+        !setup.plane.is_empty(),
+    );
     update::update_material(
         (ranks, &mut pipe.balance),
         &MaterialInputs {
@@ -167,6 +177,7 @@ pub(super) fn step_with(
             vel: &state.vel,
             grad: &scratch.grad,
             damage_vars: setup.damage_vars(),
+            shielding: zones.as_ref().map(|z| (&state.pos[..], z)),
         },
         MaterialFields {
             dev: &mut state.dev,

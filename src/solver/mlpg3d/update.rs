@@ -6,16 +6,17 @@
 
 use super::balance::Balance;
 use super::scratch::Tally;
+use super::shielding::{self, Shielding};
 use super::util::at_time;
 use super::util::material_of;
 use super::util::norm;
 use crate::Error;
 use crate::error::Result;
-use crate::material::Loading;
 use crate::material::Point;
 use crate::material::PointState;
 use crate::material::tensor::Full;
 use crate::material::tensor::SymTensor;
+use crate::material::{Loading, Shield};
 use crate::materials::Material;
 use crate::solver::mlpg3d::Body;
 use crate::solver::mlpg3d::kinetic1;
@@ -40,6 +41,9 @@ pub(super) struct MaterialInputs<'a> {
     /// Some material keeps damage variables at its points (Rajendran-Grove's
     /// or JH-2's), which ranks that share the pass exchange.
     pub(super) damage_vars: bool,
+    /// The nodes' positions and the tensile cracks' shielding zones of the
+    /// step's start, where a ceramic's cracks shield ([`Shielding`]).
+    pub(super) shielding: Option<(&'a [[f64; 3]], &'a Shielding)>,
 }
 
 /// The node fields the material pass updates.
@@ -211,6 +215,7 @@ fn update_rows(
         vel,
         grad,
         damage_vars: _,
+        shielding,
     } = *input;
     fields
         .dev
@@ -234,12 +239,6 @@ fn update_rows(
                     let rate: Full = [d(0, 0), d(1, 1), d(2, 2), d(0, 1), d(1, 2), d(2, 0)];
                     let tr = rate[0] + rate[1] + rate[2];
                     let rho_new = *rho * (1.0 - dt * tr);
-                    let load = Loading {
-                        dt,
-                        rate,
-                        spin: [w(0, 1), w(1, 2), w(2, 0)],
-                        density: rho_new,
-                    };
                     let before = Point {
                         deviator: *dev,
                         pressure: *p,
@@ -247,17 +246,45 @@ fn update_rows(
                         temperature: *temp,
                     };
                     material.seed_point(i as u64, state);
-                    let new = material.update(&load, &before, state).map_err(|l| {
-                        (
-                            i,
-                            Error::CompressionLimit {
-                                particle: i,
-                                time: 0.0,
-                                compression: l.compression,
-                                limit: l.limit,
-                            },
-                        )
-                    })?;
+                    // The state before the step, kept only where cracks shield.
+                    let saved = shielding.map(|_| *state);
+                    let mut shield = Shield::NONE;
+                    // A plane that starts to grow inside another crack's
+                    // zone does not: the step again with it shielded.
+                    let new = loop {
+                        let load = Loading {
+                            dt,
+                            rate,
+                            spin: [w(0, 1), w(1, 2), w(2, 0)],
+                            density: rho_new,
+                            shield,
+                        };
+                        let new = material.update(&load, &before, state).map_err(|l| {
+                            (
+                                i,
+                                Error::CompressionLimit {
+                                    particle: i,
+                                    time: 0.0,
+                                    compression: l.compression,
+                                    limit: l.limit,
+                                },
+                            )
+                        })?;
+                        let (Some((pos, zones)), Some(saved)) = (shielding, saved) else {
+                            break new;
+                        };
+                        let held: Vec<[f64; 3]> = shielding::started(&saved, state)
+                            .into_iter()
+                            .filter(|n| zones.holds(i, &pos[i], n))
+                            .collect();
+                        if held.is_empty() || shield.len() + held.len() > 3 {
+                            break new;
+                        }
+                        for n in held {
+                            shield.add(n);
+                        }
+                        *state = saved;
+                    };
                     let stress = |s: &Full, p: f64| -> Full {
                         [s[0] - p, s[1] - p, s[2] - p, s[3], s[4], s[5]]
                     };

@@ -3,8 +3,8 @@
 use super::layer::{CellState, Layer};
 use super::{LOST_CONTACT, PlateImpact};
 use crate::error::{Error, Result};
-use crate::material::Loading;
 use crate::material::tensor::Full;
+use crate::material::{Loading, Shield};
 
 /// Artificial viscosity coefficients (quadratic, linear).
 const VISCOSITY: (f64, f64) = (1.5, 0.06);
@@ -91,6 +91,7 @@ impl PlateImpact {
                 rate: [d, 0.0, 0.0, 0.0, 0.0, 0.0],
                 spin: [0.0; 3],
                 density: rho,
+                shield: Shield::NONE,
             };
             let k = usize::from(c >= self.setup.flyer_cells);
             let layer = self.setup.layers[k];
