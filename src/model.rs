@@ -128,6 +128,13 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// without compiled copies ignores it.
     fn set_isa(&mut self, _isa: Isa) {}
 
+    /// Makes whole on every rank what a run's ranks keep apart between
+    /// steps (the 3-D solver's damage variables, each rank's current on its
+    /// own part): a collective call, which every rank makes at the same
+    /// point of a run, before anything reads the whole state. Nothing on
+    /// one process, and by default.
+    fn share(&mut self) {}
+
     /// Shares this run's passes over its particles among `ranks` (the
     /// processes of an MPI run, [`crate::ranks`]), with the same bits on
     /// any number of ranks. A solver that runs on one process only refuses

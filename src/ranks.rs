@@ -17,6 +17,12 @@
 //! taken after the gather, on every rank, in the fixed order of
 //! `approx::sums`.
 //!
+//! One exception: the material's damage variables stay between steps with
+//! the rank that stepped them, and every rank holds every point's few
+//! marks (`material::Marks`), which is all the other passes read;
+//! the variables are gathered only when something reads them all
+//! (`MaterialState::share`, `Simulation::share`).
+//!
 //! # Errors never hang
 //!
 //! A pass that can fail at a row agrees on the first failing row over all
@@ -136,6 +142,9 @@ unsafe impl Plain for u64 {}
 unsafe impl Plain for usize {}
 // SAFETY: an array of a plain type has its elements' bytes, no padding.
 unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
+// SAFETY: two `f64` fields, `repr(C)`: no padding, every bit pattern a
+// value.
+unsafe impl Plain for crate::material::Marks {}
 
 /// The bytes of `v`, writable.
 fn bytes_mut<T: Plain>(v: &mut [T]) -> &mut [u8] {

@@ -449,20 +449,43 @@ impl Simulation {
     /// Takes one step. After an error the run is stopped and every further
     /// call returns that error.
     pub fn step(&mut self) -> Result<()> {
+        let stepped = self.step_apart();
+        self.share();
+        stepped
+    }
+
+    /// [`Simulation::step`], leaving apart what the ranks of a run on
+    /// several ([`Simulation::set_ranks`]) keep apart between steps (the 3-D
+    /// solver's damage variables: each rank's current on its own part).
+    /// A loop of steps calls [`Simulation::share`] before it reads the
+    /// run's fields, saves its state or ends; the observables, their
+    /// records and [`Simulation::finished`] need no share. On one rank the
+    /// same as [`Simulation::step`].
+    pub fn step_apart(&mut self) -> Result<()> {
         if let Some(e) = &self.error {
             return Err(e.clone());
         }
         let stepped = self.solver.step();
         self.observed.clear();
         if let Err(e) = stepped {
+            self.solver.share();
             self.record();
             self.error = Some(e.clone());
             return Err(e);
         }
         if self.time() >= self.next_record || self.finished() {
+            self.solver.share();
             self.record();
         }
         Ok(())
+    }
+
+    /// Makes whole on every rank what the ranks keep apart between steps
+    /// ([`Simulation::step_apart`]): a collective call, which every rank
+    /// makes at the same point of the run. Nothing on one rank, or where
+    /// nothing is apart.
+    pub fn share(&mut self) {
+        self.solver.share();
     }
 
     /// Steps until the simulated time reaches `t` or the end condition holds.
@@ -470,12 +493,14 @@ impl Simulation {
     /// one step; results therefore do not depend on how a run is divided.
     pub fn advance_to(&mut self, t: f64) -> Result<()> {
         // On a worker of the thread pool: see `Simulation::run`.
-        rayon::scope(|_| {
+        let stepped = rayon::scope(|_| {
             while self.time() < t && !self.finished() {
-                self.step()?;
+                self.step_apart()?;
             }
             Ok(())
-        })?;
+        });
+        self.share();
+        stepped?;
         match &self.error {
             Some(e) => Err(e.clone()),
             None => Ok(()),

@@ -94,7 +94,9 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
                 interrupted = Some(sig);
                 break;
             }
-            let stepped = sim.step();
+            // The damage variables stay apart among the ranks between
+            // steps; shared before a snapshot, a checkpoint and the end.
+            let stepped = sim.step_apart();
             if let Some(stop) =
                 team::diverged(&**team, stepped.as_ref().err().map(|e| e.to_string()))
             {
@@ -108,26 +110,32 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
             while host.vtk_next < host.vtk_times.len()
                 && sim.time() >= host.vtk_times[host.vtk_next]
             {
+                sim.share();
                 if let Err(e) = write_vtk(team, &sim, &mut host) {
                     vtk_error.get_or_insert(e);
                 }
                 host.vtk_next += 1;
             }
-            if host.checkpoint.is_some() && !sim.finished() {
-                let due = last_checkpoint.0.elapsed().as_secs_f64() >= host.checkpoint_every
+            // Rank 0 alone keeps the checkpoint, timed by its clock: the
+            // ranks agree on when, so that all share the state first.
+            let due = host.checkpoint.is_some()
+                && !sim.finished()
+                && (last_checkpoint.0.elapsed().as_secs_f64() >= host.checkpoint_every
                     || host
                         .checkpoint_steps
-                        .is_some_and(|n| sim.steps() >= last_checkpoint.1 + n);
-                if due {
-                    host.wall_s = wall_before + start.elapsed().as_secs_f64();
-                    if let Err(e) = save_checkpoint(&sim, &host) {
-                        if checkpoint_error.is_none() {
-                            let _ = errln!("warning: --checkpoint: {e}; the run goes on");
-                        }
-                        checkpoint_error.get_or_insert(e);
+                        .is_some_and(|n| sim.steps() >= last_checkpoint.1 + n));
+            if team::any(&**team, due) {
+                sim.share();
+            }
+            if due {
+                host.wall_s = wall_before + start.elapsed().as_secs_f64();
+                if let Err(e) = save_checkpoint(&sim, &host) {
+                    if checkpoint_error.is_none() {
+                        let _ = errln!("warning: --checkpoint: {e}; the run goes on");
                     }
-                    last_checkpoint = (Instant::now(), sim.steps());
+                    checkpoint_error.get_or_insert(e);
                 }
+                last_checkpoint = (Instant::now(), sim.steps());
             }
             if show_bar
                 && start.elapsed() > Duration::from_secs(1)
@@ -160,6 +168,9 @@ fn run_sim(team: &Handle, mut sim: Simulation, mut host: RunHost, a: &RunArgs) -
     if let Some(stop) = diverged {
         return Err(stop);
     }
+    // Every rank ends the loop at the same step: the state whole for the
+    // outputs.
+    sim.share();
     let wall = wall_before + start.elapsed().as_secs_f64();
     host.wall_s = wall;
 

@@ -73,6 +73,14 @@ pub(crate) fn agree_signal(team: &dyn Ranks, signal: i32) -> i32 {
     team.all_max(i64::from(signal.max(0))) as i32
 }
 
+/// Whether `mine` holds on some rank, on every rank (one exchange).
+pub(crate) fn any(team: &dyn Ranks, mine: bool) -> bool {
+    if team.size() == 1 {
+        return mine;
+    }
+    team.all_max(i64::from(mine)) > 0
+}
+
 /// After a step that failed on some ranks and not on this one (`mine` is
 /// `None`): the first failing rank's message, as this rank's stop. The
 /// ranks compute the same steps from the same state, so this happens only

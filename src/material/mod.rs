@@ -41,7 +41,7 @@ use johnson_cook::JohnsonCook;
 use johnson_holmquist::Jh2;
 use mie_gruneisen::{CompressionLimit, MieGruneisen, check};
 use rajendran_grove::{CeramicPoint, RajendranGrove};
-pub use state::{MaterialState, PointState};
+pub use state::{Marks, MaterialState, PointState};
 use state::{Memo, Vars};
 pub use tensile_cracks::Shield;
 use tensor::{Full, SymTensor, radial_return};
@@ -828,6 +828,7 @@ mod tests {
             .unwrap();
         let saved = MaterialState {
             points: vec![state, ceramic, PointState::default()],
+            ..MaterialState::default()
         };
         let json = serde_json::to_string(&saved).unwrap();
         assert!(json.starts_with("{\"ceramic\":[null,{"), "{json}");
@@ -932,6 +933,104 @@ mod tests {
         }
         // Point 0 is the pulverized one; 3 has not stepped.
         state
+    }
+
+    /// On several ranks the material pass leaves the damage variables
+    /// apart and the marks whole: after `after_pass` every rank's marks are
+    /// those of every point's own variables (pulverized, open tensile
+    /// cracks and their openings, JH-2 and comminuted), while a rank's
+    /// points outside its part keep what they held; after `share` every
+    /// rank holds every point's variables, and a second `share` changes
+    /// nothing. `share_now` shares at once. Oracle: the whole state, and
+    /// `Marks::of` against the `PointState` queries it stands for.
+    #[test]
+    fn the_ranks_keep_the_variables_apart_and_the_marks_whole() {
+        use crate::material::johnson_holmquist::Jh2Point;
+        use crate::material::tensile_cracks::TensileCracks;
+        let base = ceramic_state();
+        let mut whole = MaterialState::default();
+        for k in 0..5 {
+            for (i, p) in base.points.iter().enumerate() {
+                let mut p = *p;
+                if let (1, Vars::Ceramic(c)) = (k % 3, &mut p.vars) {
+                    c.tensile = Some(TensileCracks {
+                        normals: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                        size: [2e-4, 1e-4, 1e-4],
+                        opening: [1e-4 * (i + 1) as f64, 0.0, 0.0],
+                        shielding: None,
+                    });
+                }
+                if k == 2 && i == 3 {
+                    p.vars = Vars::Jh2(Jh2Point {
+                        deviator: [0.0; 6],
+                        pressure: 1e9,
+                        density: 3700.0,
+                        plastic_strain: 0.1,
+                        damage: 1.0,
+                        bulking: 0.0,
+                        failed: false,
+                    });
+                }
+                whole.points.push(p);
+            }
+        }
+        let n = whole.points.len();
+        let all: Vec<Marks> = whole.points.iter().map(Marks::of).collect();
+        for (m, p) in all.iter().zip(&whole.points) {
+            assert_eq!(m.is_pulverized(), p.is_pulverized());
+            assert_eq!(m.has_open_cracks(), p.has_open_cracks());
+            assert_eq!(m.is_jh2(), p.jh2().is_some());
+            assert_eq!(m.is_comminuted(), p.is_comminuted());
+            assert_eq!(m.opened().to_bits(), p.opened().to_bits());
+        }
+        assert!(all.iter().any(Marks::has_open_cracks) && all.iter().any(Marks::is_jh2));
+        assert!(all.iter().any(Marks::is_pulverized) && all.iter().any(Marks::is_comminuted));
+        for size in [2, 3, 4] {
+            for share_now in [false, true] {
+                let got = crate::ranks::tests::on_threads(size, |ranks| {
+                    let parts = crate::ranks::shares(ranks, n, 3);
+                    let own = parts[ranks.rank()].clone();
+                    // Outside its part a rank holds stale variables.
+                    let mut mine = MaterialState {
+                        points: (0..n)
+                            .map(|i| {
+                                if own.contains(&i) {
+                                    whole.points[i]
+                                } else {
+                                    base.points[3]
+                                }
+                            })
+                            .collect(),
+                        ..MaterialState::default()
+                    };
+                    mine.fit(n);
+                    let mut wire = Vec::new();
+                    mine.after_pass(ranks, &parts, share_now, &mut wire);
+                    let marks = mine.marks().to_vec();
+                    let apart: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
+                    mine.share(ranks, &mut wire);
+                    let shared: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
+                    mine.share(ranks, &mut wire);
+                    let again: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
+                    (own, marks, apart, shared, again)
+                });
+                let expected: Vec<Vars> = whole.points.iter().map(|p| p.vars).collect();
+                for (own, marks, apart, shared, again) in got {
+                    assert_eq!(marks, all, "{size} ranks");
+                    for i in 0..n {
+                        let stale = base.points[3].vars;
+                        let before = if own.contains(&i) || share_now {
+                            &expected[i]
+                        } else {
+                            &stale
+                        };
+                        assert_eq!(&apart[i], before, "{size} ranks, point {i}");
+                    }
+                    assert_eq!(shared, expected, "{size} ranks");
+                    assert_eq!(again, expected, "{size} ranks");
+                }
+            }
+        }
     }
 
     /// A state with ceramic points round-trips through postcard and JSON

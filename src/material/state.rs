@@ -128,15 +128,98 @@ impl PointState {
 /// empty and are rebuilt at the next step with the same bits. A restored
 /// state must be checked against the run's particle count
 /// ([`MaterialState::check_len`]).
+///
+/// **On several ranks** the material pass leaves each rank's damage
+/// variables current on its own part of the particles only, and every
+/// rank's [`Marks`] current on every particle
+/// ([`MaterialState::after_pass`]); [`MaterialState::share`] makes every
+/// rank's variables whole again before anything reads them all.
 #[derive(Debug, Clone, Default)]
 pub struct MaterialState {
     pub(super) points: Vec<PointState>,
+    /// What the solver's passes read of every particle's variables, kept
+    /// current on every rank ([`Marks`]).
+    pub(super) marks: Vec<Marks>,
+    /// The parts of the ranks that stepped the particles, while each
+    /// rank holds current variables on its own part only; `None` when
+    /// every rank holds every particle's.
+    pub(super) apart: Option<Vec<std::ops::Range<usize>>>,
+}
+
+/// What the solver's passes read of a particle's damage variables besides
+/// its own (a neighbour's openings, whether it is pulverized): a few
+/// numbers that travel between ranks every step, where the variables
+/// themselves travel only when something reads them all
+/// ([`MaterialState::share`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[repr(C)]
+pub struct Marks {
+    /// [`PointState::opened`].
+    opened: f64,
+    /// The flags [`Marks::PULVERIZED`], [`Marks::OPEN`], [`Marks::JH2`] and
+    /// [`Marks::COMMINUTED`] (an integer below 16, held as a float so that
+    /// the marks travel as plain numbers).
+    flags: f64,
+}
+
+impl Marks {
+    const PULVERIZED: u8 = 1;
+    const OPEN: u8 = 2;
+    const JH2: u8 = 4;
+    const COMMINUTED: u8 = 8;
+
+    /// The marks of `point`.
+    pub fn of(point: &PointState) -> Self {
+        let flag = |on: bool, bit: u8| if on { bit } else { 0 };
+        let flags = flag(point.is_pulverized(), Self::PULVERIZED)
+            | flag(point.has_open_cracks(), Self::OPEN)
+            | flag(point.jh2().is_some(), Self::JH2)
+            | flag(point.is_comminuted(), Self::COMMINUTED);
+        Marks {
+            opened: point.opened(),
+            flags: f64::from(flags),
+        }
+    }
+
+    fn has(&self, bit: u8) -> bool {
+        (self.flags as u8) & bit != 0
+    }
+
+    /// [`PointState::is_pulverized`].
+    pub fn is_pulverized(&self) -> bool {
+        self.has(Self::PULVERIZED)
+    }
+
+    /// [`PointState::has_open_cracks`].
+    pub fn has_open_cracks(&self) -> bool {
+        self.has(Self::OPEN)
+    }
+
+    /// Whether the point holds JH-2 variables ([`PointState::jh2`]).
+    pub fn is_jh2(&self) -> bool {
+        self.has(Self::JH2)
+    }
+
+    /// [`PointState::is_comminuted`].
+    pub fn is_comminuted(&self) -> bool {
+        self.has(Self::COMMINUTED)
+    }
+
+    /// [`PointState::opened`].
+    pub fn opened(&self) -> f64 {
+        self.opened
+    }
 }
 
 impl MaterialState {
     /// Sizes the state for `n` particles (new ones start empty).
     pub fn fit(&mut self, n: usize) {
         crate::approx::buffers::fit(&mut self.points, n, PointState::default());
+        // A restored state brings no marks: they are those of its points.
+        if self.marks.len() != self.points.len() {
+            self.marks.clear();
+            self.marks.extend(self.points.iter().map(Marks::of));
+        }
     }
 
     /// The particles' states, to be cut into chunks.
@@ -144,18 +227,48 @@ impl MaterialState {
         &mut self.points
     }
 
+    /// Every particle's [`Marks`] (current on every rank).
+    pub fn marks(&self) -> &[Marks] {
+        &self.marks
+    }
+
     /// After each rank of `ranks` has stepped the points of its part
-    /// `parts[rank]`, every rank's damage variables on every rank
-    /// ([`crate::ranks`]), in records of one width through `wire` (the
-    /// caller's, kept from step to step: [`crate::ranks::gather_records`]).
-    /// The caches stay each rank's own: they give the same bits whether
-    /// kept or rebuilt.
-    pub fn gather(
-        points: &mut [PointState],
+    /// `parts[rank]` (the whole run on one rank): the marks of its points,
+    /// then every rank's marks on every rank. The damage variables stay
+    /// apart, each rank's current on its own part, until
+    /// [`MaterialState::share`], unless `share_now`; on one rank there is
+    /// nothing to share.
+    pub fn after_pass(
+        &mut self,
         ranks: &dyn crate::ranks::Ranks,
         parts: &[std::ops::Range<usize>],
+        share_now: bool,
         wire: &mut Vec<u8>,
     ) {
+        use rayon::prelude::*;
+        let own = parts[ranks.rank()].clone();
+        self.marks.resize(self.points.len(), Marks::default());
+        self.marks[own.clone()]
+            .par_iter_mut()
+            .zip(&self.points[own])
+            .for_each(|(m, p)| *m = Marks::of(p));
+        if ranks.size() == 1 {
+            return;
+        }
+        crate::ranks::gather_parts(ranks, parts, &mut self.marks);
+        self.apart = Some(parts.to_vec());
+        if share_now {
+            self.share(ranks, wire);
+        }
+    }
+
+    /// Every rank's damage variables on every rank, where they are apart
+    /// ([`MaterialState::after_pass`]): a collective call, which every rank
+    /// makes at the same point of a run. The variables travel in records
+    /// of one width through `wire` (the caller's, kept from one call to
+    /// the next: [`crate::ranks::gather_records`]). The caches stay each
+    /// rank's own: they give the same bits whether kept or rebuilt.
+    pub fn share(&mut self, ranks: &dyn crate::ranks::Ranks, wire: &mut Vec<u8>) {
         /// The damage variables as they travel.
         #[derive(serde::Serialize, serde::Deserialize)]
         enum Wire {
@@ -163,10 +276,13 @@ impl MaterialState {
             Ceramic(CeramicVars),
             Jh2(Jh2Point),
         }
+        let Some(parts) = self.apart.take() else {
+            return;
+        };
         crate::ranks::gather_records(
             ranks,
-            parts,
-            points,
+            &parts,
+            &mut self.points,
             wire,
             |p| match p.vars {
                 Vars::None => Wire::None,
@@ -376,7 +492,10 @@ impl<'de> serde::Deserialize<'de> for MaterialState {
                 })
             })
             .collect::<std::result::Result<Vec<_>, D::Error>>()?;
-        Ok(MaterialState { points })
+        Ok(MaterialState {
+            points,
+            ..MaterialState::default()
+        })
     }
 }
 

@@ -54,6 +54,12 @@ impl Balance {
         self.cost[b] += seconds;
     }
 
+    /// Whether [`Balance::end_step`] of this step will split the points
+    /// again (the same answer on every rank).
+    pub(super) fn splits_at_end(&self, ranks: &dyn Ranks) -> bool {
+        ranks.size() > 1 && !self.cost.is_empty() && self.steps + 1 >= EVERY
+    }
+
     /// Ends a step: every [`EVERY`] steps the blocks' times are gathered
     /// and the blocks split again ([`split`]). A collective call: every
     /// rank calls it at every step.

@@ -14,7 +14,7 @@ use super::util::pin;
 use crate::Error;
 use crate::approx::mirror;
 use crate::error::Result;
-use crate::material::PointState;
+use crate::material::Marks;
 use crate::solver::mlpg3d::kinetic1;
 use crate::solver::shared::SHIFT_RANGE;
 use rayon::iter::IndexedParallelIterator;
@@ -186,14 +186,14 @@ pub(super) fn smooth(
 }
 
 /// The contact between the bodies ([`Frame::group`] non-empty), then between
-/// pulverized nodes closer than half a spacing (`points`, with damage):
+/// pulverized nodes closer than half a spacing (`marks`, with damage):
 /// in the quarter model on the nodes and their images, the pairs with a
 /// real node, each resolved on the images' velocities too, and only the
 /// real nodes' kept. The kinetic energy removed is added to `dissipation`.
 pub(super) fn collide(
     frame: &Frame,
     pos: &[[f64; 3]],
-    points: Option<&[PointState]>,
+    marks: Option<&[Marks]>,
     vel: &mut [[f64; 3]],
     buffers: &mut ContactBuffers,
     ext: &mut ImageBuffers,
@@ -205,7 +205,7 @@ pub(super) fn collide(
     buffers.pairs.clear();
     // No contact pass in a run of one body without damage: no copy.
     let real_pos = pos;
-    let pos: &[[f64; 3]] = if group.is_empty() && points.is_none() {
+    let pos: &[[f64; 3]] = if group.is_empty() && marks.is_none() {
         real_pos
     } else {
         extended(images, real_pos, &mut ext.pos, mirror::vector)
@@ -218,11 +218,9 @@ pub(super) fn collide(
     if !group.is_empty() {
         contact::pairs(pos, group_ext, frame.reach, frame.ranks, &mut buffers.pairs);
     }
-    if let Some(points) = points {
+    if let Some(marks) = marks {
         buffers.loose.clear();
-        buffers
-            .loose
-            .extend(points.iter().map(|p| p.is_pulverized()));
+        buffers.loose.extend(marks.iter().map(Marks::is_pulverized));
         let loose = extended(images, &buffers.loose, &mut ext.loose, mirror::same);
         contact::loose_pairs(
             pos,

@@ -332,6 +332,22 @@ impl Mlpg3d {
         self.state.material_state.points()
     }
 
+    /// The marks of each node's damage variables (empty before the first
+    /// step): current on every rank after every step, where the variables
+    /// themselves are whole only after [`Mlpg3d::share`].
+    pub fn material_marks(&self) -> &[crate::material::Marks] {
+        self.state.material_state.marks()
+    }
+
+    /// Makes every node's damage variables whole on every rank, where the
+    /// ranks keep them apart between steps (each current on its own part):
+    /// a collective call, made by every rank at the same point of a run
+    /// before anything reads them ([`crate::material::MaterialState::share`]).
+    pub fn share(&mut self) {
+        let (ranks, wire) = (&*self.pipe.ranks, &mut self.pipe.balance.wire);
+        self.state.material_state.share(ranks, wire);
+    }
+
     /// The contact reach between the bodies (m; [`contact`]).
     pub fn contact_reach(&self) -> f64 {
         self.setup.reach
@@ -442,5 +458,8 @@ impl crate::model::Model for Mlpg3d {
     fn set_ranks(&mut self, ranks: crate::ranks::Handle) -> std::result::Result<(), String> {
         self.set_ranks(ranks);
         Ok(())
+    }
+    fn share(&mut self) {
+        self.share();
     }
 }

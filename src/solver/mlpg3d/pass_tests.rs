@@ -169,7 +169,6 @@ fn material_pass(
             mass,
             vel,
             grad,
-            damage_vars: false,
             shielding: None,
         },
         MaterialFields {

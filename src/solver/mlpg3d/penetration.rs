@@ -174,10 +174,12 @@ impl Penetration {
             let rod = self.run.setup();
             let spacing = rod.cylinder.radius / rod.rings as f64;
             let reach = self.hole_radius() + 2.0 * spacing;
-            let points = self.run.material_points();
+            // The marks: `finished` asks at every step, where the damage
+            // variables may be apart among the ranks.
+            let marks = self.run.material_marks();
             let (mut p, mut total) = (0.0, 0.0);
             for i in self.nodes(1) {
-                let intact = points.get(i).is_none_or(|p| !p.is_comminuted());
+                let intact = marks.get(i).is_none_or(|m| !m.is_comminuted());
                 if intact && (x[i][0] * x[i][0] + x[i][1] * x[i][1]).sqrt() <= reach {
                     p -= m[i] * v[i][2];
                     total += m[i];
@@ -648,5 +650,8 @@ impl crate::model::Model for Penetration {
     fn set_ranks(&mut self, ranks: crate::ranks::Handle) -> std::result::Result<(), String> {
         self.run.set_ranks(ranks);
         Ok(())
+    }
+    fn share(&mut self) {
+        self.run.share();
     }
 }

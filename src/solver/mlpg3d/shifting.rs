@@ -21,7 +21,7 @@ use crate::Error;
 use crate::approx::lattice::Surfaces;
 use crate::approx::mirror;
 use crate::error::Result;
-use crate::material::PointState;
+use crate::material::Marks;
 use crate::material::tensor::Full;
 use crate::materials::Material;
 use crate::solver::mlpg3d::Body;
@@ -76,8 +76,8 @@ pub(super) fn shift(
         mass: &setup.mass,
         // Without damage variables no point has any to read (the same
         // values as reading each point's empty ones, without the visit).
-        points: if setup.damage_vars() {
-            state.material_state.points()
+        marks: if setup.damage_vars() {
+            state.material_state.marks()
         } else {
             &[]
         },
@@ -129,7 +129,7 @@ pub(super) fn shift(
         temp: &mut state.temp,
         reference: &mut state.reference,
     };
-    pack(&fields, frame.points, &mut buffers.carried);
+    pack(&fields, frame.marks, &mut buffers.carried);
     let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
     carry_on(
         ranks,
@@ -165,9 +165,9 @@ struct ShiftFrame<'a> {
     plane: &'a [u8],
     held: &'a [bool],
     mass: &'a [f64],
-    /// The material state of each node (empty before the first step, and
-    /// in a run whose materials keep no damage variables).
-    points: &'a [PointState],
+    /// The marks of each node's damage variables (empty before the first
+    /// step, and in a run whose materials keep no damage variables).
+    marks: &'a [Marks],
     /// The rod's material, the further bodies and each node's body.
     materials: (&'a Material, &'a [Body], &'a [u8]),
     time: f64,
@@ -194,7 +194,7 @@ fn freedoms(
     free: &mut [Freedom],
 ) {
     let (surf, contact, anvil, nodal) = (frame.surfaces, frame.contact, frame.anvil, frame.nodal);
-    let (shapes, points) = (&frame.geometry.shapes, frame.points);
+    let (shapes, marks) = (&frame.geometry.shapes, frame.marks);
     crate::ranks::each_own_row(ranks, free, 1, |i, f| {
         // A pulverized node stays put: its ceramic state (pulverized,
         // its porosity) is not carried, so carrying its neighbours'
@@ -206,7 +206,7 @@ fn freedoms(
         // stress and density ([`unpack`]): held still, such nodes under
         // the rod's edge collapsed (`ad85_planes` at 800 m/s, 6 across:
         // spacing collapse at 6.0 µs).
-        let pulverized = points.get(i).is_some_and(|p| p.is_pulverized());
+        let pulverized = marks.get(i).is_some_and(Marks::is_pulverized);
         *f = if pulverized {
             Freedom::Fixed
         } else if !anvil {
@@ -228,10 +228,10 @@ fn freedoms(
 }
 
 /// The carried fields of every node ([`CARRIED`]).
-fn pack(fields: &ShiftedFields, points: &[PointState], carried: &mut [[f64; CARRIED]]) {
+fn pack(fields: &ShiftedFields, marks: &[Marks], carried: &mut [[f64; CARRIED]]) {
     carried.par_iter_mut().enumerate().for_each(|(i, f)| {
         let (v, s, x) = (fields.vel[i], fields.dev[i], fields.reference[i]);
-        let opened = points.get(i).map_or(0.0, PointState::opened);
+        let opened = marks.get(i).map_or(0.0, Marks::opened);
         *f = [
             v[0],
             v[1],
@@ -323,9 +323,9 @@ fn unpack(
         fields.reference[i] = [f[12], f[13], f[14]];
         fields.pos[i] = std::array::from_fn(|k| fields.pos[i][k] + di[k]);
         if frame
-            .points
+            .marks
             .get(i)
-            .is_some_and(|p| p.has_open_cracks() || p.jh2().is_some())
+            .is_some_and(|m| m.has_open_cracks() || m.is_jh2())
         {
             // A node whose tensile cracks stand open keeps its stress,
             // density and heat: they hold its openings, which are its own.
@@ -343,7 +343,7 @@ fn unpack(
         fields.dev[i] = [f[3] - m, f[4] - m, f[5] - m, f[6], f[7], f[8]];
         // The matrix density was carried: the node's own openings take
         // their volume out of it again.
-        let opened = frame.points.get(i).map_or(0.0, PointState::opened);
+        let opened = frame.marks.get(i).map_or(0.0, Marks::opened);
         fields.rho[i] = f[9] / (1.0 + opened);
         fields.eps_p[i] = f[10];
         fields.temp[i] = f[11];

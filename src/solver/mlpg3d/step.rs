@@ -107,7 +107,7 @@ pub(super) fn step_with(
     motion::collide(
         &frame,
         &state.pos,
-        damaging.then(|| state.material_state.points()),
+        damaging.then(|| state.material_state.marks()),
         &mut state.vel,
         &mut scratch.contact,
         &mut scratch.images,
@@ -176,7 +176,6 @@ pub(super) fn step_with(
             mass: &setup.mass,
             vel: &state.vel,
             grad: &scratch.grad,
-            damage_vars: setup.damage_vars(),
             shielding: zones.as_ref().map(|z| (&state.pos[..], z)),
         },
         MaterialFields {
@@ -190,11 +189,18 @@ pub(super) fn step_with(
         },
         &mut scratch.results,
     );
-    let t = update::sum_on(
-        (ranks, pipe.balance.parts(ranks, n)),
-        &scratch.results,
-        state.clock.time,
-    );
+    // The marks of the nodes on every rank; their damage variables stay
+    // with the rank that stepped them (shared every step where the cracks
+    // shield: the zones read every node's), and are shared before the
+    // split of the points among the ranks moves.
+    let parts = pipe.balance.parts(ranks, n).to_vec();
+    if setup.damage_vars() {
+        let balance = &mut pipe.balance;
+        let splits = balance.splits_at_end(ranks);
+        let material_state = &mut state.material_state;
+        material_state.after_pass(ranks, &parts, zones.is_some() || splits, &mut balance.wire);
+    }
+    let t = update::sum_on((ranks, &parts), &scratch.results, state.clock.time);
     pipe.balance.end_step(ranks);
     let t = t?;
     pipe.profile.lap(Phase::Material, &mut watch);

@@ -38,9 +38,6 @@ pub(super) struct MaterialInputs<'a> {
     pub(super) vel: &'a [[f64; 3]],
     /// The velocity gradient `L = ∂v/∂x` at each node.
     pub(super) grad: &'a [[[f64; 3]; 3]],
-    /// Some material keeps damage variables at its points (Rajendran-Grove's
-    /// or JH-2's), which ranks that share the pass exchange.
-    pub(super) damage_vars: bool,
     /// The nodes' positions and the tensile cracks' shielding zones of the
     /// step's start, where a ceramic's cracks shield ([`Shielding`]).
     pub(super) shielding: Option<(&'a [[f64; 3]], &'a Shielding)>,
@@ -73,9 +70,9 @@ pub(super) fn update_material(
     }
     // Each rank steps its share of the points (whole blocks of the sums,
     // balanced by their cost: [`Balance`]), a block at a time, timing
-    // each; then every rank holds every point's fields and damage
-    // variables ([`crate::ranks`]); the results stay with their rank
-    // ([`sum_on`]).
+    // each; then every rank holds every point's fields ([`crate::ranks`]);
+    // the damage variables stay with their rank until they are shared
+    // (`MaterialState::after_pass`), the results too ([`sum_on`]).
     use crate::ranks::gather_parts;
     let parts = balance.parts(ranks, results.len()).to_vec();
     let own = parts[ranks.rank()].clone();
@@ -113,9 +110,6 @@ pub(super) fn update_material(
     gather_parts(ranks, &parts, temp);
     gather_parts(ranks, &parts, rho);
     gather_parts(ranks, &parts, visc);
-    if input.damage_vars {
-        crate::material::MaterialState::gather(states, ranks, &parts, &mut balance.wire);
-    }
 }
 
 /// The alignment of the material pass's shares among the ranks: whole
@@ -214,7 +208,6 @@ fn update_rows(
         mass,
         vel,
         grad,
-        damage_vars: _,
         shielding,
     } = *input;
     fields
