@@ -329,14 +329,7 @@ pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &m
         out.par_iter_mut().enumerate().for_each(|(i, v)| f(i, v));
         return;
     }
-    let parts = shares(ranks, out.len(), 1);
-    let own = parts[ranks.rank()].clone();
-    let start = own.start;
-    out[own]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(k, v)| f(start + k, v));
-    gather_parts(ranks, &parts, out);
+    each_row_in(ranks, &shares(ranks, out.len(), 1), out, f);
 }
 
 /// Every rank's `mine`, of any length, joined in rank order (two
@@ -355,6 +348,53 @@ pub fn all_gather_varying<T: Plain + Default>(ranks: &dyn Ranks, mine: &[T]) -> 
     all[parts[ranks.rank()].clone()].copy_from_slice(mine);
     gather_parts(ranks, &parts, &mut all);
     all
+}
+
+/// [`each_row`] over the given `parts` of the rows (contiguous, in rank
+/// order, covering `out`) in place of equal shares: `f(i, &mut out[i])`
+/// for the rows of this rank's part, then the parts gathered so that
+/// every rank holds every row.
+pub fn each_row_in<T: Plain>(
+    ranks: &dyn Ranks,
+    parts: &[Range<usize>],
+    out: &mut [T],
+    f: impl Fn(usize, &mut T) + Sync,
+) {
+    use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
+    assert_covers(parts, out.len());
+    let own = parts[ranks.rank()].clone();
+    let start = own.start;
+    out[own]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(k, v)| f(start + k, v));
+    gather_parts(ranks, parts, out);
+}
+
+/// Contiguous parts of the rows, in order, one for each of `parts`, each
+/// with about an equal share of the total `weight` of its rows: part `r`
+/// starts at the boundary between rows nearest to `r / parts` of the
+/// total (never behind the one before), so that a part's weight is within
+/// the heaviest row's of an equal share. With no weight at all the parts
+/// are equal in rows ([`share`]).
+pub fn weighted_parts(weight: &[usize], parts: usize) -> Vec<Range<usize>> {
+    let n = weight.len();
+    let total: usize = weight.iter().sum();
+    if total == 0 {
+        return (0..parts).map(|r| share(n, r, parts, 1)).collect();
+    }
+    let mut starts = Vec::with_capacity(parts + 1);
+    let (mut row, mut before) = (0usize, 0usize);
+    for r in 0..parts {
+        // Past the rows whose middle lies before the goal `total r / parts`.
+        while row < n && (2 * before + weight[row]) * parts < 2 * total * r {
+            before += weight[row];
+            row += 1;
+        }
+        starts.push(row);
+    }
+    starts.push(n);
+    starts.windows(2).map(|w| w[0]..w[1]).collect()
 }
 
 /// Every rank's `value`, in rank order (one exchange).
@@ -462,6 +502,38 @@ pub(crate) mod tests {
 
     /// On ranks as threads, a pass over the rows gives every rank every
     /// row, as the plain pass does; the largest and smallest agree.
+    /// The weighted parts cover the rows in order, each within the
+    /// heaviest row's weight of an equal share: one heavy row goes alone;
+    /// no weight gives equal parts; more parts than rows leave some empty.
+    #[test]
+    fn weighted_parts_share_the_weight() {
+        assert_eq!(
+            weighted_parts(&[1, 1, 1, 1, 4, 4, 4, 4], 2),
+            vec![0..5, 5..8]
+        );
+        assert_eq!(weighted_parts(&[8, 1, 1, 1, 1], 2), vec![0..1, 1..5]);
+        assert_eq!(weighted_parts(&[0; 6], 3), vec![0..2, 2..4, 4..6]);
+        let weight: Vec<usize> = (0..1000).map(|i| (i * 7919) % 61).collect();
+        let total: usize = weight.iter().sum();
+        let heaviest = *weight.iter().max().unwrap();
+        for parts in 1..9 {
+            let got = weighted_parts(&weight, parts);
+            assert_eq!(got.len(), parts);
+            assert_eq!((got[0].start, got[parts - 1].end), (0, 1000));
+            assert!(got.windows(2).all(|w| w[0].end == w[1].start));
+            for p in &got {
+                let w: usize = weight[p.clone()].iter().sum();
+                let share = total as f64 / parts as f64;
+                assert!(
+                    (w as f64 - share).abs() <= heaviest as f64,
+                    "{parts}: {w} of {share}"
+                );
+            }
+        }
+        let got = weighted_parts(&[3, 5], 4);
+        assert_eq!(got.iter().map(|r| r.len()).sum::<usize>(), 2);
+    }
+
     #[test]
     fn on_threads_each_row_gives_every_rank_the_plain_pass() {
         for size in [2, 3] {
