@@ -193,14 +193,21 @@ pub(super) fn step_with(
     // with the rank that stepped them (shared every step where the cracks
     // shield: the zones read every node's), and are shared before the
     // split of the points among the ranks moves.
-    let parts = pipe.balance.parts(ranks, n).to_vec();
+    // (The buffer taken out and put back: a step allocates nothing.)
     if setup.damage_vars() {
-        let balance = &mut pipe.balance;
-        let splits = balance.splits_at_end(ranks);
-        let material_state = &mut state.material_state;
-        material_state.after_pass(ranks, &parts, zones.is_some() || splits, &mut balance.wire);
+        let share_now = zones.is_some() || pipe.balance.splits_at_end(ranks);
+        let mut wire = std::mem::take(&mut pipe.balance.wire);
+        let parts = pipe.balance.parts(ranks, n);
+        state
+            .material_state
+            .after_pass(ranks, parts, share_now, &mut wire);
+        pipe.balance.wire = wire;
     }
-    let t = update::sum_on((ranks, &parts), &scratch.results, state.clock.time);
+    let t = update::sum_on(
+        (ranks, pipe.balance.parts(ranks, n)),
+        &scratch.results,
+        state.clock.time,
+    );
     pipe.balance.end_step(ranks);
     let t = t?;
     pipe.profile.lap(Phase::Material, &mut watch);
