@@ -406,18 +406,19 @@ pub fn all_gather_one<T: Plain + Default>(ranks: &dyn Ranks, value: T) -> Vec<T>
     all
 }
 
-/// `f(i, &mut out[i])` for the rows of this rank's share aligned to
-/// `align` ([`share`]), on the pool; the other rows are left as they were
-/// (a pass whose next reader reads only this rank's rows of the same
-/// share). Alone, every row.
+/// `f(i, &mut out[i])` for the rows of this rank's part `parts[rank]`
+/// (`parts` contiguous, in rank order, covering `out`), on the pool; the
+/// other rows are left as they were (a pass whose next reader reads only
+/// this rank's rows of the same parts).
 pub fn each_own_row<T: Send>(
     ranks: &dyn Ranks,
+    parts: &[Range<usize>],
     out: &mut [T],
-    align: usize,
     f: impl Fn(usize, &mut T) + Sync,
 ) {
     use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
-    let own = share(out.len(), ranks.rank(), ranks.size(), align);
+    assert_covers(parts, out.len());
+    let own = parts[ranks.rank()].clone();
     let start = own.start;
     out[own]
         .par_iter_mut()
@@ -631,6 +632,37 @@ pub(crate) mod tests {
                 assert_eq!(bits(&b), bits(&want), "{size} ranks: the records");
                 assert_eq!(bits(&c), bits(&want), "{size} ranks: the records again");
                 assert!(kept, "{size} ranks: the wire is reused");
+            }
+        }
+    }
+
+    /// A pass over this rank's own rows writes exactly the rows of its part
+    /// of weighted parts (the shifting's freedoms and shifts go by the same
+    /// parts), and a pass over the rows in those parts gives every rank
+    /// every row; the rows outside a rank's part keep what they held.
+    #[test]
+    fn each_own_row_writes_the_rows_of_its_part() {
+        let n = 1001;
+        let weight: Vec<usize> = (0..n).map(|i| 1 + (i * 7919) % 61).collect();
+        for size in 1..5 {
+            let parts = weighted_parts(&weight, size);
+            let got = on_threads(size, |ranks| {
+                let mut own = vec![-1.0; n];
+                each_own_row(ranks, &parts, &mut own, |i, v| *v = i as f64);
+                let mut all = vec![-1.0; n];
+                each_row_in(ranks, &parts, &mut all, |i, v| *v = 2.0 * i as f64);
+                (ranks.rank(), own, all)
+            });
+            for (rank, own, all) in got {
+                for i in 0..n {
+                    let want = if parts[rank].contains(&i) {
+                        i as f64
+                    } else {
+                        -1.0
+                    };
+                    assert_eq!(own[i], want, "{size} ranks, rank {rank}, row {i}");
+                    assert_eq!(all[i], 2.0 * i as f64, "{size} ranks, rank {rank}, row {i}");
+                }
             }
         }
     }

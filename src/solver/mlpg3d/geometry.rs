@@ -50,6 +50,27 @@ pub(super) struct Geometry {
     /// The conforming correction's multipliers at this build (empty
     /// without it): the next build starts from them.
     pub(super) multipliers: Vec<[f64; 3]>,
+    /// The parts of the shapes' rows among the ranks, of about equal
+    /// entries ([`row_parts`]): the rows each rank computes in the passes
+    /// over them (the smoothing's defect, the shifts and the carry).
+    pub(super) rows: Vec<std::ops::Range<usize>>,
+}
+
+/// The parts of the first `n` rows of `shapes` among `ranks`: one part
+/// alone; on several ranks, parts of about equal entries
+/// ([`crate::ranks::weighted_parts`]), since a row's pass costs in
+/// proportion to its entries (equal shares of the rows left rank 1
+/// waiting 0.66 s of `taylor3d` 10 across at the shifts' gather).
+pub(super) fn row_parts(
+    ranks: &dyn crate::ranks::Ranks,
+    shapes: &NodalShapes,
+    n: usize,
+) -> Vec<std::ops::Range<usize>> {
+    if ranks.size() == 1 {
+        return std::iter::once(0..n).collect();
+    }
+    let weight: Vec<usize> = (0..n).map(|i| shapes.row(i).len()).collect();
+    crate::ranks::weighted_parts(&weight, ranks.size())
 }
 
 /// What [`Mlpg3d::named_pairs`] finds.
@@ -190,6 +211,7 @@ pub(super) fn build_geometry(
         );
         pipe.profile.conform_iterations += c.iterations as u64;
     }
+    g.rows = row_parts(&*pipe.ranks, &g.shapes, n);
     pipe.profile.lap(Phase::Conform, &mut watch);
     match setup.rod.scheme.forces {
         Forces::Sphere => {

@@ -142,7 +142,7 @@ pub(super) fn smooth(
     } else {
         &mut buffers.defect
     };
-    crate::ranks::each_row(frame.ranks, weighted, |i, out| {
+    crate::ranks::each_row_in(frame.ranks, &g.rows, weighted, |i, out| {
         let mut m = [0.0; 3];
         for q in shapes.row(i) {
             let vj = vel_ext[shapes.nodes[q]];

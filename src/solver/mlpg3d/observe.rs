@@ -140,11 +140,14 @@ impl Mlpg3d {
         self.pipe.ranks = ranks;
         // The nodal operator built before holds the columns of the ranks
         // it was built for; each rank now holds its share of them.
-        if let Some(g) = self.pipe.geometry.as_mut()
-            && !g.nodal.offsets.is_empty()
-        {
-            let columns = g.nodal.columns;
-            g.nodal.rebuild_on(&*self.pipe.ranks, &g.shapes, columns);
+        if let Some(g) = self.pipe.geometry.as_mut() {
+            // So do the shapes' rows.
+            let rows = g.shapes.offsets.len().saturating_sub(1);
+            g.rows = super::geometry::row_parts(&*self.pipe.ranks, &g.shapes, rows);
+            if !g.nodal.offsets.is_empty() {
+                let columns = g.nodal.columns;
+                g.nodal.rebuild_on(&*self.pipe.ranks, &g.shapes, columns);
+            }
         }
     }
 

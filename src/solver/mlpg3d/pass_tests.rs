@@ -72,6 +72,7 @@ fn geometry(pts: &[[f64; 3]]) -> Geometry {
         supports: Some(sup),
         shapes,
         nodal,
+        rows: std::iter::once(0..pts.len()).collect(),
         ..Geometry::default()
     }
 }

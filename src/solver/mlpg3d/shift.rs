@@ -48,7 +48,7 @@ pub fn shifts(
     out: &mut [[f64; 3]],
 ) {
     shifts_on(
-        &crate::ranks::Alone,
+        (&crate::ranks::Alone, std::slice::from_ref(&(0..out.len()))),
         pos,
         shapes,
         free,
@@ -64,10 +64,11 @@ pub fn shifts(
 /// directions the node is free in, limited to `cap` in length and so that
 /// the node does not pass below the anvil plane. Written into `out`; nodes
 /// in parallel, each from the positions before any moves (the same bits for
-/// any number of threads). Shared among `ranks`: each computes its share
-/// of the nodes, then every rank holds them all (the same bits).
+/// any number of threads). Shared among `ranks`: each computes its part
+/// of the nodes (`parts`, contiguous, in rank order, covering them), then
+/// every rank holds them all (the same bits).
 pub fn shifts_on(
-    ranks: &dyn crate::ranks::Ranks,
+    (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
     pos: &[[f64; 3]],
     shapes: &NodalShapes,
     free: &[Freedom],
@@ -75,7 +76,7 @@ pub fn shifts_on(
     out: &mut [[f64; 3]],
 ) {
     let range2 = range * range;
-    crate::ranks::each_row(ranks, out, |i, d| {
+    crate::ranks::each_row_in(ranks, parts, out, |i, d| {
         *d = [0.0; 3];
         if free[i] == Freedom::Fixed {
             return;
@@ -127,7 +128,13 @@ pub fn carry<const K: usize>(
     d: &[[f64; 3]],
     out: &mut [[f64; K]],
 ) {
-    carry_on(&crate::ranks::Alone, shapes, f, d, out);
+    carry_on(
+        (&crate::ranks::Alone, std::slice::from_ref(&(0..out.len()))),
+        shapes,
+        f,
+        d,
+        out,
+    );
 }
 
 /// `f_i + d_i · ∇f_i` for the nodes with a shift `d_i` (the others keep
@@ -139,16 +146,17 @@ pub fn carry<const K: usize>(
 /// extrapolates without bound, and shifting repeats it step after step
 /// (the axisymmetric solver measured 1060 plastic strain at one particle of
 /// test 7 at 600 m/s; README, "Particle shifting"). Nodes in parallel, from
-/// `f` before any moves. Shared among `ranks`: each computes its share
-/// of the nodes, then every rank holds them all (the same bits).
+/// `f` before any moves. Shared among `ranks`: each computes its part of
+/// the nodes (`parts`, as [`shifts_on`]'s), then every rank holds them all
+/// (the same bits).
 pub fn carry_on<const K: usize>(
-    ranks: &dyn crate::ranks::Ranks,
+    (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
     shapes: &NodalShapes,
     f: &[[f64; K]],
     d: &[[f64; 3]],
     out: &mut [[f64; K]],
 ) {
-    crate::ranks::each_row(ranks, out, |i, o| {
+    crate::ranks::each_row_in(ranks, parts, out, |i, o| {
         *o = f[i];
         let di = d[i];
         if di == [0.0; 3] {

@@ -92,7 +92,7 @@ pub(super) fn shift(
     let pos = extended(images, &state.pos, &mut ext.pos, mirror::vector);
     let (spacing, step_scale) = (frame.spacing, setup.rod.step_scale());
     shifts_on(
-        ranks,
+        (ranks, &g.rows),
         pos,
         &g.shapes,
         &buffers.free,
@@ -132,7 +132,7 @@ pub(super) fn shift(
     pack(&fields, frame.marks, &mut buffers.carried);
     let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
     carry_on(
-        ranks,
+        (ranks, &g.rows),
         &g.shapes,
         carried,
         &buffers.shift,
@@ -186,7 +186,8 @@ struct ShiftedFields<'a> {
 }
 
 /// How each node may move (`reference`: the reference places, extended
-/// by the images): the nodes of this rank's share ([`shifts_on`]'s).
+/// by the images): the nodes of this rank's part of the shapes' rows
+/// ([`shifts_on`]'s).
 fn freedoms(
     frame: &ShiftFrame,
     ranks: &dyn crate::ranks::Ranks,
@@ -195,7 +196,7 @@ fn freedoms(
 ) {
     let (surf, contact, anvil, nodal) = (frame.surfaces, frame.contact, frame.anvil, frame.nodal);
     let (shapes, marks) = (&frame.geometry.shapes, frame.marks);
-    crate::ranks::each_own_row(ranks, free, 1, |i, f| {
+    crate::ranks::each_own_row(ranks, &frame.geometry.rows, free, |i, f| {
         // A pulverized node stays put: its ceramic state (pulverized,
         // its porosity) is not carried, so carrying its neighbours'
         // stress and density to it created energy (the penetration at
