@@ -341,9 +341,10 @@ pub fn contradictions(saved: &Scene, asked: &Scene) -> Vec<String> {
 mod tests {
     use super::*;
 
-    fn saved(test: &str) -> (std::path::PathBuf, Vec<u8>) {
-        let dir = std::env::temp_dir().join(format!("mi-ckpt-{test}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+    /// A checkpoint of `noh` after five steps, in a scratch folder of its
+    /// own (removed when the test passes), and its bytes.
+    fn saved(test: &str) -> (crate::test_dir::TestDir, Vec<u8>) {
+        let dir = crate::test_dir::TestDir::new(&format!("ckpt-{test}"));
         let path = dir.join("noh.ckpt");
         let mut scene = Scene::builtin("noh").unwrap();
         scene.set("particles_radial", 10.0).unwrap();
@@ -353,12 +354,13 @@ mod tests {
         }
         save(&path, &sim, &serde_json::json!({"note": "unit"})).unwrap();
         let bytes = std::fs::read(&path).unwrap();
-        (path, bytes)
+        (dir, bytes)
     }
 
     #[test]
     fn every_flipped_bit_of_the_frame_and_a_sample_of_the_body_is_named() {
-        let (path, bytes) = saved("flips");
+        let (dir, bytes) = saved("flips");
+        let path = dir.join("noh.ckpt");
         let (sim, host) = read(&path, &bytes).unwrap();
         assert_eq!(host["note"], "unit");
         assert_eq!(sim.steps(), 5);
@@ -386,7 +388,8 @@ mod tests {
 
     #[test]
     fn every_cut_is_truncated() {
-        let (path, bytes) = saved("cuts");
+        let (dir, bytes) = saved("cuts");
+        let path = dir.join("noh.ckpt");
         let n = bytes.len();
         for len in (MAGIC.len() + 1..n).step_by(97).chain(n - 50..n) {
             let e = read(&path, &bytes[..len]).unwrap_err();
@@ -397,7 +400,8 @@ mod tests {
 
     #[test]
     fn other_files_and_newer_formats_are_named() {
-        let (path, bytes) = saved("others");
+        let (dir, bytes) = saved("others");
+        let path = dir.join("noh.ckpt");
         let state = Simulation::builtin("noh").unwrap().serialize_state();
         assert_eq!(read(&path, &state).unwrap_err().name(), "NotACheckpoint");
         assert_eq!(read(&path, b"").unwrap_err().name(), "NotACheckpoint");

@@ -111,11 +111,8 @@ mod tests {
     use super::*;
     use std::os::unix::fs::FileTypeExt as _;
 
-    fn folder(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("mi-files-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn folder(name: &str) -> crate::test_dir::TestDir {
+        crate::test_dir::TestDir::new(&format!("files-{name}"))
     }
 
     #[test]

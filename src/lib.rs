@@ -102,6 +102,8 @@ mod sim;
 mod solver;
 mod state_format;
 #[cfg(test)]
+mod test_dir;
+#[cfg(test)]
 mod test_rng;
 
 pub use budget::{DEFAULT_MEMORY_BUDGET, MEMORY_BUDGET_VAR, MemoryPerNode, memory_budget};

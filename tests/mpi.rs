@@ -5,7 +5,6 @@
 //! the feature this file is empty.
 #![cfg(feature = "mpi")]
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
@@ -16,11 +15,9 @@ const PROGRAM: &str = env!("CARGO_BIN_EXE_meshless-impact");
 /// 13 s measured): a hang fails the test rather than the suite.
 const LIMIT: Duration = Duration::from_secs(240);
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mi-mpi-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+#[path = "../src/test_dir.rs"]
+mod test_dir;
+use test_dir::TestDir;
 
 /// `mpiexec` with `args`, one thread a rank (the ranks share two cores),
 /// killed past [`LIMIT`].
@@ -48,7 +45,8 @@ fn mpiexec(args: &[&str]) -> Output {
 
 /// The final JSON of `scene` with `sets` on `ranks` ranks.
 fn run(scene: &str, sets: &[&str], ranks: usize, tag: &str) -> serde_json::Value {
-    let json = dir().join(format!("{scene}-{ranks}-{tag}.json"));
+    let scratch = TestDir::new(&format!("mpi-{scene}-{ranks}-{tag}"));
+    let json = scratch.join("out.json");
     let n = ranks.to_string();
     let mut args = vec!["-n", &n, PROGRAM, "run", scene, "-q"];
     for s in sets {
@@ -155,7 +153,8 @@ fn shielding_cracks_give_the_same_bits_on_two_ranks() {
 /// printed once (by rank 0), and writes no outputs.
 #[test]
 fn a_failure_on_one_rank_stops_every_rank_with_its_error() {
-    let json = dir().join("failed.json");
+    let scratch = TestDir::new("mpi-failed");
+    let json = scratch.join("failed.json");
     let path = json.to_str().unwrap().to_string();
     let run = [
         PROGRAM,
@@ -195,8 +194,8 @@ fn a_failure_on_one_rank_stops_every_rank_with_its_error() {
 fn a_checkpoint_of_two_ranks_restarts_to_the_bits_of_one() {
     let sets = ["particles_radial=3", "symmetry=1", "end_time=8e-6"];
     let one = run("penetration", &sets, 1, "whole");
-    let checkpoint = dir().join("two.ckpt");
-    let _ = std::fs::remove_file(&checkpoint);
+    let scratch = TestDir::new("mpi-checkpoint");
+    let checkpoint = scratch.join("two.ckpt");
     let path = checkpoint.to_str().unwrap().to_string();
     let mut args = vec!["-n", "2", PROGRAM, "run", "penetration", "-q"];
     for s in &sets {
@@ -209,7 +208,7 @@ fn a_checkpoint_of_two_ranks_restarts_to_the_bits_of_one() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let json = dir().join("restarted.json");
+    let json = scratch.join("restarted.json");
     let restarted = json.to_str().unwrap().to_string();
     let out = mpiexec(&[
         "-n",
@@ -354,10 +353,10 @@ fn the_vtk_pieces_join_into_the_snapshot_of_one_rank() {
 
 /// [`the_vtk_pieces_join_into_the_snapshot_of_one_rank`] for `scene`.
 fn vtk_pieces_join(scene: &str, sets: &[&str], times: &str) {
+    let scratch = TestDir::new(&format!("mpi-vtk-{scene}"));
     let mut written = Vec::new();
     for ranks in [1, 2] {
-        let vtk = dir().join(format!("vtk-{scene}-{ranks}"));
-        let _ = std::fs::remove_dir_all(&vtk);
+        let vtk = scratch.join(format!("{ranks}"));
         let n = ranks.to_string();
         let path = vtk.to_str().unwrap().to_string();
         let mut args = vec!["-n", &n, PROGRAM, "run", scene, "-q"];
@@ -412,7 +411,8 @@ fn vtk_pieces_join(scene: &str, sets: &[&str], times: &str) {
 /// error, printed once; no rank waits for it.
 #[test]
 fn an_output_that_fails_on_one_rank_stops_every_rank() {
-    let good = dir().join("vtk-good");
+    let scratch = TestDir::new("mpi-vtk-good");
+    let good = scratch.join("vtk");
     let good = good.to_str().unwrap();
     let run = |vtk| {
         let set = ["--set", "particles_radial=3", "--vtk-dir", vtk];

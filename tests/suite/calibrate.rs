@@ -145,10 +145,9 @@ fn calibrate(dir: &Path, csv: &str, args: &[&str]) -> (bool, String, String) {
     )
 }
 
-fn scratch(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("mi-calibrate-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+/// A fresh, empty scratch folder for one test, removed when it passes.
+fn scratch(name: &str) -> crate::common::TestDir {
+    crate::common::scratch("calibrate", name)
 }
 
 /// The calibrated material (`material.toml`, `run --preset-file`)

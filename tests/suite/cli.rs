@@ -25,7 +25,7 @@ const SMALL_SWEEP: [&str; 6] = [
 ];
 
 /// A fresh, empty scratch directory for one test.
-fn scratch(test: &str) -> PathBuf {
+fn scratch(test: &str) -> common::TestDir {
     common::scratch("cli", test)
 }
 
@@ -74,8 +74,7 @@ fn out_of_range_value_names_parameter_value_and_range() {
 
 #[test]
 fn json_has_every_observable_and_run_facts() {
-    let dir = std::env::temp_dir().join(format!("mi-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("outputs");
     let common::CliOutputs { json, csv, vtk } = common::run_cli_with_outputs(
         &[
             "run",
@@ -270,7 +269,7 @@ fn output_paths_are_checked_before_the_run() {
     let vtk = dir.join("vtk");
     let cases: [(&str, PathBuf, &str); 5] = [
         ("--json", missing.join("out.json"), "does not exist"),
-        ("--json", dir.clone(), "is a directory"),
+        ("--json", dir.to_path_buf(), "is a directory"),
         ("--csv", a_file.join("hist.csv"), "is not a directory"),
         ("--vtk-dir", a_file.clone(), "cannot create the directory"),
         (

@@ -155,12 +155,14 @@ pub fn bin() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_meshless-impact"))
 }
 
-/// A fresh, empty scratch folder for one test of the file `file`.
-pub fn scratch(file: &str, test: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("mi-{file}-{}-{test}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+#[path = "../../src/test_dir.rs"]
+mod test_dir;
+pub(crate) use test_dir::TestDir;
+
+/// A fresh, empty scratch folder for one test of the file `file`, removed
+/// when the test passes.
+pub(crate) fn scratch(file: &str, test: &str) -> TestDir {
+    TestDir::new(&format!("{file}-{test}"))
 }
 
 /// A process's stderr as text.

@@ -143,8 +143,7 @@ const EXPECTED: &[(&str, &str)] = &[
 
 #[test]
 fn quick_report_regenerates_and_meets_its_claims() {
-    let dir = std::env::temp_dir().join(format!("mi-report-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = crate::common::scratch("report", "quick");
     crate::common::cli_stdout([
         std::ffi::OsStr::new("report"),
         "--quick".as_ref(),
