@@ -67,6 +67,12 @@ pub trait Ranks: Debug + Send + Sync {
 
     /// `bytes` of rank `root` on every rank (resized to its length).
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>);
+
+    /// Names the line of the program whose collective comes next (the
+    /// helpers below name their callers'), for the books an
+    /// implementation may keep of its collectives by line (the program's
+    /// `MI_MPI_STATS=2`). By default nothing.
+    fn at(&self, _line: &'static std::panic::Location<'static>) {}
 }
 
 /// [`Ranks::all_gather_in_place`] through a copy of this rank's bytes
@@ -183,6 +189,7 @@ fn assert_covers(parts: &[Range<usize>], len: usize) {
 /// After each rank has written its own part `parts[rank]` of `out`, every
 /// rank's parts gathered into `out` on every rank. `parts` are contiguous,
 /// in rank order, and cover `out`.
+#[track_caller]
 pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &mut [T]) {
     if ranks.size() == 1 {
         return;
@@ -191,12 +198,14 @@ pub fn gather_parts<T: Plain>(ranks: &dyn Ranks, parts: &[Range<usize>], out: &m
     assert_covers(parts, out.len());
     let size = std::mem::size_of::<T>();
     let counts: Vec<usize> = parts.iter().map(|p| p.len() * size).collect();
+    ranks.at(std::panic::Location::caller());
     ranks.all_gather_in_place(&counts, bytes_mut(out));
 }
 
 /// [`gather_parts`] for values that are not [`Plain`]: each rank's part
 /// travels as the postcard encoding of its values mapped by `to`, and is
 /// written back on the other ranks by `from`.
+#[track_caller]
 pub fn gather_encoded<T, W>(
     ranks: &dyn Ranks,
     parts: &[Range<usize>],
@@ -245,6 +254,7 @@ pub const RECORD_MAX: usize = 4096;
 ///
 /// If a value encodes into more than [`RECORD_MAX`] bytes (a fault of the
 /// program, not of its input: the types that travel are of fixed size).
+#[track_caller]
 pub fn gather_records<T, W>(
     ranks: &dyn Ranks,
     parts: &[Range<usize>],
@@ -273,6 +283,7 @@ pub fn gather_records<T, W>(
         })
         .max()
         .unwrap_or(0);
+    ranks.at(std::panic::Location::caller());
     let width = usize::try_from(ranks.all_max(longest as i64)).unwrap_or(0);
     if width == 0 {
         return;
@@ -285,6 +296,7 @@ pub fn gather_records<T, W>(
             postcard::to_slice(&to(v), slot).expect("a record fits its width");
         });
     let counts: Vec<usize> = parts.iter().map(|p| p.len() * width).collect();
+    ranks.at(std::panic::Location::caller());
     ranks.all_gather_in_place(&counts, &mut wire[..]);
     let wire: &[u8] = wire;
     out.par_iter_mut()
@@ -300,18 +312,21 @@ pub fn gather_records<T, W>(
 
 /// Every rank's `mine`, of any length, joined in rank order, with each
 /// rank's length (two exchanges).
+#[track_caller]
 pub fn all_gather_bytes(ranks: &dyn Ranks, mine: &[u8]) -> (Vec<u8>, Vec<usize>) {
     let counts: Vec<usize> = all_gather_one(ranks, mine.len() as u64)
         .into_iter()
         .map(|l| l as usize)
         .collect();
     let mut all = vec![0u8; counts.iter().sum()];
+    ranks.at(std::panic::Location::caller());
     ranks.all_gather(mine, &counts, &mut all);
     (all, counts)
 }
 
 /// The largest of every rank's `value` by [`f64::max`] in rank order (a
 /// NaN loses, as in a serial `fold` by `f64::max`).
+#[track_caller]
 pub fn all_max_f64(ranks: &dyn Ranks, value: f64) -> f64 {
     if ranks.size() == 1 {
         return value;
@@ -321,6 +336,7 @@ pub fn all_max_f64(ranks: &dyn Ranks, value: f64) -> f64 {
 
 /// `f(i, &mut out[i])` for the rows of this rank's share (on the pool),
 /// then the shares gathered so that every rank holds every row.
+#[track_caller]
 pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
     use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
     if ranks.size() == 1 {
@@ -334,6 +350,7 @@ pub fn each_row<T: Plain>(ranks: &dyn Ranks, out: &mut [T], f: impl Fn(usize, &m
 
 /// Every rank's `mine`, of any length, joined in rank order (two
 /// exchanges: the lengths, then the values in place).
+#[track_caller]
 pub fn all_gather_varying<T: Plain + Default>(ranks: &dyn Ranks, mine: &[T]) -> Vec<T> {
     if ranks.size() == 1 {
         return mine.to_vec();
@@ -354,6 +371,7 @@ pub fn all_gather_varying<T: Plain + Default>(ranks: &dyn Ranks, mine: &[T]) -> 
 /// order, covering `out`) in place of equal shares: `f(i, &mut out[i])`
 /// for the rows of this rank's part, then the parts gathered so that
 /// every rank holds every row.
+#[track_caller]
 pub fn each_row_in<T: Plain>(
     ranks: &dyn Ranks,
     parts: &[Range<usize>],
@@ -398,6 +416,7 @@ pub fn weighted_parts(weight: &[usize], parts: usize) -> Vec<Range<usize>> {
 }
 
 /// Every rank's `value`, in rank order (one exchange).
+#[track_caller]
 pub fn all_gather_one<T: Plain + Default>(ranks: &dyn Ranks, value: T) -> Vec<T> {
     let mut all = vec![T::default(); ranks.size()];
     all[ranks.rank()] = value;

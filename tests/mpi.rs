@@ -244,27 +244,66 @@ fn a_scene_on_one_rank_only_refuses_several() {
     );
 }
 
+/// `taylor3d` at 3 across to 1 µs on 2 ranks, with `mpiexec`'s `options`
+/// before the program and the run's `extra` arguments after it: its
+/// stderr, the run having succeeded.
+fn small_taylor3d_on_two(options: &[&str], extra: &[&str]) -> String {
+    let mut args = options.to_vec();
+    args.extend(["-n", "2", PROGRAM, "run", "taylor3d", "-q"]);
+    args.extend(["--set", "particles_radial=3", "--set", "end_time=1e-6"]);
+    args.extend(extra);
+    let out = mpiexec(&args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{err}");
+    err
+}
+
+/// With `MI_MPI_STATS=2` each rank books its collectives by the line of
+/// the program that called them: the lines add up to the rank's totals of
+/// calls and bytes, and the shared passes are named by their own lines
+/// (the material's gather, the nodal forces').
+#[test]
+fn the_collectives_are_booked_by_the_lines_that_called_them() {
+    let err = small_taylor3d_on_two(&["-genv", "MI_MPI_STATS", "2"], &[]);
+    let number = |w: &str| -> u64 { w.parse().unwrap_or_else(|_| panic!("{w}: {err}")) };
+    for rank in 0..2 {
+        let head = format!("mpi: rank {rank} of 2: ");
+        let total = err
+            .lines()
+            .find_map(|l| l.strip_prefix(&head))
+            .unwrap_or_else(|| panic!("no totals of rank {rank}: {err}"));
+        let words: Vec<&str> = total.split_whitespace().collect();
+        let (calls, bytes) = (number(words[0]), number(words[3]));
+        let mine = format!("mpi: rank {rank}: ");
+        let books: Vec<(&str, u64, u64)> = err
+            .lines()
+            .filter_map(|l| l.strip_prefix(&mine))
+            .map(|l| {
+                let (line, rest) = l.split_once(": ").expect(l);
+                let words: Vec<&str> = rest.split_whitespace().collect();
+                (line, number(words[0]), number(words[2]))
+            })
+            .collect();
+        assert_eq!(books.iter().map(|b| b.1).sum::<u64>(), calls, "{err}");
+        assert_eq!(books.iter().map(|b| b.2).sum::<u64>(), bytes, "{err}");
+        // (A rank may receive nothing at the material's gather: at 3
+        // across its points are one block, which one rank steps.)
+        for file in ["src/solver/mlpg3d/update.rs:", "src/approx/nodal.rs:"] {
+            assert!(
+                books.iter().any(|b| b.0.starts_with(file) && b.1 > 0),
+                "rank {rank}: no gather booked at {file}: {err}"
+            );
+        }
+    }
+}
+
 /// `--phases` on 2 ranks: rank 0 prints both ranks' tables, whole and in
 /// rank order (each rank printing its own interleaved them on the
 /// terminal: `phases of rank 0 of 2phases of rank 1 of 2:`), each adding
 /// up to its total as the one-rank table does.
 #[test]
 fn the_phases_of_every_rank_are_printed_whole_in_rank_order() {
-    let out = mpiexec(&[
-        "-n",
-        "2",
-        PROGRAM,
-        "run",
-        "taylor3d",
-        "-q",
-        "--phases",
-        "--set",
-        "particles_radial=3",
-        "--set",
-        "end_time=1e-6",
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
+    let err = small_taylor3d_on_two(&[], &["--phases"]);
     let lines: Vec<&str> = err.lines().collect();
     let heads: Vec<usize> = (0..lines.len())
         .filter(|&k| lines[k].starts_with("phases of rank"))

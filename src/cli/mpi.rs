@@ -10,6 +10,8 @@ use mpi::environment::Universe;
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives, Root};
+use std::panic::Location;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The bytes one rank sends in one round of [`Ranks::all_gather`]: MPI
@@ -34,8 +36,15 @@ pub(crate) struct MpiRanks {
     /// barrier for the slowest rank: the imbalance, apart from the transfer.
     spent: AtomicU64,
     waited: AtomicU64,
-    /// `MI_MPI_STATS=2`: a barrier before each collective.
+    /// `MI_MPI_STATS=2`: a barrier before each collective, and the books
+    /// by the line of the program that called it.
     split_wait: bool,
+    /// The line named for the next collective ([`Ranks::at`]; with
+    /// `MI_MPI_STATS=2` only).
+    line: Mutex<Option<&'static Location<'static>>>,
+    /// The collectives by line (`None`: a line not named), in the order
+    /// first met (with `MI_MPI_STATS=2` only).
+    books: Mutex<Vec<(Option<&'static Location<'static>>, Book)>>,
     /// The library is MPICH, whose `MPI_IN_PLACE` is `(void *) -1`
     /// (`mpi.h`): rsmpi has no in-place gather and its bindings no
     /// `MPI_IN_PLACE`, so the gathers in place use that value, and only
@@ -44,10 +53,44 @@ pub(crate) struct MpiRanks {
     _universe: Universe,
 }
 
+/// The collectives of one line of the program (`MI_MPI_STATS=2`).
+#[derive(Debug, Default, Clone, Copy)]
+struct Book {
+    calls: u64,
+    received: u64,
+    /// Seconds waiting at the barrier before them, and in them after it.
+    waited: f64,
+    transfer: f64,
+}
+
+/// `text` and a newline on stderr in one write: the ranks' lines reach
+/// `mpiexec`'s stderr whole (a line of under `PIPE_BUF` bytes written at
+/// once is not split), where `eprintln!` writes a line in pieces that
+/// another rank's can come between.
+fn line_out(text: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stderr().write_all(format!("{text}\n").as_bytes());
+}
+
 impl Drop for MpiRanks {
     fn drop(&mut self) {
+        if self.split_wait {
+            let mut books = self.books.lock().map(|b| b.clone()).unwrap_or_default();
+            books.sort_by(|a, b| {
+                (b.1.waited + b.1.transfer).total_cmp(&(a.1.waited + a.1.transfer))
+            });
+            for (line, b) in books {
+                let line = line.map_or("another line".to_string(), |l| {
+                    format!("{}:{}", l.file(), l.line())
+                });
+                line_out(&format!(
+                    "mpi: rank {}: {line}: {} calls, {} bytes received, {:.3} s waiting, {:.3} s in transfer",
+                    self.rank, b.calls, b.received, b.waited, b.transfer
+                ));
+            }
+        }
         if std::env::var_os("MI_MPI_STATS").is_some() {
-            eprintln!(
+            line_out(&format!(
                 "mpi: rank {} of {}: {} collective calls, {} bytes received, {:.3} s in them{}",
                 self.rank,
                 self.size,
@@ -62,7 +105,7 @@ impl Drop for MpiRanks {
                 } else {
                     String::new()
                 }
-            );
+            ));
         }
     }
 }
@@ -105,6 +148,8 @@ pub(crate) fn init() -> Result<MpiRanks, String> {
         spent: AtomicU64::new(0),
         waited: AtomicU64::new(0),
         split_wait: std::env::var("MI_MPI_STATS").is_ok_and(|v| v == "2"),
+        line: Mutex::new(None),
+        books: Mutex::new(Vec::new()),
         mpich,
         _universe: universe,
     })
@@ -114,7 +159,6 @@ impl MpiRanks {
     /// `value` reduced by `op` over every rank.
     fn reduce(&self, value: i64, op: SystemOperation) -> i64 {
         let _t = self.timed();
-        self.calls.fetch_add(1, Ordering::Relaxed);
         let mut out = 0i64;
         self.world.all_reduce_into(&value, &mut out, op);
         out
@@ -125,38 +169,93 @@ impl MpiRanks {
     /// that wait apart.
     fn timed(&self) -> Timed<'_> {
         let start = std::time::Instant::now();
+        let mut waited = 0;
+        let mut line = None;
         if self.split_wait {
+            line = self.line.lock().ok().and_then(|mut l| l.take());
             self.world.barrier();
-            self.waited
-                .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+            waited = start.elapsed().as_nanos() as u64;
+            self.waited.fetch_add(waited, Ordering::Relaxed);
         }
-        Timed { ranks: self, start }
+        Timed {
+            ranks: self,
+            start,
+            waited,
+            line,
+            calls: 1,
+            received: 0,
+        }
     }
 }
 
-/// The guard of [`MpiRanks::timed`].
+/// The guard of [`MpiRanks::timed`]: one collective call.
 struct Timed<'a> {
     ranks: &'a MpiRanks,
     start: std::time::Instant,
+    /// Nanoseconds at the barrier before it (`MI_MPI_STATS=2`).
+    waited: u64,
+    /// The line that called it (`MI_MPI_STATS=2`).
+    line: Option<&'static Location<'static>>,
+    /// MPI calls it makes, and the bytes this rank receives in them.
+    calls: u64,
+    received: u64,
+}
+
+impl Timed<'_> {
+    /// Books `bytes` received by this rank.
+    fn receive(&mut self, bytes: u64) {
+        self.received += bytes;
+        self.ranks.received.fetch_add(bytes, Ordering::Relaxed);
+    }
 }
 
 impl Drop for Timed<'_> {
     fn drop(&mut self) {
-        self.ranks
-            .spent
-            .fetch_add(self.start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        let spent = self.start.elapsed().as_nanos() as u64;
+        self.ranks.spent.fetch_add(spent, Ordering::Relaxed);
+        self.ranks.calls.fetch_add(self.calls, Ordering::Relaxed);
+        if !self.ranks.split_wait {
+            return;
+        }
+        let Ok(mut books) = self.ranks.books.lock() else {
+            return;
+        };
+        let same = |l: &Option<&Location>| match (l, self.line) {
+            (Some(a), Some(b)) => {
+                (a.file(), a.line(), a.column()) == (b.file(), b.line(), b.column())
+            }
+            (None, None) => true,
+            _ => false,
+        };
+        let at = match books.iter().position(|(l, _)| same(l)) {
+            Some(at) => at,
+            None => {
+                books.push((self.line, Book::default()));
+                books.len() - 1
+            }
+        };
+        let b = &mut books[at].1;
+        b.calls += self.calls;
+        b.received += self.received;
+        b.waited += self.waited as f64 * 1e-9;
+        b.transfer += spent.saturating_sub(self.waited) as f64 * 1e-9;
     }
 }
 
 impl Ranks for MpiRanks {
+    fn at(&self, line: &'static Location<'static>) {
+        if self.split_wait
+            && let Ok(mut l) = self.line.lock()
+        {
+            *l = Some(line);
+        }
+    }
     fn all_gather_in_place(&self, counts: &[usize], out: &mut [u8]) {
         if !self.mpich || out.len() > i32::MAX as usize {
             return meshless_impact::ranks::gather_through_copy(self, counts, out);
         }
-        let _t = self.timed();
-        self.calls.fetch_add(1, Ordering::Relaxed);
-        self.received
-            .fetch_add((out.len() - counts[self.rank]) as u64, Ordering::Relaxed);
+        let mut t = self.timed();
+        t.receive((out.len() - counts[self.rank]) as u64);
         let counts32: Vec<i32> = counts.iter().map(|&c| c as i32).collect();
         let displs: Vec<i32> = counts
             .iter()
@@ -198,10 +297,8 @@ impl Ranks for MpiRanks {
     }
     fn all_gather(&self, local: &[u8], counts: &[usize], out: &mut [u8]) {
         debug_assert_eq!(local.len(), counts[self.rank]);
-        let _t = self.timed();
-        self.calls.fetch_add(1, Ordering::Relaxed);
-        self.received
-            .fetch_add((out.len() - local.len()) as u64, Ordering::Relaxed);
+        let mut t = self.timed();
+        t.receive((out.len() - local.len()) as u64);
         let starts: Vec<usize> = counts
             .iter()
             .scan(0, |s, &c| {
@@ -259,14 +356,14 @@ impl Ranks for MpiRanks {
         self.reduce(value, SystemOperation::max())
     }
     fn broadcast(&self, root: usize, bytes: &mut Vec<u8>) {
-        let _t = self.timed();
+        let mut t = self.timed();
         let root = self.world.process_at_rank(root as i32);
         let mut len = bytes.len() as u64;
         root.broadcast_into(&mut len);
         bytes.resize(len as usize, 0);
         root.broadcast_into(&mut bytes[..]);
-        self.calls.fetch_add(2, Ordering::Relaxed);
-        self.received
-            .fetch_add(bytes.len() as u64, Ordering::Relaxed);
+        // Two calls: the length, then the bytes.
+        t.calls = 2;
+        t.receive(bytes.len() as u64);
     }
 }
