@@ -378,14 +378,7 @@ pub fn each_row_in<T: Plain>(
     out: &mut [T],
     f: impl Fn(usize, &mut T) + Sync,
 ) {
-    use rayon::iter::{IndexedParallelIterator, IntoParallelRefMutIterator, ParallelIterator};
-    assert_covers(parts, out.len());
-    let own = parts[ranks.rank()].clone();
-    let start = own.start;
-    out[own]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(k, v)| f(start + k, v));
+    each_own_row(ranks, parts, out, f);
     gather_parts(ranks, parts, out);
 }
 
