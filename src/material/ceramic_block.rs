@@ -176,7 +176,7 @@ const ALUMINA_SPECIFIC_HEAT: f64 = 880.0;
 /// the order of seed 004's Table 1, then the thermal constants and the
 /// initial temperature. Defaults: AD85 ([`RajendranGrove::ad85`]), 880
 /// J/(kg K), Taylor-Quinney 1, 293 K.
-pub const PLATE_CERAMIC: [ParamSpec; 28] = [
+pub const PLATE_CERAMIC: [ParamSpec; 29] = [
     levels_spec(
         "plate_ceramic",
         DEFAULT_CERAMIC,
@@ -352,6 +352,15 @@ pub const PLATE_CERAMIC: [ParamSpec; 28] = [
          a_t / s^2, s = (ln(1/U) / ln 2)^(1/m) from its index (0 = one flaw size everywhere)",
     ),
     row(
+        "plate_tensile_flaw_volume",
+        "m3",
+        AD85.tensile_flaw_volume,
+        Range::closed(0.0, 1.0),
+        "reference volume V0 of the tensile strength a_t stands for: with a scatter, each point \
+         draws its strength for its own volume V, s = ((V0 / V) ln(1/U) / ln 2)^(1/m), Weibull's \
+         volume effect (0 = none; needs plate_tensile_flaw_scatter > 0; the 3-D solver only)",
+    ),
+    row(
         "plate_shield_radius",
         "m",
         AD85.shield_radius,
@@ -434,6 +443,7 @@ fn build(v: impl Fn(&str) -> Result<f64>) -> Result<Material> {
         critical_damage: v("plate_critical_damage")?,
         tensile_flaw_size: v("plate_tensile_flaw_size")?,
         tensile_flaw_scatter: v("plate_tensile_flaw_scatter")?,
+        tensile_flaw_volume: v("plate_tensile_flaw_volume")?,
         shield_radius: v("plate_shield_radius")?,
     };
     Ok(Material::ceramic(
@@ -449,6 +459,11 @@ fn build(v: impl Fn(&str) -> Result<f64>) -> Result<Material> {
 /// `plate_porosity`; the slots of [`Material::ceramic`] that hold `beta1`
 /// and `C1` are checked as `bulk_modulus` and `yield_stress`).
 fn named(e: Error) -> Error {
+    if let Error::Inconsistent(text) = &e
+        && text.starts_with("tensile_flaw_volume")
+    {
+        return Error::Inconsistent(text.replace("tensile_flaw_", "plate_tensile_flaw_"));
+    }
     let Error::OutOfRange { name, value, range } = e else {
         return e;
     };
@@ -514,7 +529,7 @@ mod tests {
     /// level sets the same three knobs.
     #[test]
     fn defaults_are_the_seed_ad85_with_the_default_levels_knobs() {
-        let table1: [(&str, f64); 28] = [
+        let table1: [(&str, f64); 29] = [
             ("plate_ceramic", 3.0),
             ("plate_density", 3.42e3),
             ("plate_shear_modulus", 88.0e9),
@@ -539,6 +554,7 @@ mod tests {
             ("plate_critical_damage", 0.75),
             ("plate_tensile_flaw_size", 188e-6),
             ("plate_tensile_flaw_scatter", 0.0),
+            ("plate_tensile_flaw_volume", 0.0),
             ("plate_shield_radius", 0.0),
             ("plate_specific_heat", 880.0),
             ("plate_taylor_quinney", 1.0),
@@ -653,6 +669,16 @@ mod tests {
                             || name.starts_with("initial crack density");
                         assert!(joined && name.contains(s.name), "{} = {x}: {name}", s.name);
                     }
+                    // A volume needs a scatter, which is 0 by default.
+                    Err(Error::Inconsistent(text)) if s.name == "plate_tensile_flaw_volume" => {
+                        assert!(
+                            text.starts_with("plate_tensile_flaw_volume = 1 m3")
+                                && text.contains("plate_tensile_flaw_scatter is 0"),
+                            "{text}"
+                        );
+                        let both = [(s.name, x), ("plate_tensile_flaw_scatter", 10.0)];
+                        material(&both).unwrap().validate().unwrap();
+                    }
                     Err(e) => panic!("{} = {x}: {e}", s.name),
                 }
             }
@@ -738,7 +764,7 @@ mod tests {
         const CHOICE: MaterialChoice = MaterialChoice::BILINEAR_LINEAR;
         const N: usize = BEFORE.len() + block_len(CHOICE) + PLATE_CERAMIC.len();
         const TABLE: [ParamSpec; N] = compose::<N>(&BEFORE, CHOICE, &PLATE_CERAMIC);
-        assert_eq!(N, 1 + 8 + 28);
+        assert_eq!(N, 1 + 8 + 29);
         assert_eq!(TABLE[0].name, "impact_speed");
         assert_eq!(TABLE[1].name, "density");
         assert_eq!(&TABLE[9..], &PLATE_CERAMIC[..]);

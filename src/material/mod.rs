@@ -352,15 +352,17 @@ impl Material {
 
     /// Gives a point of a ceramic whose tensile flaws scatter
     /// ([`RajendranGrove::tensile_flaw_scatter`]) its own flaw before its
-    /// first step, drawn from `key` (its node or cell index); any other
-    /// point is left as it is.
-    pub(crate) fn seed_point(&self, key: u64, state: &mut PointState) {
+    /// first step, drawn from `key` (its node or cell index) for its
+    /// `volume` where the solver knows it
+    /// ([`RajendranGrove::tensile_flaw_volume`]); any other point is left as
+    /// it is.
+    pub(crate) fn seed_point(&self, key: u64, volume: Option<f64>, state: &mut PointState) {
         if let Damage::RajendranGrove(c) = &self.damage
             && c.tensile_flaw_scatter > 0.0
             && state.ceramic().is_none()
         {
             let mut vars = c.initial_point().vars();
-            vars.tensile_flaw = c.tensile_flaw_of(key);
+            vars.tensile_flaw = c.tensile_flaw_of(key, volume);
             state.vars = Vars::Ceramic(vars);
         }
     }

@@ -154,6 +154,24 @@ fn bad_input_named() {
     }
 }
 
+/// A volume for the tensile flaws' scatter is refused by name in
+/// `plate_impact`: its cells are slabs of the target's whole face, with no
+/// volume of their own to draw a strength for.
+#[test]
+fn a_volume_for_the_flaws_is_refused_by_name() {
+    let mut scene = meshless_impact::Scene::builtin("plate_impact").unwrap();
+    scene.set("plate_tensile_flaw_scatter", 10.0).unwrap();
+    scene.set("plate_tensile_flaw_volume", 1e-6).unwrap();
+    match meshless_impact::Simulation::new(scene) {
+        Err(meshless_impact::Error::OutOfRange { name, value, range }) => {
+            assert_eq!(name, "plate_tensile_flaw_volume");
+            assert_eq!(value, 1e-6);
+            assert!(range.starts_with("0 in plate_impact"), "{range}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+}
+
 /// The scene `plate_impact` with `sets`, run to its end.
 fn scene_run(sets: &[(&str, f64)]) -> meshless_impact::Simulation {
     let mut scene = meshless_impact::Scene::builtin("plate_impact").unwrap();

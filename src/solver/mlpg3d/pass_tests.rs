@@ -677,3 +677,70 @@ fn a_contact_pass_stops_an_approaching_pair() {
         "the pass booked {dissipation:e} J, not {lost:e} J"
     );
 }
+
+/// The material pass gives each node of a ceramic whose tensile flaws
+/// scatter for a volume its own flaw, drawn for its index and its volume
+/// `m / rho` before its first step
+/// ([`crate::material::rajendran_grove::RajendranGrove::tensile_flaw_of`]),
+/// bit for bit; nodes of unequal volumes draw unequal strengths from the
+/// same uniform number (a node of half the volume is `2^(1/m)` times
+/// stronger for the same draw).
+#[test]
+fn the_material_pass_draws_each_flaw_for_its_nodes_volume() {
+    use crate::material::rajendran_grove::RajendranGrove;
+    let c = RajendranGrove {
+        tensile_flaw_size: 188e-6,
+        tensile_flaw_scatter: 10.0,
+        tensile_flaw_volume: 1e-6,
+        ..RajendranGrove::ad85()
+    };
+    let material = Material::ceramic(c, 880.0, 1.0, 293.0);
+    let n = 8;
+    let rho = vec![c.density; n];
+    let mass: Vec<f64> = (0..n)
+        .map(|i| c.density * H * H * H * (1.0 + i as f64))
+        .collect();
+    let mut states = vec![PointState::default(); n];
+    let mut results = vec![Ok(Tally::default()); n];
+    let (mut dev, mut pressure, mut eps_p) = (vec![[0.0; 6]; n], vec![0.0; n], vec![0.0; n]);
+    let (mut temp, mut rho1, mut visc) = (vec![293.0; n], rho.clone(), vec![[0.0; 6]; n]);
+    update_material(
+        (&crate::ranks::Alone, &mut Default::default()),
+        &MaterialInputs {
+            dt: DT,
+            damping_time: 0.0,
+            rod: &material,
+            others: &[],
+            group: &[],
+            mass: &mass,
+            vel: &vec![[0.0; 3]; n],
+            grad: &vec![[[0.0; 3]; 3]; n],
+            shielding: None,
+        },
+        MaterialFields {
+            dev: &mut dev,
+            pressure: &mut pressure,
+            eps_p: &mut eps_p,
+            temp: &mut temp,
+            rho: &mut rho1,
+            visc: &mut visc,
+            states: &mut states,
+        },
+        &mut results,
+    );
+    for (i, s) in states.iter().enumerate() {
+        let got = s
+            .ceramic()
+            .expect("a ceramic point after a step")
+            .tensile_flaw;
+        let want = c.tensile_flaw_of(i as u64, Some(mass[i] / rho[i]));
+        assert_eq!(got.to_bits(), want.to_bits(), "node {i}");
+        // The same draw for the reference volume: the node's volume V
+        // = (1 + i) H^3 makes it (V0 / V)^(1/m) stronger, a_t smaller by
+        // the square of that.
+        let at_v0 = c.tensile_flaw_of(i as u64, None);
+        let ratio = (at_v0 / got).sqrt();
+        let expected = (1e-6 / (H * H * H * (1.0 + i as f64))).powf(0.1);
+        assert!((ratio / expected - 1.0).abs() < 1e-12, "{ratio} {expected}");
+    }
+}

@@ -238,7 +238,7 @@ fn update_rows(
                         plastic_strain: *eps,
                         temperature: *temp,
                     };
-                    material.seed_point(i as u64, state);
+                    material.seed_point(i as u64, Some(mass[i] / *rho), state);
                     // The state before the step, kept only where cracks shield.
                     let saved = shielding.map(|_| *state);
                     let mut shield = Shield::NONE;
