@@ -349,7 +349,8 @@ pub const PLATE_CERAMIC: [ParamSpec; 29] = [
         AD85.tensile_flaw_scatter,
         Range::closed(0.0, 100.0),
         "Weibull modulus m of the points' tensile strengths: each point draws its own tensile flaw \
-         a_t / s^2, s = (ln(1/U) / ln 2)^(1/m) from its index (0 = one flaw size everywhere)",
+         a_t / s^2, s = (ln(1/U) / ln 2)^(1/m) from its index (0 = one flaw size everywhere; \
+         else at least 1)",
     ),
     row(
         "plate_tensile_flaw_volume",
@@ -693,6 +694,16 @@ mod tests {
     /// check joining constants are refused naming the parameters.
     #[test]
     fn bad_values_are_refused_by_name() {
+        // A Weibull modulus in (0, 1): in the table's range, refused by the
+        // model with its name.
+        match material(&[("plate_tensile_flaw_scatter", 0.5)]) {
+            Err(Error::OutOfRange { name, value, range }) => {
+                assert_eq!(name, "plate_tensile_flaw_scatter");
+                assert_eq!(value, 0.5);
+                assert_eq!(range, "0 (none) or [1, 100]");
+            }
+            other => panic!("{other:?}"),
+        }
         match material(&[("plate_porosity", 1.5)]) {
             Err(Error::OutOfRange { name, value, range }) => {
                 assert_eq!(name, "plate_porosity");

@@ -243,6 +243,15 @@ impl RajendranGrove {
             self.tensile_flaw_scatter,
             Range::closed(0.0, 100.0),
         )?;
+        if self.tensile_flaw_scatter > 0.0 && self.tensile_flaw_scatter < 1.0 {
+            // Below 1 the draws reach flaws of infinite size (a strength of
+            // 0 in floating point).
+            return Err(Error::OutOfRange {
+                name: "tensile_flaw_scatter".to_string(),
+                value: self.tensile_flaw_scatter,
+                range: "0 (none) or [1, 100]".to_string(),
+            });
+        }
         check(
             "tensile_flaw_volume",
             self.tensile_flaw_volume,
@@ -324,6 +333,13 @@ impl RajendranGrove {
     /// The crack density `gamma = N0 a^3` of cracks of radius `a`.
     pub fn crack_density(&self, a: f64) -> f64 {
         self.flaw_density * a * a * a
+    }
+
+    /// The crack density a tensile plane with a crack of radius `a` reads:
+    /// `N0 a^3`, at most the critical density `critical_damage` at which it
+    /// splits.
+    pub fn plane_density(&self, a: f64) -> f64 {
+        self.crack_density(a).min(self.critical_damage)
     }
 
     /// The matrix compression `eta` (eq. 18) at density `rho` and porosity
@@ -744,12 +760,15 @@ pub struct CeramicVars {
 impl CeramicVars {
     /// The point's crack density: its isotropic cracks' `N0 a^3`, or the
     /// largest of its tensile planes' `N0 a_k^3` where that is larger (the
-    /// crack density the damage observables and fields read).
+    /// crack density the damage observables and fields read). A plane reads
+    /// at most the critical density, at which it splits: a flaw drawn
+    /// larger than the split size (the weak tail of a scatter) is a plane
+    /// split from its start, not a denser one.
     pub fn crack_density(&self, m: &RajendranGrove) -> f64 {
         let planes = self.tensile.map_or(0.0, |c| {
             c.size
                 .iter()
-                .fold(0.0, |g, &a| f64::max(g, m.crack_density(a)))
+                .fold(0.0, |g, &a| f64::max(g, m.plane_density(a)))
         });
         m.crack_density(self.crack_size).max(planes)
     }
@@ -783,7 +802,7 @@ impl CeramicVars {
                     let cos = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
                     cos * cos > 0.5
                 })
-                .fold(0.0, |g, k| f64::max(g, m.crack_density(c.size[k])))
+                .fold(0.0, |g, k| f64::max(g, m.plane_density(c.size[k])))
         });
         m.crack_density(self.crack_size).max(planes)
     }
@@ -1696,6 +1715,44 @@ mod scatter_tests {
             ..RajendranGrove::ad85()
         };
         assert!((0..100).all(|k| c.tensile_flaw_of(k, Some(1e-9)) == 188e-6));
+    }
+
+    /// A modulus below 1 is refused by name (its draws reach flaws of
+    /// infinite size); 1 and 100 are accepted. A plane whose crack is larger
+    /// than the split size (a flaw from the weak tail of a scatter) reads
+    /// the critical density, not more: with m = 1 a draw of `U` near 1 gives
+    /// a flaw of 10^31 a_t, whose `N0 a^3` would be some 10^84.
+    #[test]
+    fn a_modulus_below_one_is_refused_and_a_plane_reads_at_most_the_critical_density() {
+        let c = |m: f64| RajendranGrove {
+            tensile_flaw_size: 188e-6,
+            tensile_flaw_scatter: m,
+            ..RajendranGrove::ad85()
+        };
+        for m in [0.01, 0.5, 0.999] {
+            match c(m).validate() {
+                Err(Error::OutOfRange { name, value, range }) => {
+                    assert_eq!(name, "tensile_flaw_scatter");
+                    assert_eq!(value, m);
+                    assert_eq!(range, "0 (none) or [1, 100]");
+                }
+                other => panic!("{m}: {other:?}"),
+            }
+        }
+        for m in [0.0, 1.0, 100.0] {
+            c(m).validate().unwrap();
+        }
+        let m = c(1.0);
+        let split = m.crack_planes().unwrap().split_size();
+        assert_eq!(m.plane_density(split), m.crack_density(split));
+        assert_eq!(m.plane_density(0.5 * split), m.crack_density(0.5 * split));
+        assert_eq!(m.plane_density(1e-3), m.critical_damage);
+        assert!(m.crack_density(1e-3) > 10.0 * m.critical_damage);
+        let huge = m
+            .tensile_flaw_of(u64::MAX, None)
+            .max(m.tensile_flaw_of(1, None));
+        assert!(huge.is_finite());
+        assert!(m.plane_density(huge) <= m.critical_damage);
     }
 
     /// Weibull's volume effect is the weakest link: points of a tenth of the

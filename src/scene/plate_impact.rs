@@ -182,12 +182,21 @@ fn layer(level: f64, s: &Scene) -> Result<Layer> {
         let material = ceramic_material(|name| s.get(name))?;
         return match material.damage {
             // A cell of the uniaxial target is a slab of the whole face: it has
-            // no volume of its own to draw a strength for.
+            // no volume of its own to draw a strength for, and one weak draw
+            // would be a weak plane across the whole target.
             Damage::RajendranGrove(c) if c.tensile_flaw_volume > 0.0 => Err(Error::OutOfRange {
                 name: "plate_tensile_flaw_volume".to_string(),
                 value: c.tensile_flaw_volume,
                 range: "0 in plate_impact (its cells are slabs of the target's whole face, \
                         with no volume of their own; the volume effect is the 3-D scenes')"
+                    .to_string(),
+            }),
+            Damage::RajendranGrove(c) if c.tensile_flaw_scatter > 0.0 => Err(Error::OutOfRange {
+                name: "plate_tensile_flaw_scatter".to_string(),
+                value: c.tensile_flaw_scatter,
+                range: "0 in plate_impact (its cells are slabs of the target's whole face: \
+                        a point's draw would make one weak plane across the target; the \
+                        scatter is the 3-D scenes')"
                     .to_string(),
             }),
             Damage::RajendranGrove(c) => Ok(Layer::Ceramic(c)),

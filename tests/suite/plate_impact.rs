@@ -154,19 +154,61 @@ fn bad_input_named() {
     }
 }
 
-/// A volume for the tensile flaws' scatter is refused by name in
-/// `plate_impact`: its cells are slabs of the target's whole face, with no
-/// volume of their own to draw a strength for.
+/// A scatter of the tensile flaws, and a volume for it, are refused by
+/// name in `plate_impact`: its cells are slabs of the target's whole face,
+/// with no volume of their own to draw a strength for (before 2026-12-01
+/// the scatter was taken and silently not drawn: the cells started with
+/// the constants' flaw).
 #[test]
-fn a_volume_for_the_flaws_is_refused_by_name() {
-    let mut scene = meshless_impact::Scene::builtin("plate_impact").unwrap();
-    scene.set("plate_tensile_flaw_scatter", 10.0).unwrap();
-    scene.set("plate_tensile_flaw_volume", 1e-6).unwrap();
-    match meshless_impact::Simulation::new(scene) {
-        Err(meshless_impact::Error::OutOfRange { name, value, range }) => {
-            assert_eq!(name, "plate_tensile_flaw_volume");
-            assert_eq!(value, 1e-6);
-            assert!(range.starts_with("0 in plate_impact"), "{range}");
+fn a_scatter_or_a_volume_for_the_flaws_is_refused_by_name() {
+    for (sets, name, value) in [
+        (
+            &[("plate_tensile_flaw_scatter", 10.0)][..],
+            "plate_tensile_flaw_scatter",
+            10.0,
+        ),
+        (
+            &[
+                ("plate_tensile_flaw_scatter", 10.0),
+                ("plate_tensile_flaw_volume", 1e-6),
+            ][..],
+            "plate_tensile_flaw_volume",
+            1e-6,
+        ),
+    ] {
+        let mut scene = meshless_impact::Scene::builtin("plate_impact").unwrap();
+        for (n, v) in sets {
+            scene.set(n, *v).unwrap();
+        }
+        match meshless_impact::Simulation::new(scene) {
+            Err(meshless_impact::Error::OutOfRange {
+                name: n,
+                value: v,
+                range,
+            }) => {
+                assert_eq!(n, name);
+                assert_eq!(v, value);
+                assert!(range.starts_with("0 in plate_impact"), "{range}");
+            }
+            other => panic!("{name}: {:?}", other.map(|_| ())),
+        }
+    }
+    // The same through the library's layers.
+    let c = RajendranGrove {
+        tensile_flaw_size: 188e-6,
+        tensile_flaw_scatter: 10.0,
+        ..RajendranGrove::ad85()
+    };
+    match PlateImpact::new(
+        Layer::Ceramic(c),
+        2e-3,
+        Layer::Ceramic(c),
+        4e-3,
+        200.0,
+        1e-5,
+    ) {
+        Err(meshless_impact::Error::OutOfRange { name, .. }) => {
+            assert_eq!(name, "tensile_flaw_scatter")
         }
         other => panic!("{:?}", other.map(|_| ())),
     }

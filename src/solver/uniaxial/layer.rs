@@ -34,6 +34,13 @@ impl Layer {
 
     pub(super) fn validate(&self) -> Result<()> {
         match self {
+            // A cell is a slab of the whole face: no point of its own to draw
+            // a flaw for (the scene `plate_impact` names these `plate_`).
+            Layer::Ceramic(c) if c.tensile_flaw_scatter > 0.0 => Err(Error::OutOfRange {
+                name: "tensile_flaw_scatter".to_string(),
+                value: c.tensile_flaw_scatter,
+                range: "0 in a uniaxial layer (its cells are slabs of the whole face)".to_string(),
+            }),
             Layer::Ceramic(c) => c.validate(),
             Layer::Solid(m) => m.validate(),
             Layer::Jh2(j) => j.constants().validate(),

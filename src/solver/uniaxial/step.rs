@@ -121,7 +121,6 @@ impl PlateImpact {
             } else {
                 let (old, mut point_state) = self.state.cells[c].point();
                 let material_k = materials[k].expect("a ceramic or a metal has a material");
-                material_k.seed_point(c as u64, None, &mut point_state);
                 let new = match layer {
                     // The ceramic's porous pressure takes the cell's specific
                     // internal energy.
