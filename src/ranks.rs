@@ -367,6 +367,51 @@ pub fn all_gather_varying<T: Plain + Default>(ranks: &dyn Ranks, mine: &[T]) -> 
     all
 }
 
+/// After each rank has written its listed rows `lists[rank]` (ascending;
+/// no row in two lists), every rank's listed rows on every rank: each rank
+/// packs its rows by `get`, the rows travel packed in rank order through
+/// `wire` (kept by the caller from one call to the next, so that a call
+/// allocates nothing once it has grown), and `put` writes each other
+/// rank's rows; a row in no list is left as it was. The halo of a pass
+/// whose readers read only some rows of the other ranks (the material
+/// fields of the 3-D solver: `solver::mlpg3d::halo`). `get` and `put`
+/// read and write the rows of `fields`.
+#[track_caller]
+pub fn gather_listed<T: Plain + Default, F: ?Sized>(
+    ranks: &dyn Ranks,
+    lists: &[Vec<usize>],
+    wire: &mut Vec<T>,
+    fields: &mut F,
+    (get, put): (impl Fn(&F, usize) -> T, impl Fn(&mut F, usize, &T)),
+) {
+    if ranks.size() == 1 {
+        return;
+    }
+    let me = ranks.rank();
+    let mut at = Vec::with_capacity(lists.len() + 1);
+    at.push(0);
+    for l in lists {
+        at.push(at[at.len() - 1] + l.len());
+    }
+    wire.clear();
+    wire.resize(at[lists.len()], T::default());
+    for (w, &i) in wire[at[me]..at[me + 1]].iter_mut().zip(&lists[me]) {
+        *w = get(fields, i);
+    }
+    let size = std::mem::size_of::<T>();
+    let counts: Vec<usize> = lists.iter().map(|l| l.len() * size).collect();
+    ranks.at(std::panic::Location::caller());
+    ranks.all_gather_in_place(&counts, bytes_mut(wire));
+    for (r, list) in lists.iter().enumerate() {
+        if r == me {
+            continue;
+        }
+        for (w, &i) in wire[at[r]..at[r + 1]].iter().zip(list) {
+            put(fields, i, w);
+        }
+    }
+}
+
 /// [`each_row`] over the given `parts` of the rows (contiguous, in rank
 /// order, covering `out`) in place of equal shares: `f(i, &mut out[i])`
 /// for the rows of this rank's part, then the parts gathered so that
@@ -494,6 +539,29 @@ pub(crate) mod tests {
         }
     }
 
+    /// [`on_threads`] with each rank as a [`Handle`] (what a solver's
+    /// `set_ranks` takes).
+    pub(crate) fn on_thread_handles<R: Send>(
+        size: usize,
+        f: impl Fn(Handle) -> R + Sync,
+    ) -> Vec<R> {
+        let slots = Arc::new((Mutex::new(vec![Vec::new(); size]), Barrier::new(size)));
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (0..size)
+                .map(|rank| {
+                    let ranks = Handle::new(Arc::new(Threads {
+                        rank,
+                        size,
+                        slots: slots.clone(),
+                    }));
+                    let f = &f;
+                    s.spawn(move || f(ranks))
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        })
+    }
+
     /// `f` on `size` ranks, each a thread; their results in rank order.
     pub(crate) fn on_threads<R: Send>(size: usize, f: impl Fn(&dyn Ranks) -> R + Sync) -> Vec<R> {
         let slots = Arc::new((Mutex::new(vec![Vec::new(); size]), Barrier::new(size)));
@@ -560,6 +628,52 @@ pub(crate) mod tests {
             for (out, top, low) in got {
                 assert!(out.iter().enumerate().all(|(i, v)| *v == (i * i) as f64));
                 assert_eq!((top, low), (size as i64 - 1, -5));
+            }
+        }
+    }
+
+    /// A gather of listed rows writes every rank's listed rows on every
+    /// rank, and leaves each row in no list as the rank had it (on 2-4
+    /// ranks as threads, some lists empty; a second call reuses the wire).
+    #[test]
+    fn listed_rows_travel_and_the_rest_stay() {
+        for size in [2, 3, 4] {
+            // Rank r lists the rows i with i % 7 == r (none for r >= 7).
+            let lists: Vec<Vec<usize>> = (0..size)
+                .map(|r| (0..50).filter(|i| i % 7 == r && r != 1).collect())
+                .collect();
+            let got = on_threads(size, |ranks| {
+                let me = ranks.rank();
+                // Each rank's own rows hold the true value; the others a
+                // mark of the rank.
+                let mut out: Vec<[f64; 2]> = (0..50)
+                    .map(|i| {
+                        if lists[me].contains(&i) {
+                            [i as f64, 1.0]
+                        } else {
+                            [-(me as f64), 0.0]
+                        }
+                    })
+                    .collect();
+                let mut wire = Vec::new();
+                let get = |o: &Vec<[f64; 2]>, i: usize| o[i];
+                let put = |o: &mut Vec<[f64; 2]>, i: usize, v: &[f64; 2]| o[i] = *v;
+                gather_listed(ranks, &lists, &mut wire, &mut out, (get, put));
+                let grown = wire.capacity();
+                gather_listed(ranks, &lists, &mut wire, &mut out, (get, put));
+                (me, out, grown == wire.capacity())
+            });
+            for (me, out, kept) in got {
+                assert!(kept);
+                for (i, v) in out.iter().enumerate() {
+                    let listed = lists.iter().any(|l| l.contains(&i));
+                    let want = if listed {
+                        [i as f64, 1.0]
+                    } else {
+                        [-(me as f64), 0.0]
+                    };
+                    assert_eq!(*v, want, "rank {me} of {size}, row {i}");
+                }
             }
         }
     }

@@ -159,6 +159,8 @@ pub(super) fn build_geometry(
     let stamp = |e: Error| at_time(e, time);
     let mut watch = pipe.profile.stopwatch();
     let mut g = pipe.geometry.take().unwrap_or_default();
+    // New supports, rows and columns: new lists of what each rank reads.
+    pipe.halo.forget();
     // The old traction operator goes before the new is built; the
     // shapes and the nodal operator are rebuilt in their own buffers.
     // They are most of the heap (BENCHMARKS.md, memory).

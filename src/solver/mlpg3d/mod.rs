@@ -78,6 +78,7 @@ mod balance;
 pub mod contact;
 pub mod failure;
 mod geometry;
+mod halo;
 mod motion;
 mod observe;
 #[cfg(test)]
@@ -321,6 +322,9 @@ struct Pipeline3d {
     ranks: crate::ranks::Handle,
     /// The material pass's shares among the ranks, by measured cost.
     balance: balance::Balance,
+    /// What each rank sends of the material fields after the pass, and
+    /// whether they are apart ([`halo`]).
+    halo: halo::Halo,
 }
 
 /// The run's state is all it saves.

@@ -138,6 +138,7 @@ impl Mlpg3d {
     /// the same bits on any number of ranks.
     pub fn set_ranks(&mut self, ranks: crate::ranks::Handle) {
         self.pipe.ranks = ranks;
+        self.pipe.halo.forget();
         // The nodal operator built before holds the columns of the ranks
         // it was built for; each rank now holds its share of them.
         if let Some(g) = self.pipe.geometry.as_mut() {
@@ -349,6 +350,21 @@ impl Mlpg3d {
     pub fn share(&mut self) {
         let (ranks, wire) = (&*self.pipe.ranks, &mut self.pipe.balance.wire);
         self.state.material_state.share(ranks, wire);
+        // So are the material fields, which each rank holds between steps
+        // only where it reads them ([`super::halo`]).
+        let n = self.state.pos.len();
+        let parts = self.pipe.balance.parts(ranks, n).to_vec();
+        self.pipe.halo.make_whole(
+            ranks,
+            &parts,
+            super::halo::HaloFields {
+                dev: &mut self.state.dev,
+                visc: &mut self.state.visc,
+                pressure: &mut self.state.pressure,
+                eps_p: &mut self.state.eps_p,
+                temp: &mut self.state.temp,
+            },
+        );
     }
 
     /// The contact reach between the bodies (m; [`contact`]).

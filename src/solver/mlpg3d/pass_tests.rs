@@ -160,7 +160,7 @@ fn material_pass(
     };
     let mut states = vec![PointState::default(); n];
     update_material(
-        (&crate::ranks::Alone, &mut Default::default()),
+        (&crate::ranks::Alone, &mut Default::default(), true),
         &MaterialInputs {
             dt: DT,
             damping_time,
@@ -705,7 +705,7 @@ fn the_material_pass_draws_each_flaw_for_its_nodes_volume() {
     let (mut dev, mut pressure, mut eps_p) = (vec![[0.0; 6]; n], vec![0.0; n], vec![0.0; n]);
     let (mut temp, mut rho1, mut visc) = (vec![293.0; n], rho.clone(), vec![[0.0; 6]; n]);
     update_material(
-        (&crate::ranks::Alone, &mut Default::default()),
+        (&crate::ranks::Alone, &mut Default::default(), true),
         &MaterialInputs {
             dt: DT,
             damping_time: 0.0,

@@ -35,6 +35,9 @@ impl Mlpg3d {
     ) -> std::result::Result<(), String> {
         self.state = crate::solver::shared::read_state(saved, SETUP_KEYS)?;
         self.pipe.geometry = None;
+        // Every rank reads the same state: whole on each.
+        self.pipe.halo.whole();
+        self.pipe.halo.forget();
         Ok(())
     }
 

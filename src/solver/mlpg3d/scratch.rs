@@ -72,6 +72,8 @@ pub(super) struct ShiftBuffers {
     /// The carried fields ([`CARRIED`]) before and after the carry.
     pub(super) carried: Vec<[f64; CARRIED]>,
     pub(super) carried_out: Vec<[f64; CARRIED]>,
+    /// The shifted nodes' carried fields as they travel among the ranks.
+    pub(super) wire: Vec<[f64; CARRIED]>,
     /// The change of each node's momentum in the conservative carry
     /// (images after the real nodes).
     pub(super) momentum: Vec<[f64; 3]>,

@@ -120,7 +120,8 @@ pub fn shifts_on(
     });
 }
 
-/// [`carry_on`] on one rank alone (the tests' form).
+/// [`carry_shifted_on`] on one rank alone, at every node (the tests'
+/// form: a node without a shift keeps `f_i`).
 #[cfg(test)]
 pub fn carry<const K: usize>(
     shapes: &NodalShapes,
@@ -128,69 +129,94 @@ pub fn carry<const K: usize>(
     d: &[[f64; 3]],
     out: &mut [[f64; K]],
 ) {
-    carry_on(
-        (&crate::ranks::Alone, std::slice::from_ref(&(0..out.len()))),
-        shapes,
-        f,
-        d,
-        out,
-    );
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = carried_at(shapes, f, d, i);
+    }
 }
 
-/// `f_i + d_i · ∇f_i` for the nodes with a shift `d_i` (the others keep
-/// `f_i`), written into `out`: `∇f_i = Σ_J ∇φ_J(x_i) f_J` over row `i` of
-/// `shapes` (the collocated MLS gradient of eq. 4, exact for linear
-/// fields), each of the `K` components limited to the range of its values
-/// over the node and the nodes of its row. Without the limit an
-/// ill-conditioned gradient (a node with its neighbours all to one side)
-/// extrapolates without bound, and shifting repeats it step after step
-/// (the axisymmetric solver measured 1060 plastic strain at one particle of
-/// test 7 at 600 m/s; README, "Particle shifting"). Nodes in parallel, from
-/// `f` before any moves. Shared among `ranks`: each computes its part of
-/// the nodes (`parts`, as [`shifts_on`]'s), then every rank holds them all
-/// (the same bits).
-pub fn carry_on<const K: usize>(
+/// `f_i + d_i · ∇f_i` for the nodes with a shift `d_i`, written into
+/// `out`: `∇f_i = Σ_J ∇φ_J(x_i) f_J` over row `i` of `shapes` (the
+/// collocated MLS gradient of eq. 4, exact for linear fields), each of the
+/// `K` components limited to the range of its values over the node and the
+/// nodes of its row. Without the limit an ill-conditioned gradient (a node
+/// with its neighbours all to one side) extrapolates without bound, and
+/// shifting repeats it step after step (the axisymmetric solver measured
+/// 1060 plastic strain at one particle of test 7 at 600 m/s; README,
+/// "Particle shifting"). Nodes in parallel, from `f` before any moves.
+///
+/// Only the shifted nodes (`d_i` not zero), the only rows a shift's
+/// unpacking reads: each rank computes the shifted nodes of its part of
+/// `parts` (as [`shifts_on`]'s), and only their rows travel among the
+/// ranks ([`crate::ranks::gather_listed`], through `wire`, kept by the
+/// caller from one call to the next); the other rows of `out` are left as
+/// they were. Every rank holds every node's shift, so every rank makes the
+/// same lists without a message, and the bits are those of one rank.
+pub fn carry_shifted_on<const K: usize>(
     (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
     shapes: &NodalShapes,
     f: &[[f64; K]],
     d: &[[f64; 3]],
-    out: &mut [[f64; K]],
-) {
-    crate::ranks::each_row_in(ranks, parts, out, |i, o| {
-        *o = f[i];
-        let di = d[i];
-        if di == [0.0; 3] {
-            return;
-        }
-        let (mut lo, mut hi) = (f[i], f[i]);
-        let mut g = [[0.0; 3]; K];
-        for q in shapes.row(i) {
-            let (fj, gq) = (&f[shapes.nodes[q]], shapes.grad[q]);
-            for c in 0..K {
-                lo[c] = lo[c].min(fj[c]);
-                hi[c] = hi[c].max(fj[c]);
-                for k in 0..3 {
-                    g[c][k] += fj[c] * gq[k];
-                }
-            }
-        }
-        for c in 0..K {
-            let step = di[0] * g[c][0] + di[1] * g[c][1] + di[2] * g[c][2];
-            o[c] = (f[i][c] + step).clamp(lo[c], hi[c]);
-        }
-    });
+    (out, wire): (&mut [[f64; K]], &mut Vec<[f64; K]>),
+) where
+    [f64; K]: Default,
+{
+    let lists: Vec<Vec<usize>> = parts
+        .iter()
+        .map(|p| p.clone().filter(|&i| d[i] != [0.0; 3]).collect())
+        .collect();
+    let mine = &lists[ranks.rank()];
+    let values: Vec<[f64; K]> = mine
+        .par_iter()
+        .map(|&i| carried_at(shapes, f, d, i))
+        .collect();
+    for (&i, v) in mine.iter().zip(values) {
+        out[i] = v;
+    }
+    let get = |o: &[[f64; K]], i: usize| o[i];
+    let put = |o: &mut [[f64; K]], i: usize, v: &[f64; K]| o[i] = *v;
+    crate::ranks::gather_listed(ranks, &lists, wire, out, (get, put));
 }
 
-/// The conservative form of [`carry`] for a field whose amount at a node
+/// Node `i`'s carried value: `f_i + d_i · ∇f_i`, limited to the range
+/// over its row ([`carry_shifted_on`]), or `f_i` where it has no shift.
+fn carried_at<const K: usize>(
+    shapes: &NodalShapes,
+    f: &[[f64; K]],
+    d: &[[f64; 3]],
+    i: usize,
+) -> [f64; K] {
+    let di = d[i];
+    if di == [0.0; 3] {
+        return f[i];
+    }
+    let (mut lo, mut hi) = (f[i], f[i]);
+    let mut g = [[0.0; 3]; K];
+    for q in shapes.row(i) {
+        let (fj, gq) = (&f[shapes.nodes[q]], shapes.grad[q]);
+        for c in 0..K {
+            lo[c] = lo[c].min(fj[c]);
+            hi[c] = hi[c].max(fj[c]);
+            for k in 0..3 {
+                g[c][k] += fj[c] * gq[k];
+            }
+        }
+    }
+    std::array::from_fn(|c| {
+        let step = di[0] * g[c][0] + di[1] * g[c][1] + di[2] * g[c][2];
+        (f[i][c] + step).clamp(lo[c], hi[c])
+    })
+}
+
+/// The conservative form of [`carry_shifted_on`] for a field whose amount at a node
 /// is `w_i f_i` (the momentum: `w` the masses, `f` the velocities): the
 /// increment a shifted node takes is drawn from the nodes of its row, pair
 /// by pair, so that the field's total amount `Σ w f` stays what it was to
 /// round-off. Node `i` with a shift `d_i` takes
 /// `t_iJ = w_i θ_i (d_i · ∇φ_J(x_i)) (f_J − f_i)` from each node `J` of its
 /// row: in all `w_i θ_i d_i · ∇f_i` (the limited Taylor increment of
-/// [`carry`], `θ_i` in `[0, 1]` its limit's share, per component, and
+/// [`carry_shifted_on`], `θ_i` in `[0, 1]` its limit's share, per component, and
 /// `Σ_J ∇φ_J = 0`), and `J` gives up the same `t_iJ`. A node that does not
-/// shift keeps its value in [`carry`]; here it pays its share of its
+/// shift keeps its value in [`carry_shifted_on`]; here it pays its share of its
 /// shifted neighbours' increments (at most `w_i / w_J` times theirs,
 /// spread over the row). `f` and `w` cover the columns of `shapes` (real
 /// nodes and mirror images), `d` its rows; `delta` (resized to the
@@ -295,6 +321,57 @@ mod tests {
                 } else {
                     assert!((out[i][c] - want[c]).abs() < 1e-12, "{i} {c}");
                     assert_ne!(out[i][c], f[i][c]);
+                }
+            }
+        }
+    }
+
+    /// The carry of the shifted nodes only, on 1, 2 and 3 ranks (threads,
+    /// parts unequal): every rank's shifted rows hold [`carry`]'s bits,
+    /// and every other row keeps what the rank held (a mark of the rank).
+    #[test]
+    fn the_shifted_rows_carry_the_bits_of_one_rank_and_the_rest_stay() {
+        let pts = jittered_cube(6, 1.0, 0.2, 7);
+        let n = pts.len();
+        let shapes = shapes_of(&pts);
+        let mut rand = crate::test_rng::rng(99);
+        let f: Vec<[f64; 2]> = (0..n).map(|_| [rand(), 10.0 * rand()]).collect();
+        let d: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                if i % 7 == 3 {
+                    std::array::from_fn(|_| 0.06 * (rand() - 0.5))
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
+        let mut want = vec![[0.0; 2]; n];
+        carry(&shapes, &f, &d, &mut want);
+        for size in [1, 2, 3] {
+            let parts: Vec<_> = (0..size)
+                .map(|r| {
+                    (r * n / (size + 1))..(if r + 1 == size {
+                        n
+                    } else {
+                        (r + 1) * n / (size + 1)
+                    })
+                })
+                .collect();
+            let got = crate::ranks::tests::on_threads(size, |ranks| {
+                let mark = -(ranks.rank() as f64) - 1.0;
+                let mut out = vec![[mark; 2]; n];
+                let mut wire = Vec::new();
+                carry_shifted_on((ranks, &parts), &shapes, &f, &d, (&mut out, &mut wire));
+                (mark, out)
+            });
+            for (mark, out) in got {
+                for i in 0..n {
+                    if d[i] == [0.0; 3] {
+                        assert_eq!(out[i], [mark; 2], "{size} ranks, row {i}");
+                    } else {
+                        assert_eq!(out[i].map(f64::to_bits), want[i].map(f64::to_bits));
+                        assert_ne!(out[i], f[i], "row {i} moved");
+                    }
                 }
             }
         }

@@ -8,7 +8,7 @@ use super::scratch::CARRIED;
 use super::scratch::Scratch;
 use super::scratch::{ImageBuffers, ShiftBuffers};
 use super::shift::Freedom;
-use super::shift::carry_on;
+use super::shift::carry_shifted_on;
 use super::shift::exchange;
 use super::shift::shifts_on;
 use super::spheres::nanson;
@@ -49,7 +49,7 @@ use rayon::iter::ParallelIterator;
 /// fixed, two mantle nodes of the Wilkins bar's bulge close to the
 /// guard at 59.6 µs; README, "3-D MLPG mixed method"). The moved nodes
 /// take their stress, density, plastic strain, temperature and
-/// reference place by [`carry`], and their velocities by [`carry`] or,
+/// reference place by [`carry_shifted_on`], and their velocities by [`carry_shifted_on`] or,
 /// with [`RodSetup::conservative_carry`], by [`exchange`] (the momentum
 /// drawn from the nodes around). The kinetic energy the carrying
 /// changes is booked with the smoothing. A ceramic node whose tensile
@@ -131,12 +131,13 @@ pub(super) fn shift(
     };
     pack(&fields, frame.marks, &mut buffers.carried);
     let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
-    carry_on(
+    // Only the shifted nodes' rows: the unpacking reads no other.
+    carry_shifted_on(
         (ranks, &g.rows),
         &g.shapes,
         carried,
         &buffers.shift,
-        &mut buffers.carried_out,
+        (&mut buffers.carried_out, &mut buffers.wire),
     );
     let conservative = setup.rod.conservative_carry;
     let mut ke = [0.0; 2];

@@ -8,6 +8,7 @@ use super::LOST_DAMPING;
 use super::LOST_SMOOTHING;
 use super::geometry;
 use super::geometry::Geometry;
+use super::halo::HaloFields;
 use super::motion::{self, Frame};
 use super::profile::Phase;
 use super::profile::Stopwatch;
@@ -183,8 +184,14 @@ pub(super) fn step_with(
         setup.reach,
         !setup.plane.is_empty(),
     );
+    // On several ranks with the nodal forces, the deviator, the viscous
+    // stress, the pressure, the plastic strain and the temperature go only
+    // to the ranks that read them ([`super::halo`]), except where the
+    // points' split moves at the end of this step (their next owners
+    // read them): then, as with the seed's traction operator, whole.
+    let by_halo = ranks.size() > 1 && nodal && !pipe.balance.splits_at_end(ranks);
     update::update_material(
-        (ranks, &mut pipe.balance),
+        (ranks, &mut pipe.balance, !by_halo),
         &MaterialInputs {
             dt,
             damping_time: setup.damping_time,
@@ -207,6 +214,23 @@ pub(super) fn step_with(
         },
         &mut scratch.results,
     );
+    if by_halo {
+        let parts = pipe.balance.parts(ranks, n);
+        pipe.halo.exchange(
+            ranks,
+            (g, setup.rod.scheme.shifting > 0.0),
+            parts,
+            HaloFields {
+                dev: &mut state.dev,
+                visc: &mut state.visc,
+                pressure: &mut state.pressure,
+                eps_p: &mut state.eps_p,
+                temp: &mut state.temp,
+            },
+        );
+    } else {
+        pipe.halo.whole();
+    }
     // The marks of the nodes on every rank; their damage variables stay
     // with the rank that stepped them (shared every step where the cracks
     // shield: the zones read every node's), and are shared before the
