@@ -41,6 +41,19 @@ pub(super) struct HaloFields<'a> {
     pub(super) temp: &'a mut [f64],
 }
 
+impl<'a> HaloFields<'a> {
+    /// The halo's fields of `state`.
+    pub(super) fn of(state: &'a mut super::State3d) -> Self {
+        HaloFields {
+            dev: &mut state.dev,
+            visc: &mut state.visc,
+            pressure: &mut state.pressure,
+            eps_p: &mut state.eps_p,
+            temp: &mut state.temp,
+        }
+    }
+}
+
 /// What each rank sends after the material pass, and whether the fields
 /// are apart. Rebuilt, never saved.
 #[derive(Debug, Clone, Default)]

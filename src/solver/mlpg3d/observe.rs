@@ -354,17 +354,9 @@ impl Mlpg3d {
         // only where it reads them ([`super::halo`]).
         let n = self.state.pos.len();
         let parts = self.pipe.balance.parts(ranks, n).to_vec();
-        self.pipe.halo.make_whole(
-            ranks,
-            &parts,
-            super::halo::HaloFields {
-                dev: &mut self.state.dev,
-                visc: &mut self.state.visc,
-                pressure: &mut self.state.pressure,
-                eps_p: &mut self.state.eps_p,
-                temp: &mut self.state.temp,
-            },
-        );
+        self.pipe
+            .halo
+            .make_whole(ranks, &parts, super::halo::HaloFields::of(&mut self.state));
     }
 
     /// The contact reach between the bodies (m; [`contact`]).

@@ -220,13 +220,7 @@ pub(super) fn step_with(
             ranks,
             (g, setup.rod.scheme.shifting > 0.0),
             parts,
-            HaloFields {
-                dev: &mut state.dev,
-                visc: &mut state.visc,
-                pressure: &mut state.pressure,
-                eps_p: &mut state.eps_p,
-                temp: &mut state.temp,
-            },
+            HaloFields::of(state),
         );
     } else {
         pipe.halo.whole();
