@@ -135,6 +135,14 @@ pub trait Model: ModelState + std::fmt::Debug + Send + Sync + Any {
     /// one process, and by default.
     fn share(&mut self) {}
 
+    /// Makes whole on every rank what [`Model::observables`] reads of what
+    /// the ranks keep apart between steps (a collective call, as
+    /// [`Model::share`]); the rest may stay apart. By default
+    /// [`Model::share`].
+    fn share_observed(&mut self) {
+        self.share();
+    }
+
     /// Shares this run's passes over its particles among `ranks` (the
     /// processes of an MPI run, [`crate::ranks`]), with the same bits on
     /// any number of ranks. A solver that runs on one process only refuses

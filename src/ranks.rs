@@ -152,6 +152,13 @@ unsafe impl<T: Plain, const N: usize> Plain for [T; N] {}
 // value.
 unsafe impl Plain for crate::material::Marks {}
 
+/// The bytes of `v`.
+fn bytes<T: Plain>(v: &[T]) -> &[u8] {
+    // SAFETY: a `Plain` type has no padding, so every byte of the slice is
+    // initialized; the length is the slice's size in bytes.
+    unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<u8>(), std::mem::size_of_val(v)) }
+}
+
 /// The bytes of `v`, writable.
 fn bytes_mut<T: Plain>(v: &mut [T]) -> &mut [u8] {
     // SAFETY: as in `bytes`; any bytes written make valid `T`s (`Plain`).
@@ -463,6 +470,45 @@ pub fn all_gather_one<T: Plain + Default>(ranks: &dyn Ranks, value: T) -> Vec<T>
     all
 }
 
+/// [`each_row_in`] for a pass whose rows are mostly `T::default()`, bit
+/// for bit (the shifts of the 3-D solver's nodes: a few dozen of 10^4
+/// move at a step): `f(i, &mut out[i])` for the rows of this rank's part,
+/// then only the rows whose bits differ from the default's travel, with
+/// their indices (three exchanges: the counts, the indices, the rows,
+/// through `wire`, kept by the caller), and every other row of the other
+/// ranks' parts is set to the default. The bits of [`each_row_in`].
+#[track_caller]
+pub fn each_row_sparse<T: Plain + Default>(
+    ranks: &dyn Ranks,
+    parts: &[Range<usize>],
+    (out, wire): (&mut [T], &mut Vec<T>),
+    f: impl Fn(usize, &mut T) + Sync,
+) {
+    each_own_row(ranks, parts, out, f);
+    if ranks.size() == 1 {
+        return;
+    }
+    let own = parts[ranks.rank()].clone();
+    let zero = T::default();
+    let is_zero = |v: &T| bytes(std::slice::from_ref(v)) == bytes(std::slice::from_ref(&zero));
+    let mine: Vec<usize> = own.clone().filter(|&i| !is_zero(&out[i])).collect();
+    out[..own.start].fill(zero);
+    out[own.end..].fill(zero);
+    let all = all_gather_varying(ranks, &mine);
+    // In rank order, each ascending: split by the parts.
+    let mut lists = vec![Vec::new(); parts.len()];
+    let mut r = 0;
+    for i in all {
+        while i >= parts[r].end {
+            r += 1;
+        }
+        lists[r].push(i);
+    }
+    let get = |o: &[T], i: usize| o[i];
+    let put = |o: &mut [T], i: usize, v: &T| o[i] = *v;
+    gather_listed(ranks, &lists, wire, out, (get, put));
+}
+
 /// `f(i, &mut out[i])` for the rows of this rank's part `parts[rank]`
 /// (`parts` contiguous, in rank order, covering `out`), on the pool; the
 /// other rows are left as they were (a pass whose next reader reads only
@@ -628,6 +674,46 @@ pub(crate) mod tests {
             for (out, top, low) in got {
                 assert!(out.iter().enumerate().all(|(i, v)| *v == (i * i) as f64));
                 assert_eq!((top, low), (size as i64 - 1, -5));
+            }
+        }
+    }
+
+    /// [`each_row_sparse`] gives every rank the bits of [`each_row_in`]:
+    /// on 2-4 ranks as threads, parts of unequal length (one empty), rows
+    /// that are zero, rows that are zero but for a sign (−0.0 travels: its
+    /// bits are not the default's), rows of any value, and other ranks'
+    /// rows holding stale values before the call.
+    #[test]
+    fn sparse_rows_give_the_bits_of_the_whole_gather() {
+        let value = |i: usize| -> [f64; 3] {
+            match i % 5 {
+                0 => [i as f64, -1.5, 0.25],
+                1 => [0.0, -0.0, 0.0],
+                _ => [0.0; 3],
+            }
+        };
+        for size in [2, 3, 4] {
+            let parts: Vec<Range<usize>> = {
+                let mut cuts: Vec<usize> = (0..=size).map(|r| r * 47 / size).collect();
+                cuts[1] = cuts[0]; // rank 0 owns nothing
+                cuts.windows(2).map(|w| w[0]..w[1]).collect()
+            };
+            let got = on_threads(size, |ranks| {
+                let stale = |_: usize| [f64::NAN, 7.0, -(ranks.rank() as f64)];
+                let mut whole: Vec<[f64; 3]> = (0..47).map(stale).collect();
+                each_row_in(ranks, &parts, &mut whole, |i, v| *v = value(i));
+                let mut sparse: Vec<[f64; 3]> = (0..47).map(stale).collect();
+                let mut wire = Vec::new();
+                each_row_sparse(ranks, &parts, (&mut sparse, &mut wire), |i, v| {
+                    *v = value(i)
+                });
+                let bits = |v: &[[f64; 3]]| -> Vec<u64> {
+                    v.iter().flatten().map(|x| x.to_bits()).collect()
+                };
+                (bits(&whole), bits(&sparse))
+            });
+            for (rank, (whole, sparse)) in got.iter().enumerate() {
+                assert!(whole == sparse, "rank {rank} of {size}");
             }
         }
     }

@@ -458,9 +458,11 @@ impl Simulation {
     /// several ([`Simulation::set_ranks`]) keep apart between steps (the 3-D
     /// solver's damage variables: each rank's current on its own part).
     /// A loop of steps calls [`Simulation::share`] before it reads the
-    /// run's fields, saves its state or ends; the observables, their
-    /// records and [`Simulation::finished`] need no share. On one rank the
-    /// same as [`Simulation::step`].
+    /// run's fields, reads its observables between records, saves its
+    /// state or ends; the records and [`Simulation::finished`] need no
+    /// share (a record makes whole what the observables read:
+    /// [`crate::model::Model::share_observed`]). On one rank the same as
+    /// [`Simulation::step`].
     pub fn step_apart(&mut self) -> Result<()> {
         if let Some(e) = &self.error {
             return Err(e.clone());
@@ -474,7 +476,7 @@ impl Simulation {
             return Err(e);
         }
         if self.time() >= self.next_record || self.finished() {
-            self.solver.share();
+            self.solver.share_observed();
             self.record();
         }
         Ok(())

@@ -261,7 +261,7 @@ fn small_taylor3d_on_two(options: &[&str], extra: &[&str]) -> String {
 /// With `MI_MPI_STATS=2` each rank books its collectives by the line of
 /// the program that called them: the lines add up to the rank's totals of
 /// calls and bytes, and the shared passes are named by their own lines
-/// (the material's gather, the nodal forces').
+/// (the material's fields' halo, the nodal forces').
 #[test]
 fn the_collectives_are_booked_by_the_lines_that_called_them() {
     let err = small_taylor3d_on_two(&["-genv", "MI_MPI_STATS", "2"], &[]);
@@ -286,9 +286,9 @@ fn the_collectives_are_booked_by_the_lines_that_called_them() {
             .collect();
         assert_eq!(books.iter().map(|b| b.1).sum::<u64>(), calls, "{err}");
         assert_eq!(books.iter().map(|b| b.2).sum::<u64>(), bytes, "{err}");
-        // (A rank may receive nothing at the material's gather: at 3
+        // (A rank may receive nothing at the material's exchange: at 3
         // across its points are one block, which one rank steps.)
-        for file in ["src/solver/mlpg3d/update.rs:", "src/approx/nodal.rs:"] {
+        for file in ["src/solver/mlpg3d/halo.rs:", "src/approx/nodal.rs:"] {
             assert!(
                 books.iter().any(|b| b.0.starts_with(file) && b.1 > 0),
                 "rank {rank}: no gather booked at {file}: {err}"

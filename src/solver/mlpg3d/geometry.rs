@@ -54,6 +54,49 @@ pub(super) struct Geometry {
     /// entries ([`row_parts`]): the rows each rank computes in the passes
     /// over them (the smoothing's defect, the shifts and the carry).
     pub(super) rows: Vec<std::ops::Range<usize>>,
+    /// On several ranks with the order-2 smoothing, the rows of each
+    /// rank's part of `rows` that another rank's columns of `nodal` read
+    /// in the smoothing's transpose ([`pass_lists`]); empty otherwise.
+    pub(super) pass_send: Vec<Vec<usize>>,
+}
+
+/// The rows of each rank's part of the shapes' rows `g.rows` (of `n` real
+/// nodes) that another rank reads in the order-2 smoothing's transpose
+/// `Hᵀ` (`NodalOperator::defect_transpose_on`): the nodes of the entries
+/// of the columns it holds, and those columns' own nodes (which the
+/// entries hold too wherever a node lies in its own support: dropping
+/// them failed no test, so they are kept as a superset); each ascending.
+/// A collective call (one gather of each rank's reads), made at each
+/// build.
+/// Empty on one rank, or without the order-2 smoothing (`order2`).
+fn pass_lists(
+    ranks: &dyn crate::ranks::Ranks,
+    g: &Geometry,
+    n: usize,
+    order2: bool,
+) -> Vec<Vec<usize>> {
+    if ranks.size() == 1 || !order2 {
+        return Vec::new();
+    }
+    let own = g.rows[ranks.rank()].clone();
+    let mut read = vec![false; n];
+    for j in g.nodal.held.clone() {
+        if j < n {
+            read[j] = true;
+        }
+        for q in g.nodal.column(j) {
+            read[g.nodal.nodes[q]] = true;
+        }
+    }
+    let mine: Vec<usize> = (0..n).filter(|&i| read[i] && !own.contains(&i)).collect();
+    let mut wanted = vec![false; n];
+    for i in crate::ranks::all_gather_varying(ranks, &mine) {
+        wanted[i] = true;
+    }
+    g.rows
+        .iter()
+        .map(|p| p.clone().filter(|&i| wanted[i]).collect())
+        .collect()
 }
 
 /// The parts of the first `n` rows of `shapes` among `ranks`: one part
@@ -238,6 +281,8 @@ pub(super) fn build_geometry(
     } else {
         g.nodal = NodalOperator::default();
     }
+    let order2 = setup.rod.scheme.order == SmoothingOrder::Two;
+    g.pass_send = pass_lists(&*pipe.ranks, &g, n, order2);
     pipe.profile.lap(Phase::Operator, &mut watch);
     pipe.profile.operators += 1;
     pipe.geometry = Some(g);

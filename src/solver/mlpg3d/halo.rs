@@ -4,14 +4,21 @@
 //!
 //! The material pass writes, at the points of each rank's part
 //! ([`super::balance::Balance`]), the deviator, the viscous stress, the
-//! pressure, the plastic strain and the temperature. Until the next pass
-//! they are read:
+//! pressure, the plastic strain, the temperature and the density. Until
+//! the next pass they are read:
 //!
 //! - by the rank's own next material pass, at its own points;
-//! - by the nodal forces, at the nodes `i` of the columns this rank holds
+//! - by the nodal forces (the stresses, and the density in the nodal
+//!   volumes `m / ρ`), at the nodes `i` of the columns this rank holds
 //!   (`NodalOperator::nodes`);
 //! - by the shifting's carry, at the nodes of the shapes' rows of this
-//!   rank's part (`Geometry::rows`), the images' by their nodes.
+//!   rank's part (`Geometry::rows`), the images' by their nodes;
+//! - the density by the wave speed of a body without a reference density,
+//!   at node 0 (`mlpg3d::wave_speed`), and by a build of the geometry at
+//!   every node (the step makes the density whole before one:
+//!   `step::follow`; the build changes what each rank reads, but nothing
+//!   reads the other fields between it and the next exchange, which sends
+//!   by the new lists).
 //!
 //! Each rank lists the nodes it reads outside its own part; the lists are
 //! gathered once for each build of the geometry and split of the points,
@@ -29,8 +36,8 @@ use crate::ranks::Ranks;
 use std::ops::Range;
 
 /// The numbers of one node's record: the deviator, the viscous stress, the
-/// pressure, the plastic strain and the temperature.
-const RECORD: usize = 15;
+/// pressure, the plastic strain, the temperature and the density.
+const RECORD: usize = 16;
 
 /// The material fields the halo carries.
 pub(super) struct HaloFields<'a> {
@@ -39,6 +46,7 @@ pub(super) struct HaloFields<'a> {
     pub(super) pressure: &'a mut [f64],
     pub(super) eps_p: &'a mut [f64],
     pub(super) temp: &'a mut [f64],
+    pub(super) rho: &'a mut [f64],
 }
 
 impl<'a> HaloFields<'a> {
@@ -50,6 +58,7 @@ impl<'a> HaloFields<'a> {
             pressure: &mut state.pressure,
             eps_p: &mut state.eps_p,
             temp: &mut state.temp,
+            rho: &mut state.rho,
         }
     }
 }
@@ -172,7 +181,38 @@ impl Halo {
         gather_parts(ranks, parts, f.pressure);
         gather_parts(ranks, parts, f.eps_p);
         gather_parts(ranks, parts, f.temp);
+        gather_parts(ranks, parts, f.rho);
         self.apart = false;
+    }
+
+    /// The density `rho` whole on every rank, where the fields are apart
+    /// (the rest stay apart): what a build of the geometry reads of them
+    /// (`step::follow`). A collective call.
+    pub(super) fn make_density_whole(
+        &self,
+        ranks: &dyn Ranks,
+        parts: &[Range<usize>],
+        rho: &mut [f64],
+    ) {
+        if self.apart {
+            crate::ranks::gather_parts(ranks, parts, rho);
+        }
+    }
+
+    /// The plastic strain and the temperature `(eps_p, temp)` whole on
+    /// every rank, where the fields are apart (the rest stay apart): what
+    /// the observables read ([`super::Mlpg3d::share_observed`]). A
+    /// collective call.
+    pub(super) fn make_observed_whole(
+        &self,
+        ranks: &dyn Ranks,
+        parts: &[Range<usize>],
+        (eps_p, temp): (&mut [f64], &mut [f64]),
+    ) {
+        if self.apart {
+            crate::ranks::gather_parts(ranks, parts, eps_p);
+            crate::ranks::gather_parts(ranks, parts, temp);
+        }
     }
 }
 
@@ -181,7 +221,7 @@ fn pack(f: &HaloFields, i: usize) -> [f64; RECORD] {
     let mut r = [0.0; RECORD];
     r[..6].copy_from_slice(&f.dev[i]);
     r[6..12].copy_from_slice(&f.visc[i]);
-    (r[12], r[13], r[14]) = (f.pressure[i], f.eps_p[i], f.temp[i]);
+    (r[12], r[13], r[14], r[15]) = (f.pressure[i], f.eps_p[i], f.temp[i], f.rho[i]);
     r
 }
 
@@ -189,12 +229,13 @@ fn pack(f: &HaloFields, i: usize) -> [f64; RECORD] {
 fn unpack(f: &mut HaloFields, i: usize, r: &[f64; RECORD]) {
     f.dev[i] = std::array::from_fn(|k| r[k]);
     f.visc[i] = std::array::from_fn(|k| r[6 + k]);
-    (f.pressure[i], f.eps_p[i], f.temp[i]) = (r[12], r[13], r[14]);
+    (f.pressure[i], f.eps_p[i], f.temp[i], f.rho[i]) = (r[12], r[13], r[14], r[15]);
 }
 
-/// The nodes outside `own` (of `n`) that this rank reads: the nodes of the
-/// nodal operator's columns it holds, and where `shifting` the nodes of
-/// the shapes' rows of its part `g.rows[rank]` (an image by its node),
+/// The nodes outside `own` (of `n`) that this rank reads: node 0 (the
+/// density of the wave speed's fallback), the nodes of the nodal
+/// operator's columns it holds, and where `shifting` the nodes of the
+/// shapes' rows of its part `g.rows[rank]` (an image by its node),
 /// ascending; where `wider`, with the nodes of their shapes' rows too (one
 /// support more: a test's check).
 fn reads_outside(
@@ -204,6 +245,9 @@ fn reads_outside(
     (shifting, wider): (bool, bool),
 ) -> Vec<usize> {
     let mut read = vec![false; n];
+    if n > 0 {
+        read[0] = true;
+    }
     for j in g.nodal.held.clone() {
         for q in g.nodal.column(j) {
             read[g.nodal.nodes[q]] = true;
@@ -241,20 +285,7 @@ mod tests {
     /// rod (nodal forces, order-2 smoothing, shifting), on `ranks` or
     /// alone, with the halo's checks `(wider, poison)`.
     fn run(ranks: Option<crate::ranks::Handle>, check: (bool, bool), steps: usize) -> Vec<u64> {
-        let cylinder = Cylinder {
-            radius: 2e-3,
-            length: 60e-3,
-        };
-        let mut setup = RodSetup::new(cylinder, 4, 400.0, 1.0);
-        setup.quarter = true;
-        setup.scheme.forces = Forces::Nodal;
-        setup.scheme.order = SmoothingOrder::Two;
-        setup.scheme.shifting = 0.1;
-        let mut sim = Mlpg3d::new(setup, plastic_steel()).unwrap();
-        if let Some(r) = ranks {
-            sim.set_ranks(r);
-        }
-        sim.pipe.halo.check(check.0, check.1);
+        let mut sim = quarter_rod(ranks, check);
         for _ in 0..steps {
             sim.step().unwrap();
         }
@@ -269,8 +300,29 @@ mod tests {
             .chain(&s.eps_p)
             .chain(&s.temp)
             .chain(&s.rho)
+            .chain(&s.built_rho)
             .for_each(|&v| put(v));
         bits
+    }
+
+    /// The quarter rod of [`run`], on `ranks` or alone, with the halo's
+    /// checks `(wider, poison)`.
+    fn quarter_rod(ranks: Option<crate::ranks::Handle>, check: (bool, bool)) -> Mlpg3d {
+        let cylinder = Cylinder {
+            radius: 2e-3,
+            length: 60e-3,
+        };
+        let mut setup = RodSetup::new(cylinder, 4, 400.0, 1.0);
+        setup.quarter = true;
+        setup.scheme.forces = Forces::Nodal;
+        setup.scheme.order = SmoothingOrder::Two;
+        setup.scheme.shifting = 0.1;
+        let mut sim = Mlpg3d::new(setup, plastic_steel()).unwrap();
+        if let Some(r) = ranks {
+            sim.set_ranks(r);
+        }
+        sim.pipe.halo.check(check.0, check.1);
+        sim
     }
 
     /// On 2 and 3 ranks (threads) the halo gives the bits of one rank,
@@ -297,6 +349,36 @@ mod tests {
                         "{size} ranks, rank {rank}, checks {check:?}"
                     );
                 }
+            }
+        }
+    }
+    /// A record's share ([`Mlpg3d::share_observed`]: the plastic strain
+    /// and the temperature of the material fields, the rest left apart and
+    /// poisoned) gives every rank the observables of one rank: the same
+    /// quarter rod on 2 and 3 ranks, its 16 observables read on every rank
+    /// at 12 of its 120 steps. (Without the share, rank 1 reads neither the
+    /// impact face's plastic strain nor its heat.)
+    #[test]
+    fn a_records_share_gives_every_rank_the_observables_of_one() {
+        let observed = |ranks: Option<crate::ranks::Handle>| {
+            let mut sim = quarter_rod(ranks, (false, true));
+            let mut bits = Vec::new();
+            for step in 1..=120 {
+                sim.step().unwrap();
+                // Off the steps where the points' split moves (every
+                // 10th), which gather the fields whole.
+                if step % 10 == 5 {
+                    sim.share_observed();
+                    bits.extend(sim.observables().iter().map(|v| v.to_bits()));
+                }
+            }
+            bits
+        };
+        let alone = observed(None);
+        for size in [2, 3] {
+            let got = crate::ranks::tests::on_thread_handles(size, |h| observed(Some(h)));
+            for (rank, bits) in got.iter().enumerate() {
+                assert!(*bits == alone, "{size} ranks, rank {rank}");
             }
         }
     }

@@ -142,7 +142,7 @@ pub(super) fn smooth(
     } else {
         &mut buffers.defect
     };
-    crate::ranks::each_row_in(frame.ranks, &g.rows, weighted, |i, out| {
+    let row = |i: usize, out: &mut [f64; 3]| {
         let mut m = [0.0; 3];
         for q in shapes.row(i) {
             let vj = vel_ext[shapes.nodes[q]];
@@ -152,7 +152,28 @@ pub(super) fn smooth(
         }
         let w: [f64; 3] = std::array::from_fn(|d| vel[i][d] - m[d]);
         *out = if order2 { w.map(|c| mass[i] * c) } else { w };
-    });
+    };
+    if order2 && !g.pass_send.is_empty() {
+        // Only the rows another rank's transpose reads travel
+        // ([`Geometry::pass_send`]); the rest of the other ranks' rows are
+        // not read, and are set to NaN so that a read would show.
+        let ranks = frame.ranks;
+        let own = g.rows[ranks.rank()].clone();
+        crate::ranks::each_own_row(ranks, &g.rows, weighted, row);
+        weighted[..own.start].fill([f64::NAN; 3]);
+        weighted[own.end..].fill([f64::NAN; 3]);
+        let get = |o: &[[f64; 3]], i: usize| o[i];
+        let put = |o: &mut [[f64; 3]], i: usize, v: &[f64; 3]| o[i] = *v;
+        crate::ranks::gather_listed(
+            ranks,
+            &g.pass_send,
+            &mut buffers.wire,
+            &mut weighted[..],
+            (get, put),
+        );
+    } else {
+        crate::ranks::each_row_in(frame.ranks, &g.rows, weighted, row);
+    }
     if order2 {
         buffers.defect.resize(n + images.len(), [0.0; 3]);
         g.nodal

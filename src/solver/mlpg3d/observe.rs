@@ -149,6 +149,12 @@ impl Mlpg3d {
                 let columns = g.nodal.columns;
                 g.nodal.rebuild_on(&*self.pipe.ranks, &g.shapes, columns);
             }
+            // The lists of the smoothing's first pass were made for the
+            // old rows (none on one rank): until the next build, whole
+            // gathers. (Making them here would be a collective call, which
+            // a rank that fails at its start never makes: measured, the
+            // other rank waited for it.)
+            g.pass_send.clear();
         }
     }
 
@@ -359,6 +365,22 @@ impl Mlpg3d {
             .make_whole(ranks, &parts, super::halo::HaloFields::of(&mut self.state));
     }
 
+    /// [`Mlpg3d::share`] for a record of the observables: the damage
+    /// variables, and of the material fields only the plastic strain and
+    /// the temperature, whose largest values the observables read (the
+    /// rest stay apart until the next [`Mlpg3d::share`]).
+    pub fn share_observed(&mut self) {
+        let (ranks, wire) = (&*self.pipe.ranks, &mut self.pipe.balance.wire);
+        self.state.material_state.share(ranks, wire);
+        let n = self.state.pos.len();
+        let parts = self.pipe.balance.parts(ranks, n).to_vec();
+        self.pipe.halo.make_observed_whole(
+            ranks,
+            &parts,
+            (&mut self.state.eps_p, &mut self.state.temp),
+        );
+    }
+
     /// The contact reach between the bodies (m; [`contact`]).
     pub fn contact_reach(&self) -> f64 {
         self.setup.reach
@@ -472,5 +494,8 @@ impl crate::model::Model for Mlpg3d {
     }
     fn share(&mut self) {
         self.share();
+    }
+    fn share_observed(&mut self) {
+        self.share_observed();
     }
 }

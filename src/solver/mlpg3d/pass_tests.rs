@@ -213,6 +213,7 @@ fn smoothing_keeps_a_uniform_velocity_and_removes_no_energy() {
         smooth: vec![[0.0; 3]; n],
         defect: vec![[0.0; 3]; n],
         pass: vec![[0.0; 3]; n],
+        wire: Vec::new(),
     };
     let mut ext = Vec::new();
     for order in [1, 2] {

@@ -654,4 +654,7 @@ impl crate::model::Model for Penetration {
     fn share(&mut self) {
         self.run.share();
     }
+    fn share_observed(&mut self) {
+        self.run.share_observed();
+    }
 }

@@ -48,6 +48,8 @@ pub(super) struct SmoothingBuffers {
     pub(super) defect: Vec<[f64; 3]>,
     /// With order 2, the mass-weighted defect `M H v`.
     pub(super) pass: Vec<[f64; 3]>,
+    /// Its rows as they travel among the ranks.
+    pub(super) wire: Vec<[f64; 3]>,
 }
 
 /// The buffers of the contact between bodies and between pulverized nodes.
@@ -67,6 +69,8 @@ pub(super) struct ContactBuffers {
 pub(super) struct ShiftBuffers {
     /// Each node's shift.
     pub(super) shift: Vec<[f64; 3]>,
+    /// The shifted nodes' shifts as they travel among the ranks.
+    pub(super) shift_wire: Vec<[f64; 3]>,
     /// How each node may move.
     pub(super) free: Vec<Freedom>,
     /// The carried fields ([`CARRIED`]) before and after the carry.

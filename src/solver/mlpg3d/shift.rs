@@ -53,7 +53,7 @@ pub fn shifts(
         shapes,
         free,
         (spacing, range, beta, cap),
-        out,
+        (out, &mut Vec::new()),
     );
 }
 
@@ -66,17 +66,19 @@ pub fn shifts(
 /// in parallel, each from the positions before any moves (the same bits for
 /// any number of threads). Shared among `ranks`: each computes its part
 /// of the nodes (`parts`, contiguous, in rank order, covering them), then
-/// every rank holds them all (the same bits).
+/// every rank holds them all (the same bits); only the shifts that are not
+/// zero travel, through `wire` (kept by the caller), since few nodes shift
+/// at a step ([`crate::ranks::each_row_sparse`]).
 pub fn shifts_on(
     (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
     pos: &[[f64; 3]],
     shapes: &NodalShapes,
     free: &[Freedom],
     (spacing, range, beta, cap): (f64, f64, f64, f64),
-    out: &mut [[f64; 3]],
+    (out, wire): (&mut [[f64; 3]], &mut Vec<[f64; 3]>),
 ) {
     let range2 = range * range;
-    crate::ranks::each_row_in(ranks, parts, out, |i, d| {
+    crate::ranks::each_row_sparse(ranks, parts, (out, wire), |i, d| {
         *d = [0.0; 3];
         if free[i] == Freedom::Fixed {
             return;

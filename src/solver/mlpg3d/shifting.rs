@@ -102,7 +102,7 @@ pub(super) fn shift(
             setup.rod.scheme.shifting * step_scale,
             SHIFT_CAP * spacing * step_scale,
         ),
-        &mut buffers.shift,
+        (&mut buffers.shift, &mut buffers.shift_wire),
     );
     // A node on a symmetry plane moves in it; a held node stays.
     for (d, &on) in buffers.shift.iter_mut().zip(frame.plane) {

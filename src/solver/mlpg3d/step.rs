@@ -284,6 +284,13 @@ fn follow(
     check_spacing(ratio, state.clock.time, "")?;
     let supports = pairs.recompute;
     if supports || pairs.strained {
+        // The build reads every node's density (its copy, `built_rho`, is
+        // saved and read by the conforming correction's volumes), which
+        // the ranks hold between passes only where they read it.
+        let n = state.pos.len();
+        let parts = pipe.balance.parts(&*pipe.ranks, n);
+        pipe.halo
+            .make_density_whole(&*pipe.ranks, parts, &mut state.rho);
         if supports {
             state.supports_at.clone_from(&state.pos);
         }

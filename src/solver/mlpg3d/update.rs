@@ -57,9 +57,9 @@ pub(super) struct MaterialFields<'a> {
 
 /// Updates every node's material and writes its sums of the step (or the
 /// first error met at it: the compression limit, a non-finite field) to
-/// `results`. On several ranks every rank then holds every node's density,
-/// and every node's other fields where `whole` (else the caller sends
-/// them by the halo: [`super::halo`]).
+/// `results`. On several ranks every rank then holds every node's fields
+/// where `whole` (else the caller sends them by the halo:
+/// [`super::halo`]).
 pub(super) fn update_material(
     (ranks, balance, whole): (&dyn crate::ranks::Ranks, &mut Balance, bool),
     input: &MaterialInputs,
@@ -106,8 +106,8 @@ pub(super) fn update_material(
         );
         balance.book(start / MATERIAL_ALIGN, watch.elapsed().as_secs_f64());
     }
-    gather_parts(ranks, &parts, rho);
     if whole {
+        gather_parts(ranks, &parts, rho);
         gather_parts(ranks, &parts, dev);
         gather_parts(ranks, &parts, pressure);
         gather_parts(ranks, &parts, eps_p);
