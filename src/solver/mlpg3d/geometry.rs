@@ -60,6 +60,19 @@ pub(super) struct Geometry {
     pub(super) pass_send: Vec<Vec<usize>>,
 }
 
+impl Geometry {
+    /// Marks in `read` the nodes of the entries of the nodal operator's
+    /// columns this rank holds: the rows its forces and its smoothing's
+    /// transpose read.
+    pub(super) fn mark_column_reads(&self, read: &mut [bool]) {
+        for j in self.nodal.held.clone() {
+            for q in self.nodal.column(j) {
+                read[self.nodal.nodes[q]] = true;
+            }
+        }
+    }
+}
+
 /// The rows of each rank's part of the shapes' rows `g.rows` (of `n` real
 /// nodes) that another rank reads in the order-2 smoothing's transpose
 /// `Hᵀ` (`NodalOperator::defect_transpose_on`): the nodes of the entries
@@ -80,13 +93,9 @@ fn pass_lists(
     }
     let own = g.rows[ranks.rank()].clone();
     let mut read = vec![false; n];
-    for j in g.nodal.held.clone() {
-        if j < n {
-            read[j] = true;
-        }
-        for q in g.nodal.column(j) {
-            read[g.nodal.nodes[q]] = true;
-        }
+    g.mark_column_reads(&mut read);
+    for j in g.nodal.held.clone().filter(|&j| j < n) {
+        read[j] = true;
     }
     let mine: Vec<usize> = (0..n).filter(|&i| read[i] && !own.contains(&i)).collect();
     let mut wanted = vec![false; n];

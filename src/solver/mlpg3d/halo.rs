@@ -185,33 +185,21 @@ impl Halo {
         self.apart = false;
     }
 
-    /// The density `rho` whole on every rank, where the fields are apart
-    /// (the rest stay apart): what a build of the geometry reads of them
-    /// (`step::follow`). A collective call.
-    pub(super) fn make_density_whole(
+    /// Some of the fields, `fields`, whole on every rank where the fields
+    /// are apart (the rest stay apart): what a reader of those alone needs
+    /// (a build of the geometry reads the density, `step::follow`; the
+    /// observables the plastic strain and the temperature,
+    /// [`super::Mlpg3d::share_observed`]). A collective call.
+    pub(super) fn make_some_whole(
         &self,
         ranks: &dyn Ranks,
         parts: &[Range<usize>],
-        rho: &mut [f64],
+        fields: &mut [&mut [f64]],
     ) {
         if self.apart {
-            crate::ranks::gather_parts(ranks, parts, rho);
-        }
-    }
-
-    /// The plastic strain and the temperature `(eps_p, temp)` whole on
-    /// every rank, where the fields are apart (the rest stay apart): what
-    /// the observables read ([`super::Mlpg3d::share_observed`]). A
-    /// collective call.
-    pub(super) fn make_observed_whole(
-        &self,
-        ranks: &dyn Ranks,
-        parts: &[Range<usize>],
-        (eps_p, temp): (&mut [f64], &mut [f64]),
-    ) {
-        if self.apart {
-            crate::ranks::gather_parts(ranks, parts, eps_p);
-            crate::ranks::gather_parts(ranks, parts, temp);
+            for f in fields {
+                crate::ranks::gather_parts(ranks, parts, f);
+            }
         }
     }
 }
@@ -248,11 +236,7 @@ fn reads_outside(
     if n > 0 {
         read[0] = true;
     }
-    for j in g.nodal.held.clone() {
-        for q in g.nodal.column(j) {
-            read[g.nodal.nodes[q]] = true;
-        }
-    }
+    g.mark_column_reads(&mut read);
     if shifting {
         for i in g.rows[rank].clone() {
             read[i] = true;

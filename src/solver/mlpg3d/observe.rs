@@ -374,10 +374,10 @@ impl Mlpg3d {
         self.state.material_state.share(ranks, wire);
         let n = self.state.pos.len();
         let parts = self.pipe.balance.parts(ranks, n).to_vec();
-        self.pipe.halo.make_observed_whole(
+        self.pipe.halo.make_some_whole(
             ranks,
             &parts,
-            (&mut self.state.eps_p, &mut self.state.temp),
+            &mut [&mut self.state.eps_p, &mut self.state.temp],
         );
     }
 

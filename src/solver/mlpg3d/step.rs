@@ -290,7 +290,7 @@ fn follow(
         let n = state.pos.len();
         let parts = pipe.balance.parts(&*pipe.ranks, n);
         pipe.halo
-            .make_density_whole(&*pipe.ranks, parts, &mut state.rho);
+            .make_some_whole(&*pipe.ranks, parts, &mut [&mut state.rho]);
         if supports {
             state.supports_at.clone_from(&state.pos);
         }
