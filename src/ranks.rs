@@ -283,15 +283,10 @@ pub fn gather_records<T, W>(
     // The width: the longest encoding of any rank's values.
     let longest = out[own.clone()]
         .par_iter()
-        .map(|v| {
-            let len = postcard::experimental::serialized_size(&to(v)).expect("a value encodes");
-            assert!(len <= RECORD_MAX, "a record fits RECORD_MAX bytes: {len}");
-            len
-        })
+        .map(|v| encoded_len(&to(v)))
         .max()
         .unwrap_or(0);
-    ranks.at(std::panic::Location::caller());
-    let width = usize::try_from(ranks.all_max(longest as i64)).unwrap_or(0);
+    let width = record_width(ranks, longest);
     if width == 0 {
         return;
     }
@@ -315,6 +310,87 @@ pub fn gather_records<T, W>(
                 .expect("a rank's record decodes");
             from(slot, w);
         });
+}
+
+/// [`gather_records`] of listed rows: each rank's rows `lists[rank]` (no
+/// row in two lists) travel to every rank, in records of one width (the
+/// longest encoding of any listed value) through `wire`, and `from` writes
+/// each other rank's; a row in no list is left as it was. The damage
+/// variables of the points that change rank at a new split of the material
+/// pass (`MaterialState::hand_over`). Nothing travels where no rank lists
+/// a row.
+///
+/// # Panics
+///
+/// As [`gather_records`].
+#[track_caller]
+pub fn gather_records_listed<T, W>(
+    ranks: &dyn Ranks,
+    lists: &[Vec<usize>],
+    out: &mut [T],
+    wire: &mut Vec<u8>,
+    to: impl Fn(&T) -> W + Sync,
+    from: impl Fn(&mut T, W),
+) where
+    T: Send + Sync,
+    W: serde::Serialize + serde::de::DeserializeOwned,
+{
+    use rayon::prelude::*;
+    if ranks.size() == 1 {
+        return;
+    }
+    let me = ranks.rank();
+    let longest = lists[me]
+        .par_iter()
+        .map(|&i| encoded_len(&to(&out[i])))
+        .max()
+        .unwrap_or(0);
+    let width = record_width(ranks, longest);
+    if width == 0 {
+        return;
+    }
+    let mut at = Vec::with_capacity(lists.len() + 1);
+    at.push(0);
+    for l in lists {
+        at.push(at[at.len() - 1] + l.len());
+    }
+    wire.clear();
+    wire.resize(at[lists.len()] * width, 0);
+    let out_ref: &[T] = out;
+    wire[at[me] * width..at[me + 1] * width]
+        .par_chunks_mut(width)
+        .zip(&lists[me])
+        .for_each(|(slot, &i)| {
+            postcard::to_slice(&to(&out_ref[i]), slot).expect("a record fits its width");
+        });
+    let counts: Vec<usize> = lists.iter().map(|l| l.len() * width).collect();
+    ranks.at(std::panic::Location::caller());
+    ranks.all_gather_in_place(&counts, &mut wire[..]);
+    for (r, list) in lists.iter().enumerate().filter(|&(r, _)| r != me) {
+        for (k, &i) in list.iter().enumerate() {
+            let slot = &wire[(at[r] + k) * width..(at[r] + k + 1) * width];
+            // The same program encoded them: a failure is a fault, not input.
+            from(
+                &mut out[i],
+                postcard::from_bytes(slot).expect("a rank's record decodes"),
+            );
+        }
+    }
+}
+
+/// The length of a value's encoding, at most [`RECORD_MAX`].
+fn encoded_len<W: serde::Serialize>(w: &W) -> usize {
+    let len = postcard::experimental::serialized_size(w).expect("a value encodes");
+    assert!(len <= RECORD_MAX, "a record fits RECORD_MAX bytes: {len}");
+    len
+}
+
+/// The records' width: the longest of each rank's `longest` encoding (a
+/// collective call).
+#[track_caller]
+fn record_width(ranks: &dyn Ranks, longest: usize) -> usize {
+    ranks.at(std::panic::Location::caller());
+    usize::try_from(ranks.all_max(longest as i64)).unwrap_or(0)
 }
 
 /// Every rank's `mine`, of any length, joined in rank order, with each

@@ -943,7 +943,10 @@ mod tests {
     /// cracks and their openings, JH-2 and comminuted), while a rank's
     /// points outside its part keep what they held; after `share` every
     /// rank holds every point's variables, and a second `share` changes
-    /// nothing. `share_now` shares at once. Oracle: the whole state, and
+    /// nothing. `share_now` shares at once. Between them a new split
+    /// (`hand_over`): each rank then holds current variables on its new
+    /// part and at each point that changed rank, and the rest as it was
+    /// (`gather_records_listed`). Oracle: the whole state, and
     /// `Marks::of` against the `PointState` queries it stands for.
     #[test]
     fn the_ranks_keep_the_variables_apart_and_the_marks_whole() {
@@ -1010,14 +1013,51 @@ mod tests {
                     mine.after_pass(ranks, &parts, share_now, &mut wire);
                     let marks = mine.marks().to_vec();
                     let apart: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
+                    // A new split: each cut moved on by two points (rank
+                    // 0's part grows, the last one's shrinks).
+                    let moved: Vec<std::ops::Range<usize>> = parts
+                        .iter()
+                        .enumerate()
+                        .map(|(r, p)| {
+                            let cut = |c: usize| if c == 0 || c == n { c } else { (c + 2).min(n) };
+                            cut(p.start)..if r + 1 == size { n } else { cut(p.end) }
+                        })
+                        .collect();
+                    mine.hand_over(ranks, &moved, &mut wire);
+                    let handed: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
                     mine.share(ranks, &mut wire);
                     let shared: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
                     mine.share(ranks, &mut wire);
                     let again: Vec<Vars> = mine.points.iter().map(|p| p.vars).collect();
-                    (own, marks, apart, shared, again)
+                    let mine_now = moved[ranks.rank()].clone();
+                    (
+                        own,
+                        marks,
+                        apart,
+                        (parts, moved, mine_now, handed),
+                        shared,
+                        again,
+                    )
                 });
                 let expected: Vec<Vars> = whole.points.iter().map(|p| p.vars).collect();
-                for (own, marks, apart, shared, again) in got {
+                for (own, marks, apart, (parts, moved, mine_now, handed), shared, again) in got {
+                    // After the hand-over each rank holds current variables
+                    // on its new part and at every point that changed rank;
+                    // any other point is as it was.
+                    let owner = |p: &[std::ops::Range<usize>], i: usize| {
+                        p.iter().position(|r| r.contains(&i))
+                    };
+                    let mut travelled = 0;
+                    for i in 0..n {
+                        let went = owner(&parts, i) != owner(&moved, i);
+                        travelled += usize::from(went);
+                        if mine_now.contains(&i) || went {
+                            assert_eq!(handed[i], expected[i], "{size} ranks, handed point {i}");
+                        } else {
+                            assert_eq!(handed[i], apart[i], "{size} ranks, point {i}");
+                        }
+                    }
+                    assert!(travelled > 0, "the split moved");
                     assert_eq!(marks, all, "{size} ranks");
                     for i in 0..n {
                         let stale = base.points[3].vars;

@@ -292,16 +292,26 @@ mod tests {
     /// The quarter rod of [`run`], on `ranks` or alone, with the halo's
     /// checks `(wider, poison)`.
     fn quarter_rod(ranks: Option<crate::ranks::Handle>, check: (bool, bool)) -> Mlpg3d {
+        quarter_rod_of(ranks, check, plastic_steel(), 400.0)
+    }
+
+    /// The quarter rod of [`run`] of `material` at `speed` (m/s).
+    fn quarter_rod_of(
+        ranks: Option<crate::ranks::Handle>,
+        check: (bool, bool),
+        material: crate::material::Material,
+        speed: f64,
+    ) -> Mlpg3d {
         let cylinder = Cylinder {
             radius: 2e-3,
             length: 60e-3,
         };
-        let mut setup = RodSetup::new(cylinder, 4, 400.0, 1.0);
+        let mut setup = RodSetup::new(cylinder, 4, speed, 1.0);
         setup.quarter = true;
         setup.scheme.forces = Forces::Nodal;
         setup.scheme.order = SmoothingOrder::Two;
         setup.scheme.shifting = 0.1;
-        let mut sim = Mlpg3d::new(setup, plastic_steel()).unwrap();
+        let mut sim = Mlpg3d::new(setup, material).unwrap();
         if let Some(r) = ranks {
             sim.set_ranks(r);
         }
@@ -363,6 +373,65 @@ mod tests {
             let got = crate::ranks::tests::on_thread_handles(size, |h| observed(Some(h)));
             for (rank, bits) in got.iter().enumerate() {
                 assert!(*bits == alone, "{size} ranks, rank {rank}");
+            }
+        }
+    }
+
+    /// Where the material pass's split of the points among the ranks moves,
+    /// the damage variables of the points that change rank go with them
+    /// (`MaterialState::hand_over`; the others stay apart): a quarter AD85
+    /// rod at 600 m/s, 150 steps on 2 and 3 ranks, gives the bits of one
+    /// rank in its node fields and in every point's damage variables, the
+    /// split moved (a block of each rank booked dear in turn, and the
+    /// moves counted) while the impact face cracks. Without
+    /// the hand-over, rank 1's new points step from stale variables and
+    /// the bits differ.
+    #[test]
+    fn the_damage_variables_follow_their_points_to_a_new_rank() {
+        use crate::material::rajendran_grove::RajendranGrove;
+        let steps = 150;
+        let ceramic =
+            || crate::material::Material::ceramic(RajendranGrove::ad85(), 880.0, 1.0, 293.0);
+        let run = |ranks: Option<crate::ranks::Handle>| {
+            let mut sim = quarter_rod_of(ranks, (false, false), ceramic(), 600.0);
+            let n = sim.state.pos.len();
+            let mut splits = Vec::new();
+            for step in 0..steps {
+                sim.step().unwrap();
+                // The first block made dear, then the last, in turn, by
+                // the rank that holds it: the split moves every 10 steps
+                // whatever the clock measures.
+                let rank = sim.pipe.ranks.rank();
+                let own = sim.pipe.balance.parts(&*sim.pipe.ranks, n)[rank].clone();
+                let dear = if (step / 10) % 2 == 0 { 0 } else { n - 1 };
+                if own.contains(&dear) {
+                    let align = super::super::update::MATERIAL_ALIGN;
+                    sim.pipe.balance.book(dear / align, 1.0);
+                }
+                let parts = sim.pipe.balance.parts(&*sim.pipe.ranks, n).to_vec();
+                if splits.last() != Some(&parts) {
+                    splits.push(parts);
+                }
+            }
+            sim.share();
+            let s = &sim.state;
+            let mut bits: Vec<u64> = s.vel.iter().flatten().map(|v| v.to_bits()).collect();
+            bits.extend(s.dev.iter().flatten().map(|v| v.to_bits()));
+            bits.extend(s.pressure.iter().chain(&s.rho).map(|v| v.to_bits()));
+            let damage = postcard::to_allocvec(&s.material_state).expect("the state encodes");
+            (bits, damage, splits.len())
+        };
+        let (bits, damage, _) = run(None);
+        assert!(damage.len() > 1000, "the rod has damage variables");
+        for size in [2, 3] {
+            let got = crate::ranks::tests::on_thread_handles(size, |h| run(Some(h)));
+            for (rank, (b, d, splits)) in got.iter().enumerate() {
+                assert!(*splits > 1, "{size} ranks: the split moved");
+                assert!(*b == bits, "{size} ranks, rank {rank}: the node fields");
+                assert!(
+                    *d == damage,
+                    "{size} ranks, rank {rank}: the damage variables"
+                );
             }
         }
     }

@@ -73,7 +73,9 @@ pub(super) struct ShiftBuffers {
     pub(super) shift_wire: Vec<[f64; 3]>,
     /// How each node may move.
     pub(super) free: Vec<Freedom>,
-    /// The carried fields ([`CARRIED`]) before and after the carry.
+    /// The carried fields ([`CARRIED`]) before the carry (the columns:
+    /// the nodes, then the mirror images; only those the carry reads are
+    /// current) and after it.
     pub(super) carried: Vec<[f64; CARRIED]>,
     pub(super) carried_out: Vec<[f64; CARRIED]>,
     /// The shifted nodes' carried fields as they travel among the ranks.
@@ -97,7 +99,6 @@ pub(super) struct ImageBuffers {
     pub(super) mass: Vec<f64>,
     pub(super) group: Vec<u8>,
     pub(super) loose: Vec<bool>,
-    pub(super) carried: Vec<[f64; CARRIED]>,
 }
 
 /// What the velocity update saw at a node.
@@ -142,7 +143,6 @@ impl Scratch {
         let s = &mut self.shifting;
         fit(&mut s.shift, n, [0.0; 3]);
         fit(&mut s.free, n, Freedom::Fixed);
-        fit(&mut s.carried, n, [0.0; CARRIED]);
         fit(&mut s.carried_out, n, [0.0; CARRIED]);
     }
 

@@ -30,9 +30,6 @@ use crate::solver::mlpg3d::State3d;
 use crate::solver::mlpg3d::kinetic1;
 use crate::solver::shared::SHIFT_CAP;
 use crate::solver::shared::SHIFT_RANGE;
-use rayon::iter::IndexedParallelIterator;
-use rayon::iter::IntoParallelRefMutIterator;
-use rayon::iter::ParallelIterator;
 
 /// Node shifting ([`super::shift`]): pushes apart the pairs closer than
 /// [`SHIFT_RANGE`] of the initial spacing and carries the fields of the
@@ -129,8 +126,13 @@ pub(super) fn shift(
         temp: &mut state.temp,
         reference: &mut state.reference,
     };
-    pack(&fields, frame.marks, &mut buffers.carried);
-    let carried = extended(images, &buffers.carried, &mut ext.carried, reflect_carried);
+    let carried = pack_read(
+        &fields,
+        &frame,
+        (ranks, &g.rows),
+        &buffers.shift,
+        &mut buffers.carried,
+    );
     // Only the shifted nodes' rows: the unpacking reads no other.
     carry_shifted_on(
         (ranks, &g.rows),
@@ -229,29 +231,66 @@ fn freedoms(
     });
 }
 
-/// The carried fields of every node ([`CARRIED`]).
-fn pack(fields: &ShiftedFields, marks: &[Marks], carried: &mut [[f64; CARRIED]]) {
-    carried.par_iter_mut().enumerate().for_each(|(i, f)| {
-        let (v, s, x) = (fields.vel[i], fields.dev[i], fields.reference[i]);
-        let opened = marks.get(i).map_or(0.0, Marks::opened);
-        *f = [
-            v[0],
-            v[1],
-            v[2],
-            s[0],
-            s[1],
-            s[2],
-            s[3],
-            s[4],
-            s[5],
-            fields.rho[i] * (1.0 + opened),
-            fields.eps_p[i],
-            fields.temp[i],
-            x[0],
-            x[1],
-            x[2],
-        ];
-    });
+/// The carried fields ([`CARRIED`]) of the columns that the carry of this
+/// rank's shifted nodes reads ([`carry_shifted_on`] over `parts`): each
+/// such node's and those of its shapes' row (an image's reflected from
+/// its node), written into `out` (the columns: the nodes, then the
+/// images); every other entry is left as it was, and nothing reads it.
+/// (Every node packed and the images extended cost every rank of
+/// `penetration`, 8 across, about 0.9 ms a step for the few dozen nodes
+/// that shift.)
+fn pack_read<'a>(
+    fields: &ShiftedFields,
+    frame: &ShiftFrame,
+    (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
+    shift: &[[f64; 3]],
+    out: &'a mut Vec<[f64; CARRIED]>,
+) -> &'a [[f64; CARRIED]] {
+    let (images, shapes) = (&frame.geometry.mirror, &frame.geometry.shapes);
+    let n = fields.pos.len();
+    out.resize(n + images.source.len(), [0.0; CARRIED]);
+    let at = |j: usize| {
+        if j < n {
+            pack(fields, frame.marks, j)
+        } else {
+            let k = j - n;
+            reflect_carried(&pack(fields, frame.marks, images.source[k]), images.flip[k])
+        }
+    };
+    for i in parts[ranks.rank()].clone() {
+        if shift[i] == [0.0; 3] {
+            continue;
+        }
+        out[i] = at(i);
+        for q in shapes.row(i) {
+            let j = shapes.nodes[q];
+            out[j] = at(j);
+        }
+    }
+    out
+}
+
+/// The carried fields of node `i` ([`CARRIED`]).
+fn pack(fields: &ShiftedFields, marks: &[Marks], i: usize) -> [f64; CARRIED] {
+    let (v, s, x) = (fields.vel[i], fields.dev[i], fields.reference[i]);
+    let opened = marks.get(i).map_or(0.0, Marks::opened);
+    [
+        v[0],
+        v[1],
+        v[2],
+        s[0],
+        s[1],
+        s[2],
+        s[3],
+        s[4],
+        s[5],
+        fields.rho[i] * (1.0 + opened),
+        fields.eps_p[i],
+        fields.temp[i],
+        x[0],
+        x[1],
+        x[2],
+    ]
 }
 
 /// The conservative carry's velocities ([`exchange`]): each moved node's

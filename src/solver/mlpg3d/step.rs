@@ -227,16 +227,17 @@ pub(super) fn step_with(
     }
     // The marks of the nodes on every rank; their damage variables stay
     // with the rank that stepped them (shared every step where the cracks
-    // shield: the zones read every node's), and are shared before the
-    // split of the points among the ranks moves.
+    // shield: the zones read every node's), and where the split of the
+    // points among the ranks moves, the points that change rank go to
+    // their new rank.
     // (The buffer taken out and put back: a step allocates nothing.)
+    let splits = pipe.balance.splits_at_end(ranks);
     if setup.damage_vars() {
-        let share_now = zones.is_some() || pipe.balance.splits_at_end(ranks);
         let mut wire = std::mem::take(&mut pipe.balance.wire);
         let parts = pipe.balance.parts(ranks, n);
         state
             .material_state
-            .after_pass(ranks, parts, share_now, &mut wire);
+            .after_pass(ranks, parts, zones.is_some(), &mut wire);
         pipe.balance.wire = wire;
     }
     let t = update::sum_on(
@@ -245,6 +246,12 @@ pub(super) fn step_with(
         state.clock.time,
     );
     pipe.balance.end_step(ranks);
+    if setup.damage_vars() && splits {
+        let mut wire = std::mem::take(&mut pipe.balance.wire);
+        let parts = pipe.balance.parts(ranks, n);
+        state.material_state.hand_over(ranks, parts, &mut wire);
+        pipe.balance.wire = wire;
+    }
     let t = t?;
     pipe.profile.lap(Phase::Material, &mut watch);
     state.energy.internal += t.internal;
