@@ -78,6 +78,8 @@ pub(super) struct ShiftBuffers {
     /// current) and after it.
     pub(super) carried: Vec<[f64; CARRIED]>,
     pub(super) carried_out: Vec<[f64; CARRIED]>,
+    /// Which columns of `carried` are current (a buffer of the pack).
+    pub(super) read: Vec<bool>,
     /// The shifted nodes' carried fields as they travel among the ranks.
     pub(super) wire: Vec<[f64; CARRIED]>,
     /// The change of each node's momentum in the conservative carry

@@ -131,7 +131,7 @@ pub(super) fn shift(
         &frame,
         (ranks, &g.rows),
         &buffers.shift,
-        &mut buffers.carried,
+        (&mut buffers.carried, &mut buffers.read),
     );
     // Only the shifted nodes' rows: the unpacking reads no other.
     carry_shifted_on(
@@ -236,6 +236,7 @@ fn freedoms(
 /// such node's and those of its shapes' row (an image's reflected from
 /// its node), written into `out` (the columns: the nodes, then the
 /// images); every other entry is left as it was, and nothing reads it.
+/// Each column is packed once (`read`, a buffer, marks those packed).
 /// (Every node packed and the images extended cost every rank of
 /// `penetration`, 8 across, about 0.9 ms a step for the few dozen nodes
 /// that shift.)
@@ -244,27 +245,29 @@ fn pack_read<'a>(
     frame: &ShiftFrame,
     (ranks, parts): (&dyn crate::ranks::Ranks, &[std::ops::Range<usize>]),
     shift: &[[f64; 3]],
-    out: &'a mut Vec<[f64; CARRIED]>,
+    (out, read): (&'a mut Vec<[f64; CARRIED]>, &mut Vec<bool>),
 ) -> &'a [[f64; CARRIED]] {
     let (images, shapes) = (&frame.geometry.mirror, &frame.geometry.shapes);
     let n = fields.pos.len();
-    out.resize(n + images.source.len(), [0.0; CARRIED]);
-    let at = |j: usize| {
-        if j < n {
-            pack(fields, frame.marks, j)
-        } else {
-            let k = j - n;
-            reflect_carried(&pack(fields, frame.marks, images.source[k]), images.flip[k])
-        }
+    let columns = n + images.source.len();
+    out.resize(columns, [0.0; CARRIED]);
+    read.clear();
+    read.resize(columns, false);
+    let shifted = || {
+        parts[ranks.rank()]
+            .clone()
+            .filter(|&i| shift[i] != [0.0; 3])
     };
-    for i in parts[ranks.rank()].clone() {
-        if shift[i] == [0.0; 3] {
-            continue;
-        }
-        out[i] = at(i);
-        for q in shapes.row(i) {
-            let j = shapes.nodes[q];
-            out[j] = at(j);
+    let row = |i: usize| std::iter::once(i).chain(shapes.row(i).map(|q| shapes.nodes[q]));
+    for j in shifted().flat_map(row) {
+        if !read[j] {
+            read[j] = true;
+            out[j] = if j < n {
+                pack(fields, frame.marks, j)
+            } else {
+                let k = j - n;
+                reflect_carried(&pack(fields, frame.marks, images.source[k]), images.flip[k])
+            };
         }
     }
     out
