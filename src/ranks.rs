@@ -349,11 +349,7 @@ pub fn gather_records_listed<T, W>(
     if width == 0 {
         return;
     }
-    let mut at = Vec::with_capacity(lists.len() + 1);
-    at.push(0);
-    for l in lists {
-        at.push(at[at.len() - 1] + l.len());
-    }
+    let at = list_offsets(lists);
     wire.clear();
     wire.resize(at[lists.len()] * width, 0);
     let out_ref: &[T] = out;
@@ -376,6 +372,17 @@ pub fn gather_records_listed<T, W>(
             );
         }
     }
+}
+
+/// Where each rank's list starts in the lists joined in rank order, and
+/// (last) their total length.
+fn list_offsets(lists: &[Vec<usize>]) -> Vec<usize> {
+    let mut at = Vec::with_capacity(lists.len() + 1);
+    at.push(0);
+    for l in lists {
+        at.push(at[at.len() - 1] + l.len());
+    }
+    at
 }
 
 /// The length of a value's encoding, at most [`RECORD_MAX`].
@@ -471,11 +478,7 @@ pub fn gather_listed<T: Plain + Default, F: ?Sized>(
         return;
     }
     let me = ranks.rank();
-    let mut at = Vec::with_capacity(lists.len() + 1);
-    at.push(0);
-    for l in lists {
-        at.push(at[at.len() - 1] + l.len());
-    }
+    let at = list_offsets(lists);
     wire.clear();
     wire.resize(at[lists.len()], T::default());
     for (w, &i) in wire[at[me]..at[me + 1]].iter_mut().zip(&lists[me]) {
