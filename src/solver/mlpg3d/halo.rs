@@ -405,7 +405,7 @@ mod tests {
                 let own = sim.pipe.balance.parts(&*sim.pipe.ranks, n)[rank].clone();
                 let dear = if (step / 10) % 2 == 0 { 0 } else { n - 1 };
                 if own.contains(&dear) {
-                    let align = super::super::update::MATERIAL_ALIGN;
+                    let align = super::super::balance::GRANULE;
                     sim.pipe.balance.book(dear / align, 1.0);
                 }
                 let parts = sim.pipe.balance.parts(&*sim.pipe.ranks, n).to_vec();

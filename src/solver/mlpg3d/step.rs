@@ -6,6 +6,7 @@
 use super::LOST_CONTACT;
 use super::LOST_DAMPING;
 use super::LOST_SMOOTHING;
+use super::balance::GRANULE;
 use super::geometry;
 use super::geometry::Geometry;
 use super::halo::HaloFields;
@@ -34,6 +35,7 @@ use rayon::iter::IndexedParallelIterator;
 use rayon::iter::IntoParallelRefIterator;
 use rayon::iter::IntoParallelRefMutIterator;
 use rayon::iter::ParallelIterator;
+use rayon::slice::ParallelSliceMut;
 
 /// The step with its buffers (reused from step to step: the step
 /// allocates nothing once they have their size).
@@ -158,21 +160,24 @@ pub(super) fn step_with(
         g.shapes
             .velocity_gradients_on(own, vel_ext, &mut scratch.grad);
     } else {
-        // By blocks, each booked with the material's cost of the block:
-        // a row's gradient costs by its entries, not as its point's
-        // material does, and the split balances both (booked with the
-        // material alone, rank 0 of `taylor3d` 10 across waited 1.0 s
+        // By granules, each booked with the material's cost of the
+        // granule: a row's gradient costs by its entries, not as its
+        // point's material does, and the split balances both (booked with
+        // the material alone, rank 0 of `taylor3d` 10 across waited 1.0 s
         // at the material's gather).
-        for start in own.clone().step_by(update::MATERIAL_ALIGN) {
-            let block = start..own.end.min(start + update::MATERIAL_ALIGN);
-            let watch = std::time::Instant::now();
-            g.shapes
-                .velocity_gradients_on(block, vel_ext, &mut scratch.grad);
-            pipe.balance.book(
-                start / update::MATERIAL_ALIGN,
-                watch.elapsed().as_secs_f64(),
-            );
-        }
+        let first = own.start;
+        scratch.grad[own.clone()]
+            .par_chunks_mut(GRANULE)
+            .zip(pipe.balance.costs_of(&own).par_iter_mut())
+            .enumerate()
+            .for_each(|(k, (rows, cost))| {
+                let watch = std::time::Instant::now();
+                let start = first + k * GRANULE;
+                for (j, l) in rows.iter_mut().enumerate() {
+                    *l = g.shapes.gradient(start + j, vel_ext);
+                }
+                *cost += watch.elapsed().as_secs_f64();
+            });
     }
     pipe.profile.lap(Phase::Gradients, &mut watch);
     // The tensile cracks' shielding zones of the step's start, where a
@@ -242,7 +247,7 @@ pub(super) fn step_with(
     }
     let t = update::sum_on(
         (ranks, pipe.balance.parts(ranks, n)),
-        &scratch.results,
+        &mut scratch.results,
         state.clock.time,
     );
     pipe.balance.end_step(ranks);
