@@ -380,11 +380,7 @@ pub(super) fn check_planes(pos: &[[f64; 3]], plane: &[u8], time: f64) -> Result<
     if plane.is_empty() {
         return Ok(());
     }
-    match pos
-        .par_iter()
-        .enumerate()
-        .find_first(|(_, x)| x[0] < 0.0 || x[1] < 0.0)
-    {
+    match super::util::first_where(pos, |x| x[0] < 0.0 || x[1] < 0.0).map(|i| (i, pos[i])) {
         Some((i, x)) => Err(Error::ThroughBoundary {
             particle: i,
             boundary: "symmetry plane",

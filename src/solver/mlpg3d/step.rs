@@ -20,6 +20,7 @@ use super::shielding::Shielding;
 use super::shifting;
 use super::update::{self, MaterialFields, MaterialInputs};
 use super::util::extended;
+use super::util::first_where;
 use super::wave_speed;
 use crate::ENERGY_ERROR_BOUND;
 use crate::Error;
@@ -321,11 +322,7 @@ fn follow(
 /// the rod has left the anvil, or it has been quiet for
 /// [`crate::solver::shared::QUIET_TRANSITS`] transits ([`QuietEnd`]).
 fn end_step(setup: &Setup3d, state: &mut State3d, t: &Tally, d_min: f64) -> Result<()> {
-    if let Some(i) = state
-        .pos
-        .par_iter()
-        .position_first(|x| !x.iter().all(|v| v.is_finite()))
-    {
+    if let Some(i) = first_where(&state.pos, |x| !x.iter().all(|v| v.is_finite())) {
         return Err(Error::NonFinite {
             field: "position",
             particle: i,
