@@ -182,7 +182,7 @@ pub mod internals {
         pub use crate::solver::mlpg3d::SMOOTHING;
         pub use crate::solver::mlpg3d::penetration::{Penetration, PenetrationSetup};
         pub use crate::solver::mlpg3d::scheme::{Forces, Lattice, MlpgScheme, SmoothingOrder};
-        pub use crate::solver::mlpg3d::{Body, Mlpg3d, RodSetup};
+        pub use crate::solver::mlpg3d::{Body, Mlpg3d, NodeOrder, RodSetup};
     }
     pub use crate::approx::msph::{Neighbourhood, Row2};
     pub use crate::kernel::kernel2;

@@ -664,6 +664,21 @@ pub(crate) mod tests {
         }
     }
 
+    /// `f()` on thread-rank `rank`; a panic aborts the test process: the
+    /// other thread-ranks would wait at their next collective for ever (a
+    /// test that planted a fault hung rather than failed).
+    fn or_abort<R>(rank: usize, f: impl FnOnce() -> R) -> R {
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+            Ok(r) => r,
+            Err(_) => {
+                eprintln!(
+                    "thread-rank {rank} panicked (above): aborting, as the others would wait"
+                );
+                std::process::abort()
+            }
+        }
+    }
+
     /// [`on_threads`] with each rank as a [`Handle`] (what a solver's
     /// `set_ranks` takes).
     pub(crate) fn on_thread_handles<R: Send>(
@@ -680,7 +695,7 @@ pub(crate) mod tests {
                         slots: slots.clone(),
                     }));
                     let f = &f;
-                    s.spawn(move || f(ranks))
+                    s.spawn(move || or_abort(rank, || f(ranks)))
                 })
                 .collect();
             handles.into_iter().map(|h| h.join().unwrap()).collect()
@@ -699,7 +714,7 @@ pub(crate) mod tests {
                         slots: slots.clone(),
                     };
                     let f = &f;
-                    s.spawn(move || f(&ranks))
+                    s.spawn(move || or_abort(rank, || f(&ranks)))
                 })
                 .collect();
             handles.into_iter().map(|h| h.join().unwrap()).collect()

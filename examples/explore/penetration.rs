@@ -146,6 +146,7 @@ fn seed_case(rings: usize, end_time: f64, smoothing: f64) -> Penetration {
         },
         until_outcome: false,
         clamped_rim: false,
+        node_order: meshless_impact::internals::mlpg::NodeOrder::Rings,
         radial_crack_radius: 0.0,
     };
     let projectile = Cylinder {

@@ -247,6 +247,36 @@ impl NodeLattice {
         self.position.len()
     }
 
+    /// The nodes in the order of [`bisection_order`] of their positions,
+    /// with the nodes' `extra` values (the symmetry planes of the quarter
+    /// model, say) and the sets following them.
+    pub fn bisected<T: Copy>(&self, extra: &[T]) -> (Self, Vec<T>) {
+        let order = bisection_order(&self.position);
+        let mut index = vec![0; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            index[old] = new;
+        }
+        let out = NodeLattice {
+            cylinder: self.cylinder,
+            position: order.iter().map(|&i| self.position[i]).collect(),
+            volume: order.iter().map(|&i| self.volume[i]).collect(),
+            surfaces: order.iter().map(|&i| self.surfaces[i]).collect(),
+            sets: RodSets {
+                face: self.sets.face.iter().map(|&i| index[i]).collect(),
+                mantle: self.sets.mantle.iter().map(|&i| index[i]).collect(),
+                tail: index.get(self.sets.tail).copied().unwrap_or(self.sets.tail),
+            },
+            radial_spacing: self.radial_spacing,
+            axial_spacing: self.axial_spacing,
+        };
+        let extra = if extra.is_empty() {
+            Vec::new()
+        } else {
+            order.iter().map(|&i| extra[i]).collect()
+        };
+        (out, extra)
+    }
+
     /// True when there are no nodes.
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
@@ -283,6 +313,46 @@ impl NodeLattice {
 /// Nodes on ring `k`: one on the axis, `6 k` on the others.
 fn nodes_on_ring(k: usize) -> usize {
     if k == 0 { 1 } else { 6 * k }
+}
+
+/// Nodes a leaf of [`bisection_order`]: within a leaf the nodes keep
+/// their order (ascending index).
+const BISECTION_LEAF: usize = 64;
+
+/// The indices of `points` in the order of a recursive coordinate
+/// bisection: the points are halved by count across the longest side of
+/// their bounding box (the lower coordinate first, ties by index), and
+/// each half is ordered the same way, down to [`BISECTION_LEAF`] points,
+/// which keep their order. Every contiguous range of the order is then a
+/// few compact pieces of space, whatever the body's shape: what the ranks'
+/// parts of the nodes, which are ranges of the nodes' order, need (the
+/// rings' layer-by-layer order cuts a thin, wide plate into layers, each
+/// read across its whole face by the next: docs/notes/2026-12-02-mpi-eleventh-steps.md).
+/// A function of the points alone: the same order on every rank.
+pub fn bisection_order(points: &[[f64; 3]]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    bisect(points, &mut order);
+    order
+}
+
+/// [`bisection_order`] of the points of `part`, in place.
+fn bisect(points: &[[f64; 3]], part: &mut [usize]) {
+    if part.len() <= BISECTION_LEAF {
+        part.sort_unstable();
+        return;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &i in part.iter() {
+        for d in 0..3 {
+            lo[d] = lo[d].min(points[i][d]);
+            hi[d] = hi[d].max(points[i][d]);
+        }
+    }
+    let axis = (0..3).fold(0, |a, d| if hi[d] - lo[d] > hi[a] - lo[a] { d } else { a });
+    part.sort_by(|&a, &b| points[a][axis].total_cmp(&points[b][axis]).then(a.cmp(&b)));
+    let (first, second) = part.split_at_mut(part.len() / 2);
+    bisect(points, first);
+    bisect(points, second);
 }
 
 #[cfg(test)]
@@ -399,5 +469,65 @@ mod tests {
         );
         assert!(m.iter().all(|&i| lat.position[i][1] == 0.0));
         assert_eq!(lat.position[lat.sets.tail], [0.0, 0.0, cyl.length]);
+    }
+
+    /// The bisection's order of a thin, wide plate (a quarter, 20 rings,
+    /// 4 layers: 1 715 nodes) is a permutation that carries each node's
+    /// volume, surfaces, plane and sets with it; its first half lies on
+    /// one side of a plane across the plate's longest side; and its
+    /// contiguous quarters are compact: the nodes with a neighbour (within
+    /// 1.5 spacings) in another quarter are under a third of those of the
+    /// rings' layer-by-layer quarters (the measured reason for the order:
+    /// docs/notes/2026-12-02-mpi-eleventh-steps.md).
+    #[test]
+    fn the_bisection_order_cuts_a_plate_into_compact_pieces() {
+        let plate = Cylinder {
+            radius: 20.0,
+            length: 4.0,
+        };
+        let (lat, plane) = NodeLattice::cylinder(plate, 20).quarter();
+        let (cut, on) = lat.bisected(&plane);
+        let n = lat.len();
+        let order = bisection_order(&lat.position);
+        let mut seen = vec![false; n];
+        for (new, &old) in order.iter().enumerate() {
+            assert!(!seen[old], "node {old} twice");
+            seen[old] = true;
+            assert_eq!(cut.position[new], lat.position[old]);
+            assert_eq!(cut.volume[new], lat.volume[old]);
+            assert_eq!(cut.surfaces[new], lat.surfaces[old]);
+            assert_eq!(on[new], plane[old]);
+        }
+        for (&a, &b) in cut.sets.face.iter().zip(&lat.sets.face) {
+            assert_eq!(cut.position[a], lat.position[b]);
+        }
+        // The first cut: across x or y (the quarter is 20 wide, 4 thick).
+        let half = n / 2;
+        let axis = if (0..half).all(|i| cut.position[i][0] <= cut.position[half][0]) {
+            0
+        } else {
+            1
+        };
+        let edge = (0..half)
+            .map(|i| cut.position[i][axis])
+            .fold(f64::MIN, f64::max);
+        assert!(
+            (half..n).all(|i| cut.position[i][axis] >= edge),
+            "not cut by a plane"
+        );
+        // Nodes with a neighbour in another of four contiguous ranges.
+        let ghosts = |x: &[[f64; 3]]| {
+            let part = |i: usize| 4 * i / n;
+            (0..n)
+                .filter(|&i| {
+                    (0..n).any(|j| {
+                        let d: f64 = (0..3).map(|k| (x[i][k] - x[j][k]).powi(2)).sum();
+                        part(j) != part(i) && d < 2.25
+                    })
+                })
+                .count()
+        };
+        let (rings, bisection) = (ghosts(&lat.position), ghosts(&cut.position));
+        assert!(3 * bisection < rings, "{bisection} against {rings}");
     }
 }

@@ -527,13 +527,51 @@ impl NodalShapes {
         rows: usize,
         ranks: &dyn crate::ranks::Ranks,
     ) -> Result<()> {
+        let shares = self.rebuild_share_on(points, supports, rows, ranks)?;
+        self.gather_shares(ranks, &shares);
+        Ok(())
+    }
+
+    /// Every rank's share `shares` of the rows (contiguous, in rank order,
+    /// covering the rows; each rank holding its own) to every rank, in
+    /// place. Nothing on one rank.
+    pub fn gather_shares(
+        &mut self,
+        ranks: &dyn crate::ranks::Ranks,
+        shares: &[std::ops::Range<usize>],
+    ) {
+        if ranks.size() == 1 {
+            return;
+        }
+        let entries: Vec<std::ops::Range<usize>> = shares
+            .iter()
+            .map(|r| self.offsets[r.start]..self.offsets[r.end])
+            .collect();
+        crate::ranks::gather_parts(ranks, &entries, &mut self.nodes);
+        crate::ranks::gather_parts(ranks, &entries, &mut self.phi);
+        crate::ranks::gather_parts(ranks, &entries, &mut self.grad);
+    }
+
+    /// [`NodalShapes::rebuild_rows_on`] without the gather of the rows:
+    /// every rank holds every row's length (`offsets`, whole) but the
+    /// entries of its own share only; the entries of the other rows are
+    /// left as they were (the caller sends the rows each rank reads:
+    /// `solver::mlpg3d::held`). Returns every rank's share.
+    pub fn rebuild_share_on(
+        &mut self,
+        points: &[[f64; 3]],
+        supports: &Supports,
+        rows: usize,
+        ranks: &dyn crate::ranks::Ranks,
+    ) -> Result<Vec<std::ops::Range<usize>>> {
         refill(&mut self.offsets, rows + 1, 0);
+        let shares = crate::ranks::shares(ranks, rows, ROWS_PER_BLOCK);
         if points.is_empty() {
             self.offsets.truncate(1);
             self.nodes.clear();
             self.phi.clear();
             self.grad.clear();
-            return Ok(());
+            return Ok(shares);
         }
         // The nodes of a row's body whose supports cover its node, by
         // class of radius: the test is ShapeRow::evaluate's own.
@@ -545,7 +583,6 @@ impl NodalShapes {
             |i: usize, out: &mut Vec<usize>| covers.sorted_into(&points[i], i, covering(i), out);
         // Pass 1: each row's length, into offsets[i + 1] (this rank's
         // share, then every rank's).
-        let shares = crate::ranks::shares(ranks, rows, ROWS_PER_BLOCK);
         let own = shares[ranks.rank()].clone();
         self.offsets[1 + own.start..1 + own.end]
             .par_iter_mut()
@@ -604,7 +641,7 @@ impl NodalShapes {
             .collect();
         let first = errors.into_iter().flatten().next();
         if ranks.size() == 1 {
-            return first.map_or(Ok(()), |(_, e)| Err(e));
+            return first.map_or(Ok(shares), |(_, e)| Err(e));
         }
         // The first failing row over the ranks, evaluated by every rank.
         let failing = ranks.all_min(first.as_ref().map_or(i64::MAX, |(i, _)| *i as i64));
@@ -627,14 +664,7 @@ impl NodalShapes {
                     time: 0.0,
                 }));
         }
-        let entries: Vec<std::ops::Range<usize>> = shares
-            .iter()
-            .map(|r| self.offsets[r.start]..self.offsets[r.end])
-            .collect();
-        crate::ranks::gather_parts(ranks, &entries, &mut self.nodes);
-        crate::ranks::gather_parts(ranks, &entries, &mut self.phi);
-        crate::ranks::gather_parts(ranks, &entries, &mut self.grad);
-        Ok(())
+        Ok(shares)
     }
 
     /// Number of nodes.

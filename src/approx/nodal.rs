@@ -203,8 +203,7 @@ impl NodalOperator {
         shapes: &NodalShapes,
         columns: usize,
     ) {
-        self.columns = columns;
-        self.parts = if ranks.size() == 1 {
+        let parts = if ranks.size() == 1 {
             std::iter::once(0..columns).collect()
         } else {
             // Equal shares of the rows left one rank waiting for the other
@@ -216,6 +215,23 @@ impl NodalOperator {
             }
             crate::ranks::weighted_parts(&weight, ranks.size())
         };
+        self.rebuild_parts_on(ranks, shapes, columns, parts);
+    }
+
+    /// [`NodalOperator::rebuild_on`] with every rank's columns `parts`
+    /// given (contiguous, in rank order, covering the columns). `shapes`
+    /// need hold only the rows that name this rank's columns: an entry
+    /// naming a node past the columns (a row this rank does not hold,
+    /// `solver::mlpg3d::held`) is skipped.
+    pub fn rebuild_parts_on(
+        &mut self,
+        ranks: &dyn crate::ranks::Ranks,
+        shapes: &NodalShapes,
+        columns: usize,
+        parts: Vec<Range<usize>>,
+    ) {
+        self.columns = columns;
+        self.parts = parts;
         self.held = self.parts[ranks.rank()].clone();
         column_offsets(shapes, self.held.clone(), &mut self.offsets);
         let entries = column_entries(shapes, &self.offsets, self.held.clone());

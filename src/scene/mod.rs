@@ -1091,9 +1091,9 @@ mod tests {
         }
         // taylor's and taylor3d's schemes for each of four choices,
         // penetration's scheme, its run_until, its plate_rim, its
-        // plate_model and its plate_ceramic, plate_impact's two plate
-        // materials and its plate_ceramic.
-        assert_eq!(seen, 16);
+        // plate_node_order, its plate_model and its plate_ceramic,
+        // plate_impact's two plate materials and its plate_ceramic.
+        assert_eq!(seen, 17);
     }
 
     /// A scheme sets its knobs; a knob set by hand overrides it whichever

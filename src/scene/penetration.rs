@@ -18,6 +18,7 @@ use crate::material::ceramic_block::{PLATE_CERAMIC, ceramic_material};
 use crate::material::choice::{MaterialChoice, Prefix};
 use crate::material::jh2_block::{JH_BLOCK, jh2_model};
 use crate::observe::PENETRATION_OBSERVABLES;
+use crate::solver::mlpg3d::NodeOrder;
 use crate::solver::mlpg3d::penetration::{Penetration, PenetrationSetup};
 use crate::solver::mlpg3d::scheme::MlpgScheme;
 use crate::solver::mlpg3d::{DAMPING, REBUILD_STRAIN, RodSetup};
@@ -225,6 +226,29 @@ const AFTER: &[ParamSpec] = &[
         "the plate's rim: 0 = free (the default, the seed's case: momentum is shared by projectile and plate \
          alone), 1 = clamped (the outer ring of plate nodes held still; README, \"Ballistic penetration\")",
     ),
+    levels_spec(
+        "plate_node_order",
+        0,
+        PLATE_NODE_ORDER,
+        "the order of the plate's nodes: 0 = rings, layer by layer (the default), 1 = recursive coordinate \
+         bisection, whose ranges are compact pieces of the plate: the ranks of an MPI run share the nodes by ranges, \
+         so with 1 they exchange a fifth to a sixth of what they do with 0 (docs/guide/mpi.md); the two orders \
+         sum in another order, so their answers differ by round-off grown over the run",
+    ),
+];
+
+/// The levels of `plate_node_order`.
+const PLATE_NODE_ORDER: &[Level] = &[
+    Level {
+        name: "rings",
+        description: "the plate's nodes layer by layer, ring by ring (the default)",
+        sets: &[],
+    },
+    Level {
+        name: "bisection",
+        description: "the plate's nodes in the order of a recursive coordinate bisection (for runs on several ranks)",
+        sets: &[],
+    },
 ];
 
 /// The levels of `plate_model`.
@@ -378,6 +402,11 @@ fn setup(s: &Scene) -> Result<(PenetrationSetup, (Material, Material), RodSetup)
         plate,
         until_outcome: v("run_until")? >= 0.5,
         clamped_rim: v("plate_rim")? >= 0.5,
+        node_order: if v("plate_node_order")? >= 0.5 {
+            NodeOrder::Bisection
+        } else {
+            NodeOrder::Rings
+        },
         radial_crack_radius: v("radial_crack_radius")?,
     };
     // False-safe: a radius that is not a number is refused too.

@@ -3,6 +3,8 @@
 //! nodes, the traction operator, and the pass over the named pairs that
 //! decides when they are rebuilt.
 
+use super::held;
+use super::held::HeldRows;
 use super::profile::Phase;
 use super::spheres;
 use super::util::at_time;
@@ -58,6 +60,9 @@ pub(super) struct Geometry {
     /// rank's part of `rows` that another rank's columns of `nodal` read
     /// in the smoothing's transpose ([`pass_lists`]); empty otherwise.
     pub(super) pass_send: Vec<Vec<usize>>,
+    /// The shapes' rows this rank holds (every row but on several ranks
+    /// with the nodal forces: [`super::held`]).
+    pub(super) held: HeldRows,
 }
 
 impl Geometry {
@@ -228,9 +233,36 @@ pub(super) fn build_geometry(
     let sup = g.supports.as_ref().expect("computed above");
     let mut buf = Vec::new();
     let pts = extended(&g.mirror, &state.built_at, &mut buf, mirror::vector);
-    g.shapes
-        .rebuild_rows_on(pts, sup, n, &*pipe.ranks)
-        .map_err(stamp)?;
+    let ranks = &*pipe.ranks;
+    // On several ranks with the nodal forces each rank keeps the rows it
+    // reads ([`super::held`]); the other schemes read them all. (The
+    // halo's wider check reads the rows of its reads' nodes: all.)
+    let apart = ranks.size() > 1 && setup.rod.scheme.forces == Forces::Nodal && !pipe.halo.wider();
+    let mut columns = None;
+    if apart {
+        let shares = g
+            .shapes
+            .rebuild_share_on(pts, sup, n, ranks)
+            .map_err(stamp)?;
+        g.rows = row_parts(ranks, &g.shapes, n);
+        let weight =
+            held::column_weights(ranks, &g.shapes, shares[ranks.rank()].clone(), pts.len());
+        let parts = crate::ranks::weighted_parts(&weight, ranks.size());
+        let material = pipe.balance.parts(ranks, n).to_vec();
+        let listed = pipe.halo.poisons();
+        g.held = HeldRows::after_build(
+            (ranks, listed),
+            &mut g.shapes,
+            shares,
+            [&g.rows, &parts, &material],
+        );
+        columns = Some(parts);
+    } else {
+        g.shapes
+            .rebuild_rows_on(pts, sup, n, ranks)
+            .map_err(stamp)?;
+        g.held = HeldRows::whole();
+    }
     pipe.profile.lap(Phase::Shapes, &mut watch);
     if setup.rod.scheme.forces == Forces::Conforming {
         // Node-wise arrays made on the pool: at 10^6 nodes a serial fill
@@ -285,7 +317,10 @@ pub(super) fn build_geometry(
             g.spheres.clear();
         }
     }
-    if setup.rod.scheme.forces.nodal() || setup.rod.scheme.order == SmoothingOrder::Two {
+    if let Some(parts) = columns {
+        g.nodal
+            .rebuild_parts_on(&*pipe.ranks, &g.shapes, pts.len(), parts);
+    } else if setup.rod.scheme.forces.nodal() || setup.rod.scheme.order == SmoothingOrder::Two {
         g.nodal.rebuild_on(&*pipe.ranks, &g.shapes, pts.len());
     } else {
         g.nodal = NodalOperator::default();

@@ -99,6 +99,18 @@ impl Halo {
         self.current = false;
     }
 
+    /// Whether the rows a rank neither owns nor receives are poisoned (a
+    /// test's check: the shapes' rows then go by their lists however many
+    /// they are, [`super::held`]).
+    pub(super) fn poisons(&self) -> bool {
+        self.poison
+    }
+
+    /// Whether the lists are widened by one support (a test's check).
+    pub(super) fn wider(&self) -> bool {
+        self.wider
+    }
+
     /// The fields are whole again on every rank (a restored state).
     pub(super) fn whole(&mut self) {
         self.apart = false;
@@ -346,6 +358,50 @@ mod tests {
             }
         }
     }
+    /// The shapes' rows each rank holds ([`super::super::held`]: only the
+    /// rows its passes read, the rest marked unread) give the bits of one
+    /// rank with the conservative carry too, which reads every shifted
+    /// node's row: the quarter rod of [`run`] with the carry, 120 steps on
+    /// 2 and 3 ranks, its rows apart on every rank from its first build on
+    /// the ranks.
+    #[test]
+    fn the_rows_apart_give_the_bits_of_one_rank_with_the_conservative_carry() {
+        let run = |ranks: Option<crate::ranks::Handle>| {
+            let several = ranks.is_some();
+            let mut sim = quarter_rod(ranks, (false, true));
+            sim.setup.rod.conservative_carry = true;
+            let mut apart = 0;
+            for _ in 0..120 {
+                sim.step().unwrap();
+                apart += usize::from(sim.pipe.geometry.as_ref().unwrap().held.apart());
+            }
+            // Apart from the first build on the ranks on (the geometry
+            // built before the ranks were set holds every row).
+            let builds = sim.state.rebuilds;
+            assert!(builds >= 3, "{builds} builds");
+            assert!(
+                if several { apart >= 60 } else { apart == 0 },
+                "{apart} steps apart"
+            );
+            sim.share();
+            let s = &sim.state;
+            s.pos
+                .iter()
+                .chain(&s.vel)
+                .flatten()
+                .chain(&s.pressure)
+                .map(|v| v.to_bits())
+                .collect::<Vec<u64>>()
+        };
+        let alone = run(None);
+        for size in [2, 3] {
+            let got = crate::ranks::tests::on_thread_handles(size, |h| run(Some(h)));
+            for (rank, bits) in got.iter().enumerate() {
+                assert!(*bits == alone, "{size} ranks, rank {rank}");
+            }
+        }
+    }
+
     /// A record's share ([`Mlpg3d::share_observed`]: the plastic strain
     /// and the temperature of the material fields, the rest left apart and
     /// poisoned) gives every rank the observables of one rank: the same

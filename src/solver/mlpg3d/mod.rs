@@ -79,6 +79,7 @@ pub mod contact;
 pub mod failure;
 mod geometry;
 mod halo;
+mod held;
 mod motion;
 mod observe;
 #[cfg(test)]
@@ -120,7 +121,7 @@ pub use observe::{Energies, MLPG_FIELDS};
 use profile::PhaseTimes;
 use scheme::Lattice;
 use scratch::Scratch;
-pub use setup::{Body, DAMPING, REBUILD_STRAIN, RodSetup, SMOOTHING};
+pub use setup::{Body, DAMPING, NodeOrder, REBUILD_STRAIN, RodSetup, SMOOTHING};
 use util::{kinetic, kinetic1, norm};
 
 /// A 3-D MLPG run of a rod striking a rigid smooth anvil, or of several
@@ -398,11 +399,14 @@ impl Mlpg3d {
         for (b, body) in others.iter().enumerate() {
             let d = density_of(&body.material)?;
             let mut l = NodeLattice::cylinder(body.cylinder, body.rings);
+            let mut on = Vec::new();
             if setup.quarter {
-                let (q, p) = l.quarter();
-                l = q;
-                plane.extend(p);
+                (l, on) = l.quarter();
             }
+            if body.node_order == NodeOrder::Bisection {
+                (l, on) = l.bisected(&on);
+            }
+            plane.extend(on);
             reach = reach.min(l.radial_spacing);
             let k = l.len();
             if body.clamped_rim {

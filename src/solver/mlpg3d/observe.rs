@@ -139,6 +139,12 @@ impl Mlpg3d {
     pub fn set_ranks(&mut self, ranks: crate::ranks::Handle) {
         self.pipe.ranks = ranks;
         self.pipe.halo.forget();
+        // Shapes built apart hold the rows of the old ranks' passes: the
+        // next step builds them again from the state's record of the last
+        // build (as a restored run does: the same bits).
+        if self.pipe.geometry.as_ref().is_some_and(|g| g.held.apart()) {
+            self.pipe.geometry = None;
+        }
         // The nodal operator built before holds the columns of the ranks
         // it was built for; each rank now holds its share of them.
         if let Some(g) = self.pipe.geometry.as_mut() {

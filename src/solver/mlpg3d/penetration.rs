@@ -39,6 +39,8 @@ pub struct PenetrationSetup {
     /// [`crate::solver::mlpg3d::Body::clamped_rim`]); false (the default,
     /// the seed's case): free.
     pub clamped_rim: bool,
+    /// The order of the plate's nodes ([`crate::solver::mlpg3d::Body::node_order`]).
+    pub node_order: crate::solver::mlpg3d::NodeOrder,
     /// The radius about the axis at which `radial_crack_count` counts the
     /// rear face's radial cracks (m); 0 (the default): the projectile's
     /// diameter, at most 0.8 of the plate's radius.
@@ -106,6 +108,7 @@ impl Penetration {
             velocity: 0.0,
             material: plate,
             clamped_rim: setup.clamped_rim,
+            node_order: setup.node_order,
         };
         let run = Mlpg3d::bodies(rod, projectile, vec![plate_body])?;
         Ok(Penetration { setup, run })

@@ -131,4 +131,33 @@ pub struct Body {
     /// still (their velocities zero, never shifted); a held node's
     /// reaction does no work. Default: free.
     pub clamped_rim: bool,
+    /// The order of its nodes: the rings' layers (the default, not
+    /// written, so that the setups saved before it keep their digests) or
+    /// a recursive coordinate bisection, whose ranges are compact pieces
+    /// of the body (the ranks' parts: [`NodeOrder`]).
+    #[serde(default, skip_serializing_if = "NodeOrder::is_rings")]
+    pub node_order: NodeOrder,
+}
+
+/// The order of a body's nodes. The ranks of a run share the nodes by
+/// contiguous ranges of it, and every pass sums in it; the same order
+/// gives the same bits on any number of ranks, another order other
+/// round-off.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum NodeOrder {
+    /// Layer by layer from the face, ring by ring from the axis
+    /// (`NodeLattice::cylinder`): a range of a thin, wide plate is a few
+    /// layers of its whole face.
+    #[default]
+    Rings,
+    /// Recursive coordinate bisection (`approx::lattice::bisection_order`):
+    /// a range is a few compact pieces.
+    Bisection,
+}
+
+impl NodeOrder {
+    /// Whether this is the rings' order (the default).
+    pub fn is_rings(&self) -> bool {
+        *self == NodeOrder::Rings
+    }
 }

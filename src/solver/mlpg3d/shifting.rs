@@ -58,29 +58,36 @@ use crate::solver::shared::SHIFT_RANGE;
 pub(super) fn shift(
     setup: &Setup3d,
     state: &mut State3d,
-    (g, ranks): (&Geometry, &dyn crate::ranks::Ranks),
+    (g, ranks): (&mut Geometry, &dyn crate::ranks::Ranks),
     scratch: &mut Scratch,
 ) -> Result<()> {
-    let frame = ShiftFrame {
-        geometry: g,
-        spacing: setup.d_min0,
-        anvil: setup.anvil,
-        nodal: setup.rod.scheme.forces.nodal(),
-        surfaces: &setup.lattice.surfaces,
-        contact: &state.contact,
-        plane: &setup.plane,
-        held: &setup.held,
-        mass: &setup.mass,
-        // Without damage variables no point has any to read (the same
-        // values as reading each point's empty ones, without the visit).
-        marks: if setup.damage_vars() {
-            state.material_state.marks()
-        } else {
-            &[]
-        },
-        materials: (&setup.material, &setup.others, &setup.group),
-        time: state.clock.time,
-    };
+    // The frame of the shifting's passes over `geometry`.
+    macro_rules! frame {
+        ($geometry:expr) => {
+            ShiftFrame {
+                geometry: $geometry,
+                spacing: setup.d_min0,
+                anvil: setup.anvil,
+                nodal: setup.rod.scheme.forces.nodal(),
+                surfaces: &setup.lattice.surfaces,
+                contact: &state.contact,
+                plane: &setup.plane,
+                held: &setup.held,
+                mass: &setup.mass,
+                // Without damage variables no point has any to read (the
+                // same values as reading each point's empty ones, without
+                // the visit).
+                marks: if setup.damage_vars() {
+                    state.material_state.marks()
+                } else {
+                    &[]
+                },
+                materials: (&setup.material, &setup.others, &setup.group),
+                time: state.clock.time,
+            }
+        };
+    }
+    let frame = frame!(&*g);
     let (buffers, ext) = (&mut scratch.shifting, &mut scratch.images);
     let images = &g.mirror;
     let reference = extended(images, &state.reference, &mut ext.built, mirror::vector);
@@ -116,6 +123,12 @@ pub(super) fn shift(
     if buffers.shift.iter().all(|d| *d == [0.0; 3]) {
         return Ok(());
     }
+    let conservative = setup.rod.conservative_carry;
+    if conservative {
+        // The conservative carry reads every shifted node's row.
+        g.held.follow_shifted(ranks, &mut g.shapes, &buffers.shift);
+    }
+    let frame = frame!(&*g);
     let mut fields = ShiftedFields {
         pos: &mut state.pos,
         vel: &mut state.vel,
@@ -141,7 +154,6 @@ pub(super) fn shift(
         &buffers.shift,
         (&mut buffers.carried_out, &mut buffers.wire),
     );
-    let conservative = setup.rod.conservative_carry;
     let mut ke = [0.0; 2];
     if conservative {
         ke[0] = kinetic(fields.vel, frame.mass);

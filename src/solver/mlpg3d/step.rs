@@ -138,13 +138,19 @@ pub(super) fn step_with(
     motion::check_planes(&state.pos, &setup.plane, state.clock.time)?;
     pipe.profile.lap(Phase::Move, &mut watch);
     if setup.rod.scheme.shifting > 0.0 {
-        let g = pipe.geometry.as_ref().expect("built before the step");
+        let g = pipe.geometry.as_mut().expect("built before the step");
         shifting::shift(setup, state, (g, &*pipe.ranks), scratch)?;
     }
     pipe.profile.lap(Phase::Shift, &mut watch);
     // 4. The geometry follows the body.
     let d_min = follow(setup, state, pipe, scratch, &mut watch)?;
-    // 5. Velocity gradients and the material.
+    // 5. Velocity gradients and the material. Each rank reads the rows of
+    // its part of the points: where the split moved, they follow it.
+    let n = state.pos.len();
+    let parts = pipe.balance.parts(&*pipe.ranks, n);
+    if let Some(g) = pipe.geometry.as_mut() {
+        g.held.follow_material(&*pipe.ranks, &mut g.shapes, parts);
+    }
     let g = pipe.geometry.as_ref().expect("built above");
     let vel_ext = extended(
         &g.mirror,
@@ -155,7 +161,6 @@ pub(super) fn step_with(
     // Each rank's rows of the material pass's part only (whole blocks of
     // its sums, balanced by cost: `balance.rs`).
     let ranks = &*pipe.ranks;
-    let n = state.pos.len();
     let own = pipe.balance.parts(ranks, n)[ranks.rank()].clone();
     if ranks.size() == 1 {
         g.shapes

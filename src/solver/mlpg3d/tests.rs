@@ -138,7 +138,7 @@ fn a_conservative_shift_keeps_the_momentum_and_books_its_energy() {
             let mut scratch = std::mem::take(&mut run.pipe.scratch);
             scratch.fit(n);
             scratch.fit_shift(n);
-            let g = run.pipe.geometry.as_ref().unwrap();
+            let g = run.pipe.geometry.as_mut().unwrap();
             super::shifting::shift(
                 &run.setup,
                 &mut run.state,
